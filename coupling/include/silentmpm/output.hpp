@@ -1,0 +1,56 @@
+#pragma once
+// Output files of a run (the contract in DESIGN.md):
+//   DIR/history.csv    first column `time`, then `<probe>.<field>` and `energy.<term>` columns
+//   DIR/summary.json   steps, dt, t_end, wall_seconds, particles, particle_updates_per_second,
+//                      energy {kinetic, elastic, dissipated, absorbed, external_work, ...}
+//   DIR/particles.h5 + DIR/particles.xdmf   particle snapshots that open in ParaView
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "silentmpm/particles.hpp"
+
+namespace smpm {
+
+class HistoryWriter {
+ public:
+  HistoryWriter() = default;
+  ~HistoryWriter();
+  HistoryWriter(const HistoryWriter&) = delete;
+  HistoryWriter& operator=(const HistoryWriter&) = delete;
+  // Opens path and writes the header line: "time," + columns joined by ','. Throws on failure.
+  void open(const std::string& path, const std::vector<std::string>& columns);
+  void row(double time, const std::vector<double>& values);  // %.9e, one line
+  void close();
+
+ private:
+  std::FILE* f_ = nullptr;
+  std::size_t ncol_ = 0;
+};
+
+// Particle snapshots: one HDF5 file with a group per snapshot ("/step_000123") holding datasets
+// of length N (double unless noted): x, y (as a N x 3 "xyz" dataset for XDMF), vx, vy, sxx, syy,
+// szz, sxy, J2, eps_p, mass, volume, body (int32). The XDMF sidecar (temporal collection of
+// Polyvertex grids) is rewritten after every snapshot so a partial run still opens.
+class SnapshotWriter {
+ public:
+  SnapshotWriter() = default;
+  ~SnapshotWriter();
+  SnapshotWriter(const SnapshotWriter&) = delete;
+  SnapshotWriter& operator=(const SnapshotWriter&) = delete;
+  // Creates DIR/<base>.h5 (truncating) and remembers DIR/<base>.xdmf. Throws std::runtime_error.
+  void open(const std::string& dir, const std::string& base = "particles");
+  void write(const Particles& p, long step, double time);
+  void close();
+  int count() const { return static_cast<int>(times_.size()); }
+
+ private:
+  long long file_ = -1;  // hid_t
+  std::string dir_, base_;
+  std::vector<double> times_;
+  std::vector<long> steps_;
+  std::vector<std::size_t> sizes_;
+  void write_xdmf() const;
+};
+
+}  // namespace smpm

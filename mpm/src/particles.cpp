@@ -1,0 +1,28 @@
+#include "silentmpm/particles.hpp"
+
+namespace smpm {
+
+namespace {
+template <class T>
+void apply(std::vector<T>& v, const std::vector<uint32_t>& perm) {
+  std::vector<T> out(v.size());
+  for (std::size_t k = 0; k < perm.size(); ++k) out[k] = v[perm[k]];
+  v.swap(out);
+}
+}  // namespace
+
+void Particles::resize(std::size_t n) {
+  for (auto* v : {&x, &y, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p}) v->resize(n, 0.0);
+  id.resize(n, 0);
+  body.resize(n, 0);
+  group.resize(n, 0);
+}
+
+void Particles::permute(const std::vector<uint32_t>& perm) {
+  for (auto* v : {&x, &y, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p}) apply(*v, perm);
+  apply(id, perm);
+  apply(body, perm);
+  apply(group, perm);
+}
+
+}  // namespace smpm

@@ -1,0 +1,762 @@
+#include "silentmpm/solver.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "silentmpm/shape.hpp"
+
+namespace smpm {
+
+const char* scheme_name(Scheme s) {
+  switch (s) {
+    case Scheme::USF: return "USF";
+    case Scheme::USL: return "USL";
+    case Scheme::MUSL: return "MUSL";
+  }
+  return "?";
+}
+
+const char* model_name(Model m) {
+  switch (m) {
+    case Model::Elastic: return "elastic";
+    case Model::VonMises: return "von_mises";
+  }
+  return "?";
+}
+
+// ------------------------------------------------------------------------------------------
+// Setup
+// ------------------------------------------------------------------------------------------
+
+std::size_t Solver::seed_rectangle(double x0, double y0, double x1, double y1, int n, int group,
+                                   int body, double vx0, double vy0) {
+  const double sp = grid.h / n;
+  const long cx = std::max(1L, std::lround((x1 - x0) / sp));
+  const long cy = std::max(1L, std::lround((y1 - y0) / sp));
+  const double dx = (x1 - x0) / cx, dy = (y1 - y0) / cy;
+  const double rho = materials.at(group).rho;
+  const std::size_t first = p.size();
+  p.resize(first + cx * cy);
+  std::size_t k = first;
+  for (long j = 0; j < cy; ++j)
+    for (long i = 0; i < cx; ++i, ++k) {
+      p.x[k] = x0 + (i + 0.5) * dx;
+      p.y[k] = y0 + (j + 0.5) * dy;
+      p.vx[k] = vx0;
+      p.vy[k] = vy0;
+      p.vol[k] = dx * dy;
+      p.mass[k] = rho * dx * dy;
+      p.id[k] = static_cast<uint32_t>(k);
+      p.body[k] = static_cast<uint16_t>(body);
+      p.group[k] = static_cast<uint16_t>(group);
+    }
+  return cx * cy;
+}
+
+BoundaryLayer Solver::select_layer(const std::string& name, int body, double ex0, double ey0,
+                                   double ex1, double ey1, double nx, double ny,
+                                   double width) const {
+  BoundaryLayer L;
+  L.name = name;
+  L.depth = width;
+  const double nn = std::hypot(nx, ny);
+  nx /= nn; ny /= nn;
+  const double tx = ex1 - ex0, ty = ey1 - ey0;
+  L.length = std::hypot(tx, ty);
+  const double tol = 1e-9 * grid.h;
+  double vsum = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if (p.body[k] != body) continue;
+    const double rx = p.x[k] - ex0, ry = p.y[k] - ey0;
+    const double dist = -(rx * nx + ry * ny);  // depth inside the body
+    const double s = (rx * tx + ry * ty) / (L.length * L.length);
+    if (dist < -tol || dist >= width - tol || s < -1e-9 || s > 1 + 1e-9) continue;
+    L.ids.push_back(p.id[k]);
+    L.idx.push_back(static_cast<uint32_t>(k));
+    L.nx.push_back(nx);
+    L.ny.push_back(ny);
+    L.w.push_back(p.vol[k]);
+    L.d.push_back(std::max(dist, 0.0));
+    vsum += p.vol[k];
+  }
+  if (vsum > 0) {
+    L.width = vsum / L.length;
+    for (double& w : L.w) w /= L.width;
+  }
+  return L;
+}
+
+std::vector<uint32_t> Solver::nodes_in_box(double x0, double y0, double x1, double y1) const {
+  std::vector<uint32_t> out;
+  const double tol = 1e-3 * grid.h;
+  for (int j = 0; j < grid.nny; ++j) {
+    const double y = grid.node_y(j);
+    if (y < y0 - tol || y > y1 + tol) continue;
+    for (int i = 0; i < grid.nnx; ++i) {
+      const double x = grid.node_x(i);
+      if (x < x0 - tol || x > x1 + tol) continue;
+      out.push_back(static_cast<uint32_t>(j * grid.nnx + i));
+    }
+  }
+  return out;
+}
+
+double Solver::critical_dt() const {
+  double cmax = 0;
+  for (const auto& m : materials) cmax = std::max(cmax, m.cd);
+  return cmax > 0 ? grid.h / cmax : std::numeric_limits<double>::infinity();
+}
+
+long Solver::first_particle_outside() const {
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (!grid.inside(p.x[k], p.y[k])) return static_cast<long>(k);
+  return -1;
+}
+
+void Solver::finalize() {
+  nthreads_ = opt.threads > 0 ? opt.threads : omp_get_max_threads();
+  nstrips_ = 2 * nthreads_;
+  double mmin = std::numeric_limits<double>::infinity();
+  for (double m : p.mass) mmin = std::min(mmin, m);
+  mass_floor_ = p.size() ? opt.mass_tolerance * mmin : 0.0;
+  std::fill(grid.fix.begin(), grid.fix.end(), 0);
+  for (const auto& c : constraints)
+    for (uint32_t n : c.nodes) grid.fix[n] |= c.mask;
+  // Dashpot coefficients from the material of each layer particle.
+  for (auto& s : silents) {
+    s.zn.resize(s.layer.idx.size());
+    s.zt.resize(s.layer.idx.size());
+    for (std::size_t k = 0; k < s.layer.idx.size(); ++k) {
+      const Material& m = materials[p.group[s.layer.idx[k]]];
+      s.zn[k] = s.a * m.rho * m.cd;
+      s.zt[k] = s.b * m.rho * m.cs;
+    }
+  }
+  sort_particles();
+  update_energies();
+  energy.initial = energy.kinetic + energy.elastic;
+}
+
+// Order particles by (strip, material group, cell row) with a stable counting sort. Strips are
+// bands of cell rows holding about the same number of particles.
+void Solver::sort_particles() {
+  const std::size_t n = p.size();
+  const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
+  const int ny = grid.ny;
+  std::vector<int> row(n);
+  std::vector<std::size_t> per_row(ny, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    int r = static_cast<int>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
+    r = std::clamp(r, 0, ny - 1);
+    row[k] = r;
+    ++per_row[r];
+  }
+  std::vector<int> strip_of_row(ny);
+  {
+    std::size_t acc = 0;
+    for (int r = 0; r < ny; ++r) {
+      int s = n ? static_cast<int>((acc + per_row[r] / 2) * nstrips_ / n) : 0;
+      strip_of_row[r] = std::min(s, nstrips_ - 1);
+      acc += per_row[r];
+    }
+  }
+  const std::size_t nkeys = static_cast<std::size_t>(nstrips_) * G * ny;
+  std::vector<uint32_t> count(nkeys + 1, 0);
+  std::vector<uint32_t> key(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    key[k] = (static_cast<uint32_t>(strip_of_row[row[k]]) * G + p.group[k]) * ny + row[k];
+    ++count[key[k] + 1];
+  }
+  for (std::size_t i = 0; i < nkeys; ++i) count[i + 1] += count[i];
+  ranges_.assign(static_cast<std::size_t>(nstrips_) * G, {0, 0});
+  for (int s = 0; s < nstrips_; ++s)
+    for (int g = 0; g < G; ++g) {
+      const std::size_t k0 = (static_cast<std::size_t>(s) * G + g) * ny;
+      ranges_[s * G + g] = {count[k0], count[k0 + ny]};
+    }
+  std::vector<uint32_t> perm(n);
+  for (std::size_t k = 0; k < n; ++k) perm[count[key[k]]++] = static_cast<uint32_t>(k);
+  p.permute(perm);
+  where_.assign(n, 0);
+  for (std::size_t k = 0; k < n; ++k) where_[p.id[k]] = static_cast<uint32_t>(k);
+  for (auto& tl : tractions)
+    for (std::size_t k = 0; k < tl.layer.ids.size(); ++k) tl.layer.idx[k] = where_[tl.layer.ids[k]];
+  for (auto& sl : silents)
+    for (std::size_t k = 0; k < sl.layer.ids.size(); ++k) sl.layer.idx[k] = where_[sl.layer.ids[k]];
+  refresh_strip_rows();
+  strips_ok_ = !strips_conflict();
+}
+
+void Solver::refresh_strip_rows() {
+  const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
+  strip_lo_.assign(nstrips_, std::numeric_limits<int>::max());
+  strip_hi_.assign(nstrips_, std::numeric_limits<int>::min());
+  for (int s = 0; s < nstrips_; ++s)
+    for (int g = 0; g < G; ++g)
+      for (uint32_t k = ranges_[s * G + g][0]; k < ranges_[s * G + g][1]; ++k) {
+        const int r = static_cast<int>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
+        strip_lo_[s] = std::min(strip_lo_[s], r);
+        strip_hi_[s] = std::max(strip_hi_[s], r);
+      }
+}
+
+// Two strips of one colour must not write a common node row: a strip touching cell rows
+// [lo, hi] writes node rows [lo, hi + 1].
+bool Solver::strips_conflict() const {
+  if (nthreads_ == 1) return false;
+  for (int a = 0; a < nstrips_; ++a) {
+    if (strip_lo_[a] > strip_hi_[a]) continue;
+    for (int b = a + 2; b < nstrips_; b += 2) {
+      if (strip_lo_[b] > strip_hi_[b]) continue;
+      if (strip_lo_[a] <= strip_hi_[b] + 1 && strip_lo_[b] <= strip_hi_[a] + 1) return true;
+    }
+  }
+  return false;
+}
+
+// ------------------------------------------------------------------------------------------
+// Loop helpers
+// ------------------------------------------------------------------------------------------
+
+// fn(begin, end, group, strip) for every range; no two concurrent ranges write one node.
+template <class Fn>
+void Solver::scatter_over_groups(Fn&& fn) {
+  const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
+  if (!strips_ok_ || nthreads_ == 1) {
+    for (int s = 0; s < nstrips_; ++s)
+      for (int g = 0; g < G; ++g) fn(ranges_[s * G + g][0], ranges_[s * G + g][1], g, s);
+    return;
+  }
+  for (int colour = 0; colour < 2; ++colour) {
+#pragma omp parallel for schedule(static, 1) num_threads(nthreads_)
+    for (int s = colour; s < nstrips_; s += 2)
+      for (int g = 0; g < G; ++g) fn(ranges_[s * G + g][0], ranges_[s * G + g][1], g, s);
+  }
+}
+
+// fn(begin, end, group, strip) for every range, strips in parallel (no scatter allowed).
+template <class Fn>
+void Solver::parallel_over_groups(Fn&& fn) {
+  const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
+#pragma omp parallel for schedule(static, 1) num_threads(nthreads_)
+  for (int s = 0; s < nstrips_; ++s)
+    for (int g = 0; g < G; ++g) fn(ranges_[s * G + g][0], ranges_[s * G + g][1], g, s);
+}
+
+// ------------------------------------------------------------------------------------------
+// Kernels
+// ------------------------------------------------------------------------------------------
+
+void Solver::reset_grid() {
+  const long n = static_cast<long>(grid.nodes());
+  double* m = grid.m.data();
+  double* px = grid.px.data();
+  double* py = grid.py.data();
+  double* fx = grid.fx.data();
+  double* fy = grid.fy.data();
+#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
+  for (long i = 0; i < n; ++i) {
+    m[i] = 0; px[i] = 0; py[i] = 0; fx[i] = 0; fy[i] = 0;
+  }
+  if (opt.scheme == Scheme::MUSL) {
+    std::fill(grid.qx.begin(), grid.qx.end(), 0.0);
+    std::fill(grid.qy.begin(), grid.qy.end(), 0.0);
+  }
+}
+
+void Solver::p2g(bool with_momentum, bool with_force) {
+  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h;
+  const int nnx = grid.nnx;
+  double* gm = grid.m.data();
+  double* gpx = grid.px.data();
+  double* gpy = grid.py.data();
+  double* gfx = grid.fx.data();
+  double* gfy = grid.fy.data();
+  const double* X = p.x.data(); const double* Y = p.y.data();
+  const double* VX = p.vx.data(); const double* VY = p.vy.data();
+  const double* M = p.mass.data(); const double* V = p.vol.data();
+  const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
+  scatter_over_groups([&](uint32_t b, uint32_t e, int, int) {
+    Bilinear sf;
+    for (uint32_t k = b; k < e; ++k) {
+      sf.eval(X[k], Y[k], x0, y0, ih);
+      const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
+      const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
+      if (with_momentum) {
+        const double mk = M[k], mvx = mk * VX[k], mvy = mk * VY[k];
+        for (int a = 0; a < 4; ++a) {
+          gm[nodes[a]] += mk * sf.N[a];
+          gpx[nodes[a]] += mvx * sf.N[a];
+          gpy[nodes[a]] += mvy * sf.N[a];
+        }
+      }
+      if (with_force) {
+        const double v = V[k], sxx = SXX[k], syy = SYY[k], sxy = SXY[k];
+        for (int a = 0; a < 4; ++a) {
+          gfx[nodes[a]] -= v * (sxx * sf.dNx[a] + sxy * sf.dNy[a]);
+          gfy[nodes[a]] -= v * (sxy * sf.dNx[a] + syy * sf.dNy[a]);
+        }
+      }
+    }
+  });
+}
+
+// Shape functions of boundary particle q of layer L at its anchor point; fills nodes[4].
+void Solver::layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, Bilinear& sf,
+                         long nodes[4]) const {
+  const uint32_t k = L.idx[q];
+  double x = p.x[k], y = p.y[k];
+  if (anchor == Anchor::Boundary) {
+    x += L.d[q] * L.nx[q];
+    y += L.d[q] * L.ny[q];
+  }
+  sf.eval_clamped(x, y, grid.x0, grid.y0, grid.inv_h, grid.nx, grid.ny);
+  const long n0 = static_cast<long>(sf.cj) * grid.nnx + sf.ci;
+  nodes[0] = n0; nodes[1] = n0 + 1; nodes[2] = n0 + grid.nnx + 1; nodes[3] = n0 + grid.nnx;
+}
+
+// Traction vector of load tl on particle q of its layer at the current time.
+static inline void traction_of(const TractionLoad& tl, std::size_t q, double f, double& tx,
+                               double& ty) {
+  const double nx = tl.layer.nx[q], ny = tl.layer.ny[q];
+  tx = f * (tl.normal * nx - tl.tangential * ny + tl.vx);
+  ty = f * (tl.normal * ny + tl.tangential * nx + tl.vy);
+}
+
+// LK dashpot traction for velocity (ux, uy) on particle q of layer sl (Eq. 21).
+static inline void dashpot_of(const SilentBoundary& sl, std::size_t q, double ux, double uy,
+                              double& tx, double& ty) {
+  const double nx = sl.layer.nx[q], ny = sl.layer.ny[q];
+  const double vn = ux * nx + uy * ny;
+  tx = -(sl.zn[q] * vn * nx + sl.zt[q] * (ux - vn * nx));
+  ty = -(sl.zn[q] * vn * ny + sl.zt[q] * (uy - vn * ny));
+}
+
+// Tractions and silent-layer dashpots carried by boundary particles (Eq. 16, 20, 21).
+void Solver::apply_loads() {
+  Bilinear sf;
+  long nodes[4];
+  for (const auto& tl : tractions) {
+    const double f = tl.fn(t);
+    if (f == 0.0) continue;
+    for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
+      double tx, ty;
+      traction_of(tl, q, f, tx, ty);
+      layer_shape(tl.layer, q, tl.anchor, sf, nodes);
+      for (int a = 0; a < 4; ++a) {
+        grid.fx[nodes[a]] += tx * tl.layer.w[q] * sf.N[a];
+        grid.fy[nodes[a]] += ty * tl.layer.w[q] * sf.N[a];
+      }
+    }
+  }
+  // Nodal dashpot blocks: clear the nodes assembled last step, then assemble
+  // C_i += (V_p / h) N_i [a rho c_d n n^T + b rho c_s (I - n n^T)].
+  for (long i : dashpot_nodes_) grid.cxx[i] = grid.cxy[i] = grid.cyy[i] = 0;
+  dashpot_nodes_.clear();
+  has_nodal_dashpot_ = false;
+  for (const auto& sl : silents) {
+    const auto& L = sl.layer;
+    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+      layer_shape(L, q, sl.anchor, sf, nodes);
+      if (sl.form == SilentForm::Particle) {  // lagged: the particle velocity of the last step
+        double tx, ty;
+        dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
+        for (int a = 0; a < 4; ++a) {
+          grid.fx[nodes[a]] += tx * L.w[q] * sf.N[a];
+          grid.fy[nodes[a]] += ty * L.w[q] * sf.N[a];
+        }
+        continue;
+      }
+      has_nodal_dashpot_ = true;
+      const double nx = L.nx[q], ny = L.ny[q], zn = sl.zn[q], zt = sl.zt[q];
+      const double bxx = zn * nx * nx + zt * (1 - nx * nx);
+      const double bxy = (zn - zt) * nx * ny;
+      const double byy = zn * ny * ny + zt * (1 - ny * ny);
+      for (int a = 0; a < 4; ++a) {
+        const double wn = L.w[q] * sf.N[a];
+        grid.cxx[nodes[a]] += wn * bxx;
+        grid.cxy[nodes[a]] += wn * bxy;
+        grid.cyy[nodes[a]] += wn * byy;
+        dashpot_nodes_.push_back(nodes[a]);
+      }
+    }
+  }
+}
+
+// Nodal velocities v = p / m (void nodes get zero) with the essential conditions applied.
+void Solver::nodal_velocity(std::vector<double>& ax, std::vector<double>& ay,
+                            const std::vector<double>& mx, const std::vector<double>& my) {
+  const long n = static_cast<long>(grid.nodes());
+  const double floor = mass_floor_;
+  const double* m = grid.m.data();
+  const uint8_t* fix = grid.fix.data();
+  double* vx = ax.data(); double* vy = ay.data();
+  const double* qx = mx.data(); const double* qy = my.data();
+#pragma omp parallel for schedule(static) num_threads(nthreads_)
+  for (long i = 0; i < n; ++i) {
+    if (m[i] > floor) {
+      vx[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
+      vy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
+    } else {
+      vx[i] = 0; vy[i] = 0;
+    }
+  }
+}
+
+// v+ = v + dt f / m; where a nodal dashpot block C is present,
+// (m + dt/2 C) v+ = (m - dt/2 C) v + dt f  (trapezoidal, unconditionally stable for C).
+void Solver::grid_update() {
+  nodal_velocity(grid.vx, grid.vy, grid.px, grid.py);
+  const long n = static_cast<long>(grid.nodes());
+  const double floor = mass_floor_, h = 0.5 * dt, DT = dt;
+  const bool damp = has_nodal_dashpot_;
+  const double* m = grid.m.data();
+  const uint8_t* fix = grid.fix.data();
+  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
+  const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
+  const double* cxx = grid.cxx.data(); const double* cxy = grid.cxy.data();
+  const double* cyy = grid.cyy.data();
+  double* ux = grid.vnx.data(); double* uy = grid.vny.data();
+#pragma omp parallel for schedule(static) num_threads(nthreads_)
+  for (long i = 0; i < n; ++i) {
+    const double mi = m[i];
+    if (mi <= floor) { ux[i] = 0; uy[i] = 0; continue; }
+    double a = 0, b = 0;
+    if (damp && (cxx[i] != 0 || cyy[i] != 0 || cxy[i] != 0)) {
+      const double rx = mi * vx[i] - h * (cxx[i] * vx[i] + cxy[i] * vy[i]) + DT * fx[i];
+      const double ry = mi * vy[i] - h * (cxy[i] * vx[i] + cyy[i] * vy[i]) + DT * fy[i];
+      const double A = mi + h * cxx[i], B = h * cxy[i], D = mi + h * cyy[i];
+      switch (fix[i] & 3) {
+        case 0: {
+          const double det = A * D - B * B;
+          a = (D * rx - B * ry) / det;
+          b = (A * ry - B * rx) / det;
+          break;
+        }
+        case 1: b = ry / D; break;
+        case 2: a = rx / A; break;
+        default: break;
+      }
+    } else {
+      a = (fix[i] & 1) ? 0.0 : vx[i] + DT * fx[i] / mi;
+      b = (fix[i] & 2) ? 0.0 : vy[i] + DT * fy[i] / mi;
+    }
+    ux[i] = a; uy[i] = b;
+  }
+}
+
+// Work of tractions and energy absorbed by dashpots over the step, with the mid-step nodal
+// velocity (v + v+)/2, the velocity that the central-difference update makes conjugate.
+void Solver::boundary_work() {
+  Bilinear sf;
+  long nodes[4];
+  auto vbar = [&](long i, double& ax, double& ay) {
+    ax = 0.5 * (grid.vx[i] + grid.vnx[i]);
+    ay = 0.5 * (grid.vy[i] + grid.vny[i]);
+  };
+  for (const auto& tl : tractions) {
+    const double f = tl.fn(t);
+    if (f == 0.0) continue;
+    for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
+      double tx, ty, ax, ay;
+      traction_of(tl, q, f, tx, ty);
+      layer_shape(tl.layer, q, tl.anchor, sf, nodes);
+      for (int a = 0; a < 4; ++a) {
+        vbar(nodes[a], ax, ay);
+        energy.external_work += dt * tl.layer.w[q] * sf.N[a] * (tx * ax + ty * ay);
+      }
+    }
+  }
+  for (const auto& sl : silents) {
+    const auto& L = sl.layer;
+    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+      layer_shape(L, q, sl.anchor, sf, nodes);
+      for (int a = 0; a < 4; ++a) {
+        double ax, ay, tx, ty;
+        vbar(nodes[a], ax, ay);
+        // The dashpot acts on the particle velocity (paper form) or on each node's mid-step one.
+        if (sl.form == SilentForm::Particle) dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
+        else dashpot_of(sl, q, ax, ay, tx, ty);
+        energy.absorbed -= dt * L.w[q] * sf.N[a] * (tx * ax + ty * ay);
+      }
+    }
+  }
+}
+
+// Particle velocities from the grid (FLIP/PIC blend); MUSL re-maps the particle momenta to the
+// grid at the same positions; USF moves the particles here.
+void Solver::g2p_velocity(bool remap, bool move) {
+  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h, DT = dt;
+  const int nnx = grid.nnx;
+  const double flip = opt.flip, pic = 1.0 - opt.flip;
+  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
+  const double* ux = grid.vnx.data(); const double* uy = grid.vny.data();
+  double* qx = grid.qx.data(); double* qy = grid.qy.data();
+  double* X = p.x.data(); double* Y = p.y.data();
+  double* VX = p.vx.data(); double* VY = p.vy.data();
+  const double* M = p.mass.data();
+  auto body = [&](uint32_t b, uint32_t e, int, int s) {
+    Bilinear sf;
+    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
+    for (uint32_t k = b; k < e; ++k) {
+      sf.eval(X[k], Y[k], x0, y0, ih);
+      const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
+      const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
+      double dvx = 0, dvy = 0, wx = 0, wy = 0;
+      for (int a = 0; a < 4; ++a) {
+        const long i = nodes[a];
+        wx += sf.N[a] * ux[i];
+        wy += sf.N[a] * uy[i];
+        dvx += sf.N[a] * (ux[i] - vx[i]);
+        dvy += sf.N[a] * (uy[i] - vy[i]);
+      }
+      const double nvx = flip * (VX[k] + dvx) + pic * wx;
+      const double nvy = flip * (VY[k] + dvy) + pic * wy;
+      VX[k] = nvx; VY[k] = nvy;
+      if (remap) {
+        const double mvx = M[k] * nvx, mvy = M[k] * nvy;
+        for (int a = 0; a < 4; ++a) {
+          qx[nodes[a]] += mvx * sf.N[a];
+          qy[nodes[a]] += mvy * sf.N[a];
+        }
+      }
+      if (move) {
+        X[k] += DT * wx;
+        Y[k] += DT * wy;
+        const int r = static_cast<int>(std::floor((Y[k] - y0) * ih));
+        lo = std::min(lo, r); hi = std::max(hi, r);
+      }
+    }
+    if (move) {
+      strip_lo_[s] = std::min(strip_lo_[s], lo);
+      strip_hi_[s] = std::max(strip_hi_[s], hi);
+    }
+  };
+  if (move) {
+    std::fill(strip_lo_.begin(), strip_lo_.end(), std::numeric_limits<int>::max());
+    std::fill(strip_hi_.begin(), strip_hi_.end(), std::numeric_limits<int>::min());
+  }
+  if (remap) scatter_over_groups(body);
+  else parallel_over_groups(body);
+}
+
+namespace {
+// Stress update of one group with material model M: velocity gradient from the nodal field
+// (gx, gy), Jaumann rotation, strain increment, material update, volume; optionally the
+// particle moves with the updated nodal velocity (ux, uy).
+template <Model MODEL>
+double stress_range(uint32_t b, uint32_t e, const Material& mat, const Grid& grid,
+                    const double* gx, const double* gy, const double* ux, const double* uy,
+                    double dt, bool move, Particles& p, int& lo, int& hi) {
+  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h;
+  const int nnx = grid.nnx;
+  double* X = p.x.data(); double* Y = p.y.data();
+  double* V = p.vol.data();
+  double* SXX = p.sxx.data(); double* SYY = p.syy.data();
+  double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
+  double* EP = p.eps_p.data();
+  double diss = 0;
+  Bilinear sf;
+  for (uint32_t k = b; k < e; ++k) {
+    sf.eval(X[k], Y[k], x0, y0, ih);
+    const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
+    const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
+    double lxx = 0, lxy = 0, lyx = 0, lyy = 0, wx = 0, wy = 0;
+    for (int a = 0; a < 4; ++a) {
+      const long i = nodes[a];
+      lxx += gx[i] * sf.dNx[a];
+      lxy += gx[i] * sf.dNy[a];
+      lyx += gy[i] * sf.dNx[a];
+      lyy += gy[i] * sf.dNy[a];
+      wx += sf.N[a] * ux[i];
+      wy += sf.N[a] * uy[i];
+    }
+    double sxx = SXX[k], syy = SYY[k], szz = SZZ[k], sxy = SXY[k];
+    // Jaumann rotation with spin w = (dvx/dy - dvy/dx) / 2.
+    const double w = 0.5 * (lxy - lyx) * dt;
+    const double rxx = 2 * w * sxy, rxy = w * (syy - sxx);
+    sxx += rxx; syy -= rxx; sxy += rxy;
+    const double wp = stress_update<MODEL>(mat, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy,
+                                           szz, sxy, EP[k]);
+    SXX[k] = sxx; SYY[k] = syy; SZZ[k] = szz; SXY[k] = sxy;
+    V[k] *= (1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt;
+    diss += wp * V[k];
+    if (move) {
+      X[k] += dt * wx;
+      Y[k] += dt * wy;
+      const int r = static_cast<int>(std::floor((Y[k] - y0) * ih));
+      lo = std::min(lo, r); hi = std::max(hi, r);
+    }
+  }
+  return diss;
+}
+}  // namespace
+
+void Solver::update_stress_and_position(const std::vector<double>& gx,
+                                        const std::vector<double>& gy, bool move) {
+  std::vector<double> diss(nstrips_, 0.0);
+  if (move) {
+    std::fill(strip_lo_.begin(), strip_lo_.end(), std::numeric_limits<int>::max());
+    std::fill(strip_hi_.begin(), strip_hi_.end(), std::numeric_limits<int>::min());
+  }
+  parallel_over_groups([&](uint32_t b, uint32_t e, int g, int s) {
+    if (b == e) return;
+    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
+    const Material& mat = materials[g];
+    double d = 0;
+    switch (mat.model) {
+      case Model::Elastic:
+        d = stress_range<Model::Elastic>(b, e, mat, grid, gx.data(), gy.data(), grid.vnx.data(),
+                                         grid.vny.data(), dt, move, p, lo, hi);
+        break;
+      case Model::VonMises:
+        d = stress_range<Model::VonMises>(b, e, mat, grid, gx.data(), gy.data(),
+                                          grid.vnx.data(), grid.vny.data(), dt, move, p, lo, hi);
+        break;
+    }
+    diss[s] += d;
+    if (move) {
+      strip_lo_[s] = std::min(strip_lo_[s], lo);
+      strip_hi_[s] = std::max(strip_hi_[s], hi);
+    }
+  });
+  for (double d : diss) energy.dissipated += d;
+}
+
+void Solver::check_outside() {
+  // Rows are tracked per strip during the move; columns need a check only when a strip's
+  // rows or any particle left the grid, so do one cheap pass over x here.
+  bool bad = false;
+  for (int s = 0; s < nstrips_; ++s)
+    if (strip_lo_[s] <= strip_hi_[s] && (strip_lo_[s] < 0 || strip_hi_[s] >= grid.ny)) bad = true;
+  if (!bad) {
+    const double xa = grid.x0, xb = grid.x1();
+    const double* X = p.x.data();
+    const long n = static_cast<long>(p.size());
+    long found = n;
+#pragma omp parallel for reduction(min : found) num_threads(nthreads_)
+    for (long k = 0; k < n; ++k)
+      if (!(X[k] >= xa && X[k] < xb)) found = std::min(found, k);
+    if (found == n) {
+      strips_ok_ = !strips_conflict();
+      return;
+    }
+  }
+  const long k = first_particle_outside();
+  std::ostringstream o;
+  o << "particle " << (k >= 0 ? p.id[k] : 0) << " left the grid at step " << steps << " (t = " << t
+    << " s)";
+  if (k >= 0) o << " at (" << p.x[k] << ", " << p.y[k] << ")";
+  o << "; enlarge grid.size or check the loads";
+  throw std::runtime_error(o.str());
+}
+
+void Solver::step() {
+  if (!strips_ok_) sort_particles();
+  reset_grid();
+  switch (opt.scheme) {
+    case Scheme::USL:
+    case Scheme::MUSL:
+      p2g(true, true);
+      apply_loads();
+      grid_update();
+      boundary_work();
+      if (opt.scheme == Scheme::MUSL) {
+        g2p_velocity(true, false);
+        nodal_velocity(grid.qx, grid.qy, grid.qx, grid.qy);
+        update_stress_and_position(grid.qx, grid.qy, true);
+      } else {
+        g2p_velocity(false, false);
+        update_stress_and_position(grid.vnx, grid.vny, true);
+      }
+      break;
+    case Scheme::USF:
+      p2g(true, false);
+      nodal_velocity(grid.vx, grid.vy, grid.px, grid.py);
+      update_stress_and_position(grid.vx, grid.vy, false);
+      p2g(false, true);
+      apply_loads();
+      grid_update();
+      boundary_work();
+      g2p_velocity(false, true);
+      break;
+  }
+  t += dt;
+  ++steps;
+  check_outside();
+}
+
+// ------------------------------------------------------------------------------------------
+// Diagnostics
+// ------------------------------------------------------------------------------------------
+
+void Solver::update_energies() {
+  double ke = 0, el = 0;
+  const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
+  for (int s = 0; s < nstrips_; ++s)
+    for (int g = 0; g < G && !ranges_.empty(); ++g) {
+      const Material& m = materials[g];
+      for (uint32_t k = ranges_[s * G + g][0]; k < ranges_[s * G + g][1]; ++k) {
+        ke += 0.5 * p.mass[k] * (p.vx[k] * p.vx[k] + p.vy[k] * p.vy[k]);
+        el += p.vol[k] * elastic_energy_density(m, p.sxx[k], p.syy[k], p.szz[k], p.sxy[k]);
+      }
+    }
+  energy.kinetic = ke;
+  energy.elastic = el;
+}
+
+std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>& pts) const {
+  const std::size_t np = pts.size();
+  std::vector<ProbeSample> out(np);
+  if (np == 0) return out;
+  // Per probe: the 4 nodes of its cell; accumulate m, m*field for each.
+  struct Acc { double m[4] = {0, 0, 0, 0}, f[4][6] = {}; int ci, cj; Bilinear sf; };
+  std::vector<Acc> acc(np);
+  for (std::size_t q = 0; q < np; ++q) {
+    acc[q].sf.eval(pts[q][0], pts[q][1], grid.x0, grid.y0, grid.inv_h);
+    acc[q].ci = acc[q].sf.ci;
+    acc[q].cj = acc[q].sf.cj;
+  }
+  Bilinear sf;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    sf.eval(p.x[k], p.y[k], grid.x0, grid.y0, grid.inv_h);
+    for (std::size_t q = 0; q < np; ++q) {
+      Acc& A = acc[q];
+      if (std::abs(sf.ci - A.ci) > 1 || std::abs(sf.cj - A.cj) > 1) continue;
+      const double vals[6] = {p.sxx[k], p.syy[k], p.szz[k], p.sxy[k], p.vx[k], p.vy[k]};
+      for (int a = 0; a < 4; ++a) {
+        const int li = sf.ci + sf.di[a] - A.ci, lj = sf.cj + sf.dj[a] - A.cj;
+        if (li < 0 || li > 1 || lj < 0 || lj > 1) continue;
+        const int slot = lj == 0 ? li : 3 - li;  // node numbering of Bilinear
+        const double w = p.mass[k] * sf.N[a];
+        A.m[slot] += w;
+        for (int c = 0; c < 6; ++c) A.f[slot][c] += w * vals[c];
+      }
+    }
+  }
+  for (std::size_t q = 0; q < np; ++q) {
+    const Acc& A = acc[q];
+    double v[6] = {0, 0, 0, 0, 0, 0}, wsum = 0;
+    for (int a = 0; a < 4; ++a) {
+      if (A.m[a] <= 0) continue;
+      wsum += A.sf.N[a];
+      for (int c = 0; c < 6; ++c) v[c] += A.sf.N[a] * A.f[a][c] / A.m[a];
+    }
+    ProbeSample& s = out[q];
+    if (wsum <= 0) continue;
+    s.valid = true;
+    s.sxx = v[0] / wsum; s.syy = v[1] / wsum; s.szz = v[2] / wsum; s.sxy = v[3] / wsum;
+    s.vx = v[4] / wsum; s.vy = v[5] / wsum;
+    s.j2 = j2_of(s.sxx, s.syy, s.szz, s.sxy);
+  }
+  return out;
+}
+
+ProbeSample Solver::sample(double x, double y) const { return sample({{x, y}})[0]; }
+
+}  // namespace smpm

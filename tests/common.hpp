@@ -1,0 +1,79 @@
+#pragma once
+// Helpers shared by the physics tests: materials of REFERENCE.md §2 and the 1D column.
+#include <memory>
+
+#include "silentmpm/solver.hpp"
+
+namespace smpm::testing {
+
+inline Material tungsten(Model model = Model::Elastic, double sigma_y = 1.0e9) {
+  Material m;
+  m.name = "tungsten";
+  m.model = model;
+  m.E = 411e9; m.nu = 0.28; m.rho = 15000; m.sigma_y = sigma_y;
+  m.derive();
+  return m;
+}
+
+enum class End { Free, Silent, Fixed };
+
+struct ColumnSpec {
+  int cells = 100;          // column length in cells
+  int height = 4;           // cells across (rollers on top and bottom)
+  int ppc_side = 1;         // particles per cell side (1, 2, 3)
+  double h = 1e-3;
+  double cfl = 0.3;
+  bool shear = false;       // S wave: tangential traction, rollers hold vx
+  End end = End::Silent;
+  SilentForm form = SilentForm::Nodal;
+  Scheme scheme = Scheme::MUSL;
+  double amplitude = 100e6; // traction magnitude (compressive normal, or tangential)
+  TimeFunction fn;          // load history
+  double offset = 0;        // shift of the column start inside its first cell (partly filled cells)
+  int threads = 1;
+  Anchor anchor = Anchor::Boundary;
+};
+
+// A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
+inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
+  auto s = std::make_unique<Solver>();
+  s->materials.push_back(tungsten());
+  const double L = c.cells * c.h;
+  s->grid.init(-2 * c.h, 0.0, c.h, c.cells + 6, c.height);
+  s->seed_rectangle(c.offset, 0, c.offset + L, c.height * c.h, c.ppc_side, 0, 0, 0, 0);
+  const double top = c.height * c.h;
+  const uint8_t mask = c.shear ? 1 : 2;
+  s->constraints.push_back({"bottom", s->nodes_in_box(-1, 0, 1, 0), mask});
+  s->constraints.push_back({"top", s->nodes_in_box(-1, top, 1, top), mask});
+  TractionLoad tl;
+  tl.layer = s->select_layer("left", 0, c.offset, top, c.offset, 0, -1, 0, c.h);
+  if (c.shear) tl.tangential = c.amplitude; else tl.normal = -c.amplitude;
+  tl.fn = c.fn;
+  tl.anchor = c.anchor;
+  s->tractions.push_back(tl);
+  if (c.end == End::Silent) {
+    SilentBoundary sb;
+    sb.layer = s->select_layer("right", 0, c.offset + L, 0, c.offset + L, top, 1, 0, c.h);
+    sb.form = c.form;
+    sb.anchor = c.anchor;
+    s->silents.push_back(sb);
+  } else if (c.end == End::Fixed) {
+    const double xr = c.offset + L;
+    s->constraints.push_back({"right", s->nodes_in_box(xr - 1e-9, 0, xr + 1e-9, top), 3});
+  }
+  s->opt.scheme = c.scheme;
+  s->opt.threads = c.threads;
+  s->dt = c.cfl * c.h / s->materials[0].cd;
+  s->finalize();
+  return s;
+}
+
+inline TimeFunction sin2_pulse(double duration, double ramp) {
+  TimeFunction f;
+  f.kind = TimeFunction::Kind::Sin2Pulse;
+  f.duration = duration;
+  f.ramp = ramp;
+  return f;
+}
+
+}  // namespace smpm::testing

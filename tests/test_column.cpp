@@ -1,0 +1,234 @@
+// The 1D column with rollers (REFERENCE.md §4): arrival time, plateau, and what the right end
+// reflects (free, LK silent layer in both its forms).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common.hpp"
+
+using namespace smpm;
+using namespace smpm::testing;
+
+namespace {
+
+struct Trace {
+  std::vector<double> t, sxx, sxy, vx, vy;
+};
+
+// Run to t_end recording the probe at x.
+Trace run_probe(Solver& s, double x, double y, double t_end) {
+  Trace tr;
+  while (s.t < t_end - 0.5 * s.dt) {
+    s.step();
+    const auto p = s.sample(x, y);
+    tr.t.push_back(s.t); tr.sxx.push_back(p.sxx); tr.sxy.push_back(p.sxy);
+    tr.vx.push_back(p.vx); tr.vy.push_back(p.vy);
+  }
+  return tr;
+}
+
+
+}  // namespace
+
+// Step load: the front reaches x at x / c_d (within one cell), the plateau is -sigma0 and the
+// particle velocity sigma0 / (rho c_d), within 2 %.
+TEST(Column, ArrivalAndPlateauP) {
+  ColumnSpec c;
+  c.cells = 120;
+  c.end = End::Silent;
+  c.fn.kind = TimeFunction::Kind::Step;
+  c.fn.ramp = 12 * c.h / 5918.5;  // sin^2 rise over 12 cells, to limit Gibbs ringing
+  auto s = make_column(c);
+  const Material& m = s->materials[0];
+  const double xp = 40.5 * c.h;
+  const double t_end = (c.cells * c.h) / m.cd * 0.95 + c.fn.ramp;
+  const Trace tr = run_probe(*s, xp, 2 * c.h, t_end);
+  // Arrival: half-amplitude crossing, minus half the rise.
+  double t_half = -1;
+  for (std::size_t i = 0; i < tr.t.size(); ++i)
+    if (-tr.sxx[i] >= 0.5 * c.amplitude) { t_half = tr.t[i]; break; }
+  ASSERT_GT(t_half, 0);
+  const double t_arr = xp / m.cd;
+  EXPECT_NEAR(t_half - 0.5 * c.fn.ramp, t_arr, c.h / m.cd);
+  // Plateau: mean over the second half of the time after arrival + 10 cells.
+  double ss = 0, sv = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < tr.t.size(); ++i)
+    if (tr.t[i] > t_arr + c.fn.ramp + 10 * c.h / m.cd) { ss += tr.sxx[i]; sv += tr.vx[i]; ++n; }
+  ASSERT_GT(n, 50);
+  EXPECT_NEAR(ss / n, -c.amplitude, 0.02 * c.amplitude);
+  const double v0 = c.amplitude / (m.rho * m.cd);
+  EXPECT_NEAR(sv / n, v0, 0.02 * v0);
+}
+
+TEST(Column, ArrivalAndPlateauS) {
+  ColumnSpec c;
+  c.cells = 80;
+  c.shear = true;
+  c.end = End::Silent;
+  c.fn.kind = TimeFunction::Kind::Step;
+  c.fn.ramp = 12 * c.h / 3271.6;
+  auto s = make_column(c);
+  const Material& m = s->materials[0];
+  const double xp = 40.5 * c.h;
+  const double t_end = (c.cells * c.h) / m.cs * 0.95 + c.fn.ramp;
+  const Trace tr = run_probe(*s, xp, 2 * c.h, t_end);
+  double t_half = -1;
+  for (std::size_t i = 0; i < tr.t.size(); ++i)
+    if (std::abs(tr.sxy[i]) >= 0.5 * c.amplitude) { t_half = tr.t[i]; break; }
+  ASSERT_GT(t_half, 0);
+  const double t_arr = xp / m.cs;
+  EXPECT_NEAR(t_half - 0.5 * c.fn.ramp, t_arr, c.h / m.cs);
+  double ss = 0, sv = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < tr.t.size(); ++i)
+    if (tr.t[i] > t_arr + c.fn.ramp + 10 * c.h / m.cs) { ss += tr.sxy[i]; sv += tr.vy[i]; ++n; }
+  ASSERT_GT(n, 50);
+  // Tangential traction tau on the left end (s = (0, -1)) gives sigma_xy = +tau behind the front.
+  EXPECT_NEAR(std::abs(ss / n), c.amplitude, 0.02 * c.amplitude);
+  const double v0 = c.amplitude / (m.rho * m.cs);
+  EXPECT_NEAR(std::abs(sv / n), v0, 0.02 * v0);
+}
+
+// Energy reflected by the right end, by extended-domain differencing (REFERENCE.md §4.1): run A
+// has the boundary under test at x = L; run B is the same column three times as long (same
+// particles, same dt), so nothing comes back from its end in the window. At a time when the
+// incident pulse has left A and its reflection is inside, the energy of the field A - B on the
+// particles of A is the reflected energy. Pulse: sin^2 bell whose full width at half maximum is
+// `fwhm_cells` (its support is twice that).
+double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
+  const Material m = tungsten();
+  const double cw = c.shear ? m.cs : m.cd;
+  const double dur = 2.0 * fwhm_cells * c.h / cw;
+  c.fn = sin2_pulse(dur, 0.5 * dur);
+  auto A = make_column(c);
+  ColumnSpec cb = c;
+  cb.cells = 3 * c.cells;
+  cb.end = End::Free;
+  auto B = make_column(cb);
+  const double tstar = dur + 1.8 * c.cells * c.h / cw;
+  while (A->t < tstar - 0.5 * A->dt) A->step();
+  while (B->t < tstar - 0.5 * B->dt) B->step();
+  // Particles are seeded row by row; match them by lattice position.
+  const long na = static_cast<long>(c.cells) * c.ppc_side, nb = static_cast<long>(cb.cells) * c.ppc_side;
+  std::vector<long> of_b(B->p.size());
+  for (std::size_t k = 0; k < B->p.size(); ++k) of_b[B->p.id[k]] = static_cast<long>(k);
+  double er = 0;
+  for (std::size_t k = 0; k < A->p.size(); ++k) {
+    const long id = A->p.id[k], j = id / na, i = id % na;
+    const long kb = of_b[j * nb + i];
+    const double dvx = A->p.vx[k] - B->p.vx[kb], dvy = A->p.vy[k] - B->p.vy[kb];
+    er += 0.5 * A->p.mass[k] * (dvx * dvx + dvy * dvy) +
+          A->p.vol[k] * elastic_energy_density(m, A->p.sxx[k] - B->p.sxx[kb],
+                                               A->p.syy[k] - B->p.syy[kb],
+                                               A->p.szz[k] - B->p.szz[kb],
+                                               A->p.sxy[k] - B->p.sxy[kb]);
+  }
+  EXPECT_NEAR(A->energy.external_work, B->energy.external_work, 1e-9 * B->energy.external_work);
+  if (c.end == End::Silent && c.ppc_side == 1) {
+    // Energy balance with the dashpots: kinetic + elastic + absorbed = external work. (At 4 and 9
+    // particles per cell the FLIP particle kinetic energy exceeds the grid's by about 1 %.)
+    const double imb = std::abs(A->energy.imbalance()) / A->energy.external_work;
+    EXPECT_LE(imb, 0.01) << "energy imbalance";
+  }
+  return er / A->energy.external_work;
+}
+
+struct ReflectCase {
+  bool shear;
+  End end;
+  SilentForm form;
+  Anchor anchor;
+  int ppc_side;
+  double bound;  // reflected / incident <= bound (silent) or >= bound (free)
+  const char* label;
+};
+
+class ColumnReflection : public ::testing::TestWithParam<ReflectCase> {};
+
+TEST_P(ColumnReflection, ReflectedEnergy) {
+  const ReflectCase rc = GetParam();
+  ColumnSpec c;
+  c.cells = 100;
+  c.shear = rc.shear;
+  c.end = rc.end;
+  c.form = rc.form;
+  c.anchor = rc.anchor;
+  c.ppc_side = rc.ppc_side;
+  const double ratio = reflected_energy_ratio(c, 8);
+  std::printf("  [%s] reflected energy / incident = %.3e\n", rc.label, ratio);
+  if (rc.end == End::Free) EXPECT_GE(ratio, rc.bound);
+  else EXPECT_LE(ratio, rc.bound);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Ends, ColumnReflection,
+    ::testing::Values(
+        // Default: semi-implicit nodal dashpot at the boundary points (measured 9.1e-4 P,
+        // 7.1e-4 S at 1 ppc; 3.1e-4 P at 4 ppc).
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 1, 1e-3, "P default 1ppc"},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 2, 1e-3, "P default 4ppc"},
+        ReflectCase{true, End::Silent, SilentForm::Nodal, Anchor::Boundary, 1, 1e-3, "S default 1ppc"},
+        ReflectCase{true, End::Silent, SilentForm::Nodal, Anchor::Boundary, 3, 1e-3, "S default 9ppc"},
+        // The paper's Eq. 20-21 as written (lagged particle velocity, mapped at the particle):
+        // measured 1.5e-3 (P) and 2.1e-3 (S) at 1 ppc.
+        ReflectCase{false, End::Silent, SilentForm::Particle, Anchor::Particle, 1, 3e-3, "P paper form"},
+        ReflectCase{true, End::Silent, SilentForm::Particle, Anchor::Particle, 1, 3e-3, "S paper form"},
+        ReflectCase{false, End::Free, SilentForm::Nodal, Anchor::Boundary, 1, 0.95, "P free end"},
+        ReflectCase{true, End::Free, SilentForm::Nodal, Anchor::Boundary, 1, 0.95, "S free end"}),
+    [](const auto& info) {
+      std::string s = info.param.label;
+      for (char& ch : s) if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      return s;
+    });
+
+// Stability of the dashpot forms (REFERENCE.md §1). A pulse runs into the silent end of a short
+// column for 20 pulse lengths; a stable absorbing end leaves < 5 % of the input energy. The
+// column starts inside its first cell (offset) so the boundary cells are partly filled.
+//  * the paper's form (lagged particle velocity, mapped at the particle) is stable up to the
+//    bulk limit CFL = 1, because each node's dashpot share never exceeds m_i c / h;
+//  * the semi-implicit nodal form is stable everywhere;
+//  * a lagged dashpot mapped at the boundary point (where nodes can be nearly massless) is not:
+//    that is why the nodal form is the default.
+double energy_left_after(SilentForm form, Anchor anchor, double offset_cells, int ppc, double cfl) {
+  ColumnSpec c;
+  c.cells = 40;
+  c.end = End::Silent;
+  c.form = form;
+  c.anchor = anchor;
+  c.offset = offset_cells * c.h;
+  c.cfl = cfl;
+  c.ppc_side = ppc;
+  const double dur = 16 * c.h / 5918.5;
+  c.fn = sin2_pulse(dur, 0.5 * dur);
+  auto s = make_column(c);
+  try {
+    while (s->t < 20 * dur) s->step();
+  } catch (const std::exception&) {
+    return 1e300;  // blew up (particles left the grid)
+  }
+  s->update_energies();
+  const double e = s->energy.kinetic + s->energy.elastic;
+  return std::isfinite(e) ? e / s->energy.external_work : 1e300;
+}
+
+TEST(SilentStability, PaperFormStableUpToBulkLimit) {
+  for (int ppc : {1, 2})
+    for (double off : {0.0, 0.3, 0.45})
+      for (double cfl : {0.1, 0.3, 0.5, 0.7, 0.9, 1.0})
+        EXPECT_LT(energy_left_after(SilentForm::Particle, Anchor::Particle, off, ppc, cfl), 0.05)
+            << "ppc_side " << ppc << " offset " << off << " CFL " << cfl;
+}
+
+TEST(SilentStability, NodalFormStable) {
+  for (int ppc : {1, 2})
+    for (double off : {0.0, 0.3, 0.45})
+      for (double cfl : {0.1, 0.3, 0.5, 0.7, 0.9, 1.0})
+        EXPECT_LT(energy_left_after(SilentForm::Nodal, Anchor::Boundary, off, ppc, cfl), 0.05)
+            << "ppc_side " << ppc << " offset " << off << " CFL " << cfl;
+}
+
+TEST(SilentStability, LaggedDashpotOnLightBoundaryNodeFails) {
+  // Documented failure mode, kept as a regression guard for the choice of the default.
+  EXPECT_GT(energy_left_after(SilentForm::Particle, Anchor::Boundary, 0.3, 2, 0.3), 0.5);
+}
