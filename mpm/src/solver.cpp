@@ -386,6 +386,8 @@ void Solver::apply_loads() {
       }
     }
   }
+  std::sort(dashpot_nodes_.begin(), dashpot_nodes_.end());
+  dashpot_nodes_.erase(std::unique(dashpot_nodes_.begin(), dashpot_nodes_.end()), dashpot_nodes_.end());
 }
 
 // Nodal velocities v = p / m (void nodes get zero) with the essential conditions applied.
@@ -408,43 +410,45 @@ void Solver::nodal_velocity(std::vector<double>& ax, std::vector<double>& ay,
   }
 }
 
-// v+ = v + dt f / m; where a nodal dashpot block C is present,
+// v+ = v + dt f / m on every node; then, on the few nodes that carry a dashpot block C,
 // (m + dt/2 C) v+ = (m - dt/2 C) v + dt f  (trapezoidal, unconditionally stable for C).
+// The second loop touches only the boundary nodes, so the silent layer costs O(boundary).
 void Solver::grid_update() {
   nodal_velocity(grid.vx, grid.vy, grid.px, grid.py);
   const long n = static_cast<long>(grid.nodes());
-  const double floor = mass_floor_, h = 0.5 * dt, DT = dt;
-  const bool damp = has_nodal_dashpot_;
+  const double floor = mass_floor_, DT = dt;
   const double* m = grid.m.data();
   const uint8_t* fix = grid.fix.data();
   const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
   const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
-  const double* cxx = grid.cxx.data(); const double* cxy = grid.cxy.data();
-  const double* cyy = grid.cyy.data();
   double* ux = grid.vnx.data(); double* uy = grid.vny.data();
 #pragma omp parallel for schedule(static) num_threads(nthreads_)
   for (long i = 0; i < n; ++i) {
     const double mi = m[i];
     if (mi <= floor) { ux[i] = 0; uy[i] = 0; continue; }
+    ux[i] = (fix[i] & 1) ? 0.0 : vx[i] + DT * fx[i] / mi;
+    uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * fy[i] / mi;
+  }
+  if (!has_nodal_dashpot_) return;
+  const double h = 0.5 * dt;
+  for (long i : dashpot_nodes_) {
+    const double mi = m[i];
+    if (mi <= floor) continue;
+    const double cxx = grid.cxx[i], cxy = grid.cxy[i], cyy = grid.cyy[i];
+    const double rx = mi * vx[i] - h * (cxx * vx[i] + cxy * vy[i]) + DT * fx[i];
+    const double ry = mi * vy[i] - h * (cxy * vx[i] + cyy * vy[i]) + DT * fy[i];
+    const double A = mi + h * cxx, B = h * cxy, D = mi + h * cyy;
     double a = 0, b = 0;
-    if (damp && (cxx[i] != 0 || cyy[i] != 0 || cxy[i] != 0)) {
-      const double rx = mi * vx[i] - h * (cxx[i] * vx[i] + cxy[i] * vy[i]) + DT * fx[i];
-      const double ry = mi * vy[i] - h * (cxy[i] * vx[i] + cyy[i] * vy[i]) + DT * fy[i];
-      const double A = mi + h * cxx[i], B = h * cxy[i], D = mi + h * cyy[i];
-      switch (fix[i] & 3) {
-        case 0: {
-          const double det = A * D - B * B;
-          a = (D * rx - B * ry) / det;
-          b = (A * ry - B * rx) / det;
-          break;
-        }
-        case 1: b = ry / D; break;
-        case 2: a = rx / A; break;
-        default: break;
+    switch (fix[i] & 3) {
+      case 0: {
+        const double det = A * D - B * B;
+        a = (D * rx - B * ry) / det;
+        b = (A * ry - B * rx) / det;
+        break;
       }
-    } else {
-      a = (fix[i] & 1) ? 0.0 : vx[i] + DT * fx[i] / mi;
-      b = (fix[i] & 2) ? 0.0 : vy[i] + DT * fy[i] / mi;
+      case 1: b = ry / D; break;   // x held: solve for y alone
+      case 2: a = rx / A; break;   // y held
+      default: break;
     }
     ux[i] = a; uy[i] = b;
   }

@@ -1,0 +1,1040 @@
+// Case files: parsing, validation and construction of the Solver.
+//
+// The format is specified in docs/case-format-spec.txt and documented for users in
+// docs/case-reference.md. Every problem is reported as CaseError "<source>: <key path>: <what>",
+// where the key path is written like materials.tungsten.poisson or boundaries[2].time.duration.
+//
+// Structure of this file:
+//   * Ctx / Obj     a small key walker: wraps one JSON object and its key path, gives typed
+//                   getters with defaults, rejects unknown keys, and checks every key was used.
+//   * parse_text    JSON text -> document (with line/column errors and duplicate-key detection).
+//   * overrides     "a.b.0.c=value" edits applied before validation.
+//   * build         the sections in dependency order: grid, time, scheme, output, materials,
+//                   bodies, probes, seeding, boundaries, finalize, time step.
+#include "silentmpm/case.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <new>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+#include <nlohmann/json.hpp>
+
+namespace smpm {
+namespace {
+
+using ojson = nlohmann::ordered_json;
+
+// Largest grid (cells) and particle count a case may ask for; beyond these the allocation alone
+// would take tens of GB.
+constexpr double kMaxCells = 2e8;
+constexpr double kMaxParticles = 2e8;
+
+// Shortest form that reads back as v (so a value the user typed prints as typed), else 6 digits.
+std::string fmt(double v) {
+  char b[40];
+  for (int p = 1; p <= 12; ++p) {
+    std::snprintf(b, sizeof b, "%.*g", p, v);
+    if (std::strtod(b, nullptr) == v) return b;
+  }
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// 6 significant digits, rounded towards zero (a limit the user can copy without exceeding it).
+std::string fmt_down(double v) {
+  if (!(v > 0) || !std::isfinite(v)) return fmt(v);
+  const double scale = std::pow(10.0, 5 - std::floor(std::log10(v)));
+  return fmt(std::floor(v * scale + 1e-9) / scale);
+}
+
+std::string fmt_list(const std::vector<double>& v) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + fmt(v[i]);
+  return s + "]";
+}
+
+std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+std::string quoted_list(const std::vector<std::string>& v) {
+  std::vector<std::string> q;
+  for (const auto& s : v) q.push_back("\"" + s + "\"");
+  return join(q);
+}
+
+// "a string", "an array", ... for messages like "expected a number, got a string".
+std::string a_type(const ojson& v) {
+  switch (v.type()) {
+    case ojson::value_t::null: return "null";
+    case ojson::value_t::boolean: return "a boolean";
+    case ojson::value_t::number_integer:
+    case ojson::value_t::number_unsigned:
+    case ojson::value_t::number_float: return "a number";
+    case ojson::value_t::string: return "a string";
+    case ojson::value_t::array: return "an array";
+    case ojson::value_t::object: return "an object";
+    default: return "an unsupported value";
+  }
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                        std::tolower(static_cast<unsigned char>(b[j - 1]));
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (same ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// " (did you mean \"poisson\"?)" when a candidate is close to `word`, else "".
+std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_d = std::max<std::size_t>(2, word.size() / 3) + 1;
+  for (const auto& c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best_d) best_d = d, best = c;
+  }
+  return best.empty() ? "" : " (did you mean \"" + best + "\"?)";
+}
+
+bool starts_with(const std::string& s, const std::string& p) {
+  return s.size() >= p.size() && s.compare(0, p.size(), p) == 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Error context: the source name, and which key paths were set by command-line overrides (so a
+// bad value set by an override says so).
+struct Ctx {
+  std::string source;
+  std::vector<std::pair<std::string, std::string>> overridden;  // canonical path, override text
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    std::string m = source + ": " + (path.empty() ? "" : path + ": ") + what;
+    for (const auto& [p, text] : overridden)
+      if (!path.empty() && (path == p || starts_with(path, p + ".") || starts_with(path, p + "["))) {
+        m += " (value set by override '" + text + "')";
+        break;
+      }
+    throw CaseError(m);
+  }
+};
+
+std::string index_path(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+// Typed reading of one value at a known path.
+double as_number(const Ctx& ctx, const ojson& v, const std::string& path) {
+  if (!v.is_number()) ctx.fail(path, "expected a number, got " + a_type(v));
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) ctx.fail(path, "expected a finite number");
+  return d;
+}
+
+long as_integer(const Ctx& ctx, const ojson& v, const std::string& path) {
+  if (v.is_number_integer()) {  // signed or unsigned
+    if (v.is_number_unsigned() && v.get<std::uint64_t>() > 1000000000000ULL)
+      ctx.fail(path, "integer too large");
+    return static_cast<long>(v.get<std::int64_t>());
+  }
+  if (v.is_number_float()) {  // 1e3 parses as a float; accept it when it is a whole number
+    const double d = v.get<double>();
+    if (std::isfinite(d) && d == std::floor(d) && std::fabs(d) <= 1e12) return static_cast<long>(d);
+    ctx.fail(path, "expected an integer, got " + fmt(d));
+  }
+  ctx.fail(path, "expected an integer, got " + a_type(v));
+}
+
+std::string as_string(const Ctx& ctx, const ojson& v, const std::string& path) {
+  if (!v.is_string()) ctx.fail(path, "expected a string, got " + a_type(v));
+  return v.get<std::string>();
+}
+
+std::vector<double> as_numbers(const Ctx& ctx, const ojson& v, const std::string& path,
+                               std::size_t n) {
+  const std::string want = "expected an array of " + std::to_string(n) + " numbers";
+  if (!v.is_array()) ctx.fail(path, want + ", got " + a_type(v));
+  if (v.size() != n)
+    ctx.fail(path, want + ", got an array of " + std::to_string(v.size()) + " element" +
+                       (v.size() == 1 ? "" : "s"));
+  std::vector<double> out;
+  for (std::size_t i = 0; i < n; ++i) out.push_back(as_number(ctx, v[i], index_path(path, i)));
+  return out;
+}
+
+// One JSON object at a key path. Reads are recorded; done() rejects any key that was not read,
+// and allow() rejects keys outside a list up front (before a misspelt key can show up as a
+// "missing required key" of its correct spelling).
+class Obj {
+ public:
+  Obj(const Ctx& ctx, const ojson& j, std::string path)
+      : ctx_(&ctx), j_(&j), path_(std::move(path)) {
+    if (!j.is_object()) ctx.fail(path_, "expected an object, got " + a_type(j));
+  }
+
+  const std::string& path() const { return path_; }
+  std::string at(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const Ctx& ctx() const { return *ctx_; }
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    ctx_->fail(key.empty() ? path_ : at(key), what);
+  }
+  bool has(const std::string& key) const { return j_->contains(key); }
+
+  // Rejects every key not in `keys`. `where` qualifies the message ("for a fixed boundary").
+  void allow(const std::vector<std::string>& keys, const std::string& where = "") const {
+    for (const auto& item : j_->items()) {
+      if (std::find(keys.begin(), keys.end(), item.key()) != keys.end()) continue;
+      fail(item.key(), "unknown key" + (where.empty() ? "" : " " + where) +
+                           suggestion(item.key(), keys) + "; allowed: " + join(keys));
+    }
+  }
+  // Safety net: every key present must have been read by the parser.
+  void done() const {
+    std::vector<std::string> known(read_.begin(), read_.end());
+    for (const auto& item : j_->items())
+      if (!read_.count(item.key()))
+        fail(item.key(), "unknown key" + suggestion(item.key(), known));
+  }
+
+  const ojson* find(const std::string& key) {
+    read_.insert(key);
+    auto it = j_->find(key);
+    return it == j_->end() ? nullptr : &*it;
+  }
+  const ojson& need(const std::string& key) {
+    const ojson* v = find(key);
+    if (!v) fail(key, "missing required key");
+    return *v;
+  }
+
+  double num(const std::string& key) { return as_number(*ctx_, need(key), at(key)); }
+  double num(const std::string& key, double def) {
+    const ojson* v = find(key);
+    return v ? as_number(*ctx_, *v, at(key)) : def;
+  }
+  long integer(const std::string& key, long def) {
+    const ojson* v = find(key);
+    return v ? as_integer(*ctx_, *v, at(key)) : def;
+  }
+  std::string str(const std::string& key) { return as_string(*ctx_, need(key), at(key)); }
+  std::string str(const std::string& key, const std::string& def) {
+    const ojson* v = find(key);
+    return v ? as_string(*ctx_, *v, at(key)) : def;
+  }
+  bool boolean(const std::string& key, bool def) {
+    const ojson* v = find(key);
+    if (!v) return def;
+    if (!v->is_boolean()) fail(key, "expected true or false, got " + a_type(*v));
+    return v->get<bool>();
+  }
+  // A string from a fixed list; required when def is null.
+  std::string choice(const std::string& key, const std::vector<std::string>& options,
+                     const char* def = nullptr) {
+    const ojson* v = find(key);
+    if (!v) {
+      if (!def) fail(key, "missing required key (one of " + quoted_list(options) + ")");
+      return def;
+    }
+    const std::string s = as_string(*ctx_, *v, at(key));
+    if (std::find(options.begin(), options.end(), s) == options.end())
+      fail(key, "must be one of " + quoted_list(options) + ", got \"" + s + "\"" +
+                    suggestion(s, options));
+    return s;
+  }
+  std::vector<double> nums(const std::string& key, std::size_t n) {
+    return as_numbers(*ctx_, need(key), at(key), n);
+  }
+  std::vector<double> nums(const std::string& key, std::vector<double> def) {
+    const ojson* v = find(key);
+    return v ? as_numbers(*ctx_, *v, at(key), def.size()) : def;
+  }
+  Obj obj(const std::string& key) { return Obj(*ctx_, need(key), at(key)); }
+  const ojson& array(const std::string& key) {
+    const ojson& v = need(key);
+    if (!v.is_array()) fail(key, "expected an array, got " + a_type(v));
+    return v;
+  }
+
+  // Range checks on a value already read from `key`.
+  void gt(const std::string& key, double v, double lo) const {
+    if (!(v > lo)) fail(key, "must be > " + fmt(lo) + ", got " + fmt(v));
+  }
+  void ge(const std::string& key, double v, double lo) const {
+    if (!(v >= lo)) fail(key, "must be >= " + fmt(lo) + ", got " + fmt(v));
+  }
+  void lt(const std::string& key, double v, double hi) const {
+    if (!(v < hi)) fail(key, "must be < " + fmt(hi) + ", got " + fmt(v));
+  }
+  void le(const std::string& key, double v, double hi) const {
+    if (!(v <= hi)) fail(key, "must be <= " + fmt(hi) + ", got " + fmt(v));
+  }
+
+ private:
+  const Ctx* ctx_;
+  const ojson* j_;
+  std::string path_;
+  std::set<std::string> read_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// JSON text -> document. Errors carry line and column; a key given twice in one object is an
+// error (the JSON library would silently keep the last one).
+ojson parse_text(const std::string& text, const std::string& source) {
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;
+    std::size_t index = 0;
+  };
+  std::vector<Frame> stack;
+  auto path_to = [&](const std::string& last) {
+    std::string p;
+    for (std::size_t i = 0; i + 1 < stack.size(); ++i) {
+      if (stack[i].object)
+        p += (p.empty() ? "" : ".") + stack[i].key;
+      else
+        p += "[" + std::to_string(stack[i].index) + "]";
+    }
+    return p + (p.empty() ? "" : ".") + last;
+  };
+  const ojson::parser_callback_t cb = [&](int, ojson::parse_event_t ev, ojson& parsed) {
+    using E = ojson::parse_event_t;
+    switch (ev) {
+      case E::object_start: stack.push_back(Frame{true, {}, {}, 0}); break;
+      case E::array_start: stack.push_back(Frame{false, {}, {}, 0}); break;
+      case E::key: {
+        const std::string k = parsed.get<std::string>();
+        if (!stack.back().keys.insert(k).second)
+          throw CaseError(source + ": " + path_to(k) + ": key given twice");
+        stack.back().key = k;
+        break;
+      }
+      case E::value:
+        if (!stack.empty() && !stack.back().object) ++stack.back().index;
+        break;
+      case E::object_end:
+      case E::array_end:
+        stack.pop_back();
+        if (!stack.empty() && !stack.back().object) ++stack.back().index;
+        break;
+    }
+    return true;
+  };
+  try {
+    return ojson::parse(text, cb, /*allow_exceptions=*/true, /*ignore_comments=*/false);
+  } catch (const ojson::parse_error& e) {
+    // e.what(): "[json.exception.parse_error.101] parse error at line L, column C: <message>"
+    const std::string w = e.what();
+    static const std::regex re(R"(at line (\d+), column (\d+): (.*))");
+    std::smatch m;
+    if (std::regex_search(w, m, re))
+      throw CaseError(source + ": invalid JSON at line " + m[1].str() + ", column " + m[2].str() +
+                      ": " + m[3].str());
+    // Fallback: locate the byte offset ourselves.
+    std::size_t line = 1, col = 0;
+    for (std::size_t i = 0; i < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') ++line, col = 0;
+      else ++col;
+    }
+    throw CaseError(source + ": invalid JSON at line " + std::to_string(line) + ", column " +
+                    std::to_string(col) + ": " + w);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Overrides: "key.path=value"; the value is parsed as JSON, or taken as a string when it is not
+// valid JSON. Every element of the path but the last must exist; the last may be new (an object
+// key) or one past the end of an array (appends).
+void apply_override(Ctx& ctx, ojson& doc, const std::string& text) {
+  const std::string where = "override '" + text + "'";
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw CaseError(ctx.source + ": " + where + ": expected key.path=value");
+  const std::string keypath = text.substr(0, eq);
+  const std::string raw = text.substr(eq + 1);
+  std::vector<std::string> segs;
+  {
+    std::size_t b = 0;
+    while (true) {
+      const std::size_t d = keypath.find('.', b);
+      segs.push_back(keypath.substr(b, d == std::string::npos ? std::string::npos : d - b));
+      if (d == std::string::npos) break;
+      b = d + 1;
+    }
+  }
+  for (const auto& s : segs)
+    if (s.empty()) throw CaseError(ctx.source + ": " + where + ": empty key in path \"" + keypath + "\"");
+
+  ojson value;
+  try {
+    value = ojson::parse(raw);
+  } catch (const ojson::parse_error&) {
+    value = raw;
+  }
+
+  auto bad = [&](const std::string& path, const std::string& what) {
+    throw CaseError(ctx.source + ": " + where + ": " + path + ": " + what);
+  };
+  ojson* cur = &doc;
+  std::string path;  // canonical path walked so far
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    const std::string& s = segs[i];
+    const bool last = i + 1 == segs.size();
+    if (cur->is_object()) {
+      const std::string next = path.empty() ? s : path + "." + s;
+      if (last) {
+        (*cur)[s] = value;
+        path = next;
+        break;
+      }
+      auto it = cur->find(s);
+      if (it == cur->end())
+        bad(next, "does not exist" + (path.empty() ? std::string(" in the case")
+                                                   : " (no key \"" + s + "\" in " + path + ")"));
+      cur = &*it;
+      path = next;
+    } else if (cur->is_array()) {
+      if (s.find_first_not_of("0123456789") != std::string::npos || s.size() > 9)
+        bad(path, "is an array; \"" + s + "\" is not an index");
+      const std::size_t k = std::stoul(s);
+      const std::string next = index_path(path, k);
+      const std::string size_note =
+          " (" + path + " has " + std::to_string(cur->size()) + " element" +
+          (cur->size() == 1 ? "" : "s") + ")";
+      if (last) {
+        if (k < cur->size()) (*cur)[k] = value;
+        else if (k == cur->size()) cur->push_back(value);
+        else bad(next, "does not exist" + size_note);
+        path = next;
+        break;
+      }
+      if (k >= cur->size()) bad(next, "does not exist" + size_note);
+      cur = &(*cur)[k];
+      path = next;
+    } else {
+      bad(path, "is " + a_type(*cur) + ", it has no key \"" + s + "\"");
+    }
+  }
+  ctx.overridden.emplace_back(path, text);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sections.
+struct GridSpec {
+  double x0 = 0, y0 = 0, h = 0;
+  int nx = 0, ny = 0;
+  double x1() const { return x0 + nx * h; }
+  double y1() const { return y0 + ny * h; }
+  std::string describe() const {
+    return "[" + fmt(x0) + ", " + fmt(x1()) + "] x [" + fmt(y0) + ", " + fmt(y1()) + "]";
+  }
+};
+
+struct BodySpec {
+  std::string name;
+  int material = 0;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  int ppc = 1;
+  double vx = 0, vy = 0;
+};
+
+const std::vector<std::string> kSides = {"left", "right", "bottom", "top"};
+
+GridSpec parse_grid(Obj g) {
+  g.allow({"origin", "size", "cell"});
+  GridSpec s;
+  const auto org = g.nums("origin", std::vector<double>{0.0, 0.0});
+  const auto size = g.nums("size", 2);
+  for (int k = 0; k < 2; ++k)
+    if (!(size[k] > 0))
+      g.ctx().fail(index_path(g.at("size"), k), "must be > 0, got " + fmt(size[k]));
+  const double h = g.num("cell");
+  g.gt("cell", h, 0);
+  int n[2];
+  for (int k = 0; k < 2; ++k) {
+    const double ratio = size[k] / h;
+    if (ratio > kMaxCells)
+      g.fail("size", "too many cells (" + fmt(ratio) + " along " + (k ? "y" : "x") + ")");
+    const long c = std::lround(ratio);
+    if (c < 1 || !(std::fabs(c * h - size[k]) < 1e-6 * h))
+      g.fail("size", std::string(k ? "Ly" : "Lx") + " = " + fmt(size[k]) +
+                         " is not a multiple of cell = " + fmt(h));
+    n[k] = static_cast<int>(c);
+  }
+  if (static_cast<double>(n[0]) * n[1] > kMaxCells)
+    g.fail("size", "too many cells: " + std::to_string(n[0]) + " x " + std::to_string(n[1]) +
+                       " (the limit is " + fmt(kMaxCells) + ")");
+  g.done();
+  s.x0 = org[0];
+  s.y0 = org[1];
+  s.h = h;
+  s.nx = n[0];
+  s.ny = n[1];
+  return s;
+}
+
+Material parse_material(const Ctx& ctx, const std::string& name, const ojson& j) {
+  Obj m(ctx, j, "materials." + name);
+  const std::string model = m.choice("model", {"elastic", "von_mises"});
+  if (model == "elastic" && m.has("yield_stress"))
+    m.fail("yield_stress", "not used by model \"elastic\" (use \"von_mises\" for plasticity)");
+  std::vector<std::string> keys = {"model", "young", "poisson", "density"};
+  if (model == "von_mises") keys.push_back("yield_stress");
+  m.allow(keys, "for model \"" + model + "\"");
+  Material mat;
+  mat.name = name;
+  mat.model = model == "elastic" ? Model::Elastic : Model::VonMises;
+  mat.E = m.num("young");
+  m.gt("young", mat.E, 0);
+  mat.nu = m.num("poisson");
+  m.gt("poisson", mat.nu, -1);
+  m.lt("poisson", mat.nu, 0.5);
+  mat.rho = m.num("density");
+  m.gt("density", mat.rho, 0);
+  if (mat.model == Model::VonMises) {
+    mat.sigma_y = m.num("yield_stress");
+    m.gt("yield_stress", mat.sigma_y, 0);
+  }
+  m.done();
+  mat.derive();
+  return mat;
+}
+
+TimeFunction parse_time_function(Obj o) {
+  const std::string shape =
+      o.choice("shape", {"constant", "step", "rectangular", "triangular", "sin2", "table"},
+               "constant");
+  std::vector<std::string> keys = {"shape"};
+  if (shape == "step") keys.insert(keys.end(), {"start", "ramp"});
+  if (shape == "rectangular" || shape == "triangular") keys.insert(keys.end(), {"start", "duration"});
+  if (shape == "sin2") keys.insert(keys.end(), {"start", "duration", "ramp"});
+  if (shape == "table") keys.push_back("table");
+  if ((shape == "constant" || shape == "table") && o.has("start"))
+    o.fail("start", "not used by shape \"" + shape + "\"" +
+                        (shape == "constant" ? " (use \"step\" for a load that starts later)"
+                                             : " (the table times are absolute)"));
+  o.allow(keys, "for shape \"" + shape + "\"");
+
+  TimeFunction f;
+  if (shape != "constant" && shape != "table") {
+    f.start = o.num("start", 0.0);
+    o.ge("start", f.start, 0);
+  }
+  if (shape == "constant") f.kind = TimeFunction::Kind::Constant;
+  if (shape == "step") {
+    f.kind = TimeFunction::Kind::Step;
+    f.ramp = o.num("ramp", 0.0);
+    o.ge("ramp", f.ramp, 0);
+  }
+  if (shape == "rectangular" || shape == "triangular" || shape == "sin2") {
+    f.kind = shape == "rectangular"  ? TimeFunction::Kind::Rectangular
+             : shape == "triangular" ? TimeFunction::Kind::Triangular
+                                     : TimeFunction::Kind::Sin2Pulse;
+    f.duration = o.num("duration");
+    o.gt("duration", f.duration, 0);
+  }
+  if (shape == "sin2") {
+    f.ramp = o.num("ramp");
+    o.gt("ramp", f.ramp, 0);
+    if (!(f.ramp <= 0.5 * f.duration))
+      o.fail("ramp", "must be <= duration/2 = " + fmt(0.5 * f.duration) + ", got " + fmt(f.ramp));
+  }
+  if (shape == "table") {
+    f.kind = TimeFunction::Kind::Table;
+    const ojson& t = o.array("table");
+    const std::string path = o.at("table");
+    if (t.size() < 2)
+      o.fail("table", "needs at least 2 rows [t, value], got " + std::to_string(t.size()));
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const auto row = as_numbers(o.ctx(), t[i], index_path(path, i), 2);
+      if (i > 0 && !(row[0] > f.table.back().first))
+        o.ctx().fail(index_path(path, i), "times must be strictly increasing, got " +
+                                              fmt(row[0]) + " after " + fmt(f.table.back().first));
+      f.table.emplace_back(row[0], row[1]);
+    }
+  }
+  o.done();
+  return f;
+}
+
+ProbeSpec parse_probe(Obj o, const GridSpec& g) {
+  o.allow({"name", "at", "fields"});
+  ProbeSpec p;
+  p.name = o.str("name");
+  static const std::regex ok("[A-Za-z0-9_]+");
+  if (!std::regex_match(p.name, ok))
+    o.fail("name", "must be letters, digits and _ only, got \"" + p.name + "\"");
+  const auto at = o.nums("at", 2);
+  p.x = at[0];
+  p.y = at[1];
+  if (!(p.x >= g.x0 && p.x < g.x1() && p.y >= g.y0 && p.y < g.y1()))
+    o.fail("at", "outside the grid " + g.describe() + ": (" + fmt(p.x) + ", " + fmt(p.y) + ")");
+  static const std::vector<std::string> all = {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"};
+  if (const ojson* f = o.find("fields")) {
+    const std::string path = o.at("fields");
+    if (!f->is_array()) o.fail("fields", "expected an array of strings, got " + a_type(*f));
+    if (f->empty()) o.fail("fields", "must name at least one field (or leave it out for all)");
+    for (std::size_t i = 0; i < f->size(); ++i) {
+      const std::string s = as_string(o.ctx(), (*f)[i], index_path(path, i));
+      if (std::find(all.begin(), all.end(), s) == all.end())
+        o.ctx().fail(index_path(path, i),
+                     "must be one of " + quoted_list(all) + ", got \"" + s + "\"" + suggestion(s, all));
+      if (std::find(p.fields.begin(), p.fields.end(), s) != p.fields.end())
+        o.ctx().fail(index_path(path, i), "field \"" + s + "\" listed twice");
+      p.fields.push_back(s);
+    }
+  } else {
+    p.fields = all;
+  }
+  o.done();
+  return p;
+}
+
+// Which edge of a box, with its outward normal. Endpoints run counter-clockwise around the box,
+// so the edge direction is the tangent s = (-n_y, n_x).
+struct Edge {
+  double ex0, ey0, ex1, ey1, nx, ny;
+  double extent;  // body size normal to the edge
+};
+
+Edge box_edge(const BodySpec& b, const std::string& side) {
+  if (side == "left") return {b.x0, b.y1, b.x0, b.y0, -1, 0, b.x1 - b.x0};
+  if (side == "right") return {b.x1, b.y0, b.x1, b.y1, 1, 0, b.x1 - b.x0};
+  if (side == "bottom") return {b.x0, b.y0, b.x1, b.y0, 0, -1, b.y1 - b.y0};
+  return {b.x1, b.y1, b.x0, b.y1, 0, 1, b.y1 - b.y0};  // top
+}
+
+class Builder {
+ public:
+  Builder(const Ctx& ctx, const ojson& doc) : ctx_(ctx), doc_(doc) {}
+
+  Case build() {
+    if (!doc_.is_object())
+      ctx_.fail("", "a case file must be a JSON object {...}, got " + a_type(doc_));
+    Obj top(ctx_, doc_, "");
+    top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes",
+               "output"});
+    for (const char* k : {"grid", "time", "materials", "bodies"})
+      if (!top.has(k)) top.fail(k, "missing required key");
+
+    Case c;
+    c.source = ctx_.source;
+    c.title = top.str("title", "");
+    grid_ = parse_grid(top.obj("grid"));
+    parse_time(top.obj("time"), c);
+    if (const ojson* s = top.find("scheme")) parse_scheme(Obj(ctx_, *s, "scheme"));
+    if (const ojson* o = top.find("output")) parse_output(Obj(ctx_, *o, "output"), c.output);
+    parse_materials(top);
+    parse_bodies(top.array("bodies"));
+    if (const ojson* p = top.find("probes")) parse_probes(*p, c);
+    // Boundaries select seeded particles and nodes, so they are built after seeding.
+    const ojson* bnd = top.find("boundaries");
+    if (bnd && !bnd->is_array()) top.fail("boundaries", "expected an array, got " + a_type(*bnd));
+    top.done();
+
+    seed();
+    if (bnd)
+      for (std::size_t i = 0; i < bnd->size(); ++i)
+        parse_boundary(Obj(ctx_, (*bnd)[i], index_path("boundaries", i)), i, c);
+
+    s_->finalize();
+    const long out = s_->first_particle_outside();
+    if (out >= 0) {
+      const auto k = static_cast<std::size_t>(out);
+      const int b = s_->p.body[k];
+      ctx_.fail(index_path("bodies", b) + ".box",
+                "particle at (" + fmt(s_->p.x[k]) + ", " + fmt(s_->p.y[k]) +
+                    ") is outside the grid " + grid_.describe());
+    }
+    set_time_step();
+    c.solver = std::move(s_);
+    return c;
+  }
+
+ private:
+  const Ctx& ctx_;
+  const ojson& doc_;
+  GridSpec grid_;
+  std::unique_ptr<Solver> s_ = std::make_unique<Solver>();
+  std::vector<Material> materials_;
+  std::map<std::string, int> material_index_;
+  std::vector<BodySpec> bodies_;
+  bool use_cfl_ = false;
+  double dt_or_cfl_ = 0;
+
+  void parse_time(Obj t, Case& c) {
+    t.allow({"end", "dt", "cfl"});
+    c.t_end = t.num("end");
+    t.gt("end", c.t_end, 0);
+    const bool has_dt = t.has("dt"), has_cfl = t.has("cfl");
+    if (has_dt && has_cfl) t.fail("", "give either dt or cfl, not both");
+    if (!has_dt && !has_cfl)
+      t.fail("", "missing dt or cfl (give exactly one: a time step in s, or a fraction of the "
+                 "stability limit)");
+    use_cfl_ = has_cfl;
+    if (has_cfl) {
+      dt_or_cfl_ = t.num("cfl");
+      t.gt("cfl", dt_or_cfl_, 0);
+      t.le("cfl", dt_or_cfl_, 1);
+    } else {
+      dt_or_cfl_ = t.num("dt");
+      t.gt("dt", dt_or_cfl_, 0);
+    }
+    t.done();
+  }
+
+  void parse_scheme(Obj s) {
+    s.allow({"update", "flip", "threads"});
+    const std::string u = s.choice("update", {"USF", "USL", "MUSL"}, "MUSL");
+    s_->opt.scheme = u == "USF" ? Scheme::USF : u == "USL" ? Scheme::USL : Scheme::MUSL;
+    s_->opt.flip = s.num("flip", 1.0);
+    s.ge("flip", s_->opt.flip, 0);
+    s.le("flip", s_->opt.flip, 1);
+    const long th = s.integer("threads", 0);
+    s.ge("threads", static_cast<double>(th), 0);
+    s.le("threads", static_cast<double>(th), 4096);
+    s_->opt.threads = static_cast<int>(th);
+    s.done();
+  }
+
+  void parse_output(Obj o, OutputSpec& out) {
+    o.allow({"history_every", "snapshots", "progress"});
+    out.history_every = o.integer("history_every", 1);
+    o.ge("history_every", static_cast<double>(out.history_every), 1);
+    const long snaps = o.integer("snapshots", 10);
+    o.ge("snapshots", static_cast<double>(snaps), 0);
+    o.le("snapshots", static_cast<double>(snaps), 1000000);
+    out.snapshots = static_cast<int>(snaps);
+    out.progress = o.boolean("progress", true);
+    o.done();
+  }
+
+  void parse_materials(Obj& top) {
+    const ojson& m = top.need("materials");
+    if (!m.is_object()) top.fail("materials", "expected an object {name: {...}}, got " + a_type(m));
+    if (m.empty()) top.fail("materials", "must define at least one material");
+    if (m.size() > 65535) top.fail("materials", "too many materials");
+    for (const auto& item : m.items()) {
+      material_index_[item.key()] = static_cast<int>(materials_.size());
+      materials_.push_back(parse_material(ctx_, item.key(), item.value()));
+    }
+  }
+
+  std::vector<std::string> material_names() const {
+    std::vector<std::string> v;
+    for (const auto& m : materials_) v.push_back(m.name);
+    return v;
+  }
+  std::vector<std::string> body_names() const {
+    std::vector<std::string> v;
+    for (const auto& b : bodies_) v.push_back(b.name);
+    return v;
+  }
+
+  void parse_bodies(const ojson& arr) {
+    if (arr.empty()) ctx_.fail("bodies", "must contain at least one body");
+    if (arr.size() > 65535) ctx_.fail("bodies", "too many bodies");
+    const double tol = 1e-6 * grid_.h;
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      Obj o(ctx_, arr[i], index_path("bodies", i));
+      o.allow({"name", "material", "box", "particles_per_cell", "velocity"});
+      BodySpec b;
+      b.name = o.str("name");
+      if (b.name.empty()) o.fail("name", "must not be empty");
+      for (const auto& other : bodies_)
+        if (other.name == b.name) o.fail("name", "body name \"" + b.name + "\" is used twice");
+      const std::string mat = o.str("material");
+      auto it = material_index_.find(mat);
+      if (it == material_index_.end())
+        o.fail("material", "no material named \"" + mat + "\"" +
+                               suggestion(mat, material_names()) +
+                               "; defined: " + join(material_names()));
+      b.material = it->second;
+      const auto box = o.nums("box", 4);
+      b.x0 = box[0], b.y0 = box[1], b.x1 = box[2], b.y1 = box[3];
+      if (!(b.x1 > b.x0)) o.fail("box", "x1 must be > x0, got " + fmt_list(box));
+      if (!(b.y1 > b.y0)) o.fail("box", "y1 must be > y0, got " + fmt_list(box));
+      for (int k = 0; k < 4; ++k) {
+        const double x = k % 2 ? b.x1 : b.x0, y = k / 2 ? b.y1 : b.y0;
+        if (x < grid_.x0 - tol || x > grid_.x1() + tol || y < grid_.y0 - tol ||
+            y > grid_.y1() + tol)
+          o.fail("box", "outside the grid " + grid_.describe() + ": corner (" + fmt(x) + ", " +
+                            fmt(y) + ") of " + fmt_list(box));
+      }
+      if (const ojson* p = o.find("particles_per_cell")) {
+        const long n = as_integer(ctx_, *p, o.at("particles_per_cell"));
+        if (n != 1 && n != 4 && n != 9)
+          o.fail("particles_per_cell", "must be 1, 4 or 9, got " + std::to_string(n));
+        b.ppc = static_cast<int>(n);
+      }
+      const auto v = o.nums("velocity", std::vector<double>{0.0, 0.0});
+      b.vx = v[0];
+      b.vy = v[1];
+      o.done();
+      bodies_.push_back(b);
+    }
+  }
+
+  void parse_probes(const ojson& arr, Case& c) {
+    if (!arr.is_array()) ctx_.fail("probes", "expected an array, got " + a_type(arr));
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+      Obj o(ctx_, arr[i], index_path("probes", i));
+      ProbeSpec p = parse_probe(o, grid_);
+      for (const auto& q : c.probes)
+        if (q.name == p.name) o.fail("name", "probe name \"" + p.name + "\" is used twice");
+      c.probes.push_back(std::move(p));
+    }
+  }
+
+  void seed() {
+    double estimate = 0;
+    for (const auto& b : bodies_) {
+      const double n = std::sqrt(static_cast<double>(b.ppc));
+      estimate += std::max(1.0, std::round((b.x1 - b.x0) / grid_.h * n)) *
+                  std::max(1.0, std::round((b.y1 - b.y0) / grid_.h * n));
+    }
+    if (estimate > kMaxParticles)
+      ctx_.fail("bodies", "too many particles (about " + fmt(estimate) + "; the limit is " +
+                              fmt(kMaxParticles) + ")");
+    s_->grid.init(grid_.x0, grid_.y0, grid_.h, grid_.nx, grid_.ny);
+    s_->materials = materials_;
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+      const auto& b = bodies_[i];
+      const int n = b.ppc == 1 ? 1 : b.ppc == 4 ? 2 : 3;
+      const std::size_t added = s_->seed_rectangle(b.x0, b.y0, b.x1, b.y1, n, b.material,
+                                                   static_cast<int>(i), b.vx, b.vy);
+      if (added == 0) ctx_.fail(index_path("bodies", i) + ".box", "seeds no particle");
+    }
+  }
+
+  int body_ref(Obj& o) {
+    const std::string name = o.str("body");
+    for (std::size_t i = 0; i < bodies_.size(); ++i)
+      if (bodies_[i].name == name) return static_cast<int>(i);
+    o.fail("body", "no body named \"" + name + "\"" + suggestion(name, body_names()) +
+                       "; bodies: " + join(body_names()));
+  }
+
+  // Nodes for fixed / roller: exactly one of grid_side, box, body + side.
+  std::vector<uint32_t> select_nodes(Obj& o) {
+    const int forms = o.has("grid_side") + o.has("box") + o.has("body");
+    if (forms == 0)
+      o.fail("", "needs a node selection: one of grid_side, box, or body + side");
+    if (forms > 1) o.fail("", "give only one node selection: grid_side, box, or body + side");
+    if (o.has("side") && !o.has("body"))
+      o.fail("side", "only used with body (use grid_side for an edge of the grid)");
+    const double tol = 1e-6 * grid_.h;
+    double x0, y0, x1, y1;
+    std::string what;
+    if (o.has("grid_side")) {
+      const std::string side = o.choice("grid_side", kSides);
+      x0 = side == "right" ? grid_.x1() : grid_.x0;
+      x1 = side == "left" ? grid_.x0 : grid_.x1();
+      y0 = side == "top" ? grid_.y1() : grid_.y0;
+      y1 = side == "bottom" ? grid_.y0 : grid_.y1();
+      what = "grid side " + side;
+    } else if (o.has("box")) {
+      const auto box = o.nums("box", 4);
+      if (!(box[2] >= box[0])) o.fail("box", "x1 must be >= x0, got " + fmt_list(box));
+      if (!(box[3] >= box[1])) o.fail("box", "y1 must be >= y0, got " + fmt_list(box));
+      x0 = box[0], y0 = box[1], x1 = box[2], y1 = box[3];
+      what = "box " + fmt_list(box);
+    } else {
+      const BodySpec& b = bodies_[body_ref(o)];
+      const std::string side = o.choice("side", kSides);
+      const Edge e = box_edge(b, side);
+      // The grid line nearest the edge; the edge must lie on it.
+      const bool vertical = e.nx != 0;
+      const double coord = vertical ? e.ex0 : e.ey0;
+      const double origin = vertical ? grid_.x0 : grid_.y0;
+      const double line = origin + std::round((coord - origin) / grid_.h) * grid_.h;
+      if (std::fabs(line - coord) > tol)
+        o.fail("side", "the " + side + " edge of body \"" + b.name + "\" (" +
+                           (vertical ? "x" : "y") + " = " + fmt(coord) +
+                           ") is not on a grid line (nearest: " + fmt(line) + ")");
+      x0 = vertical ? line : b.x0;
+      x1 = vertical ? line : b.x1;
+      y0 = vertical ? b.y0 : line;
+      y1 = vertical ? b.y1 : line;
+      what = side + " edge of body \"" + b.name + "\"";
+    }
+    auto nodes = s_->nodes_in_box(x0, y0, x1, y1);
+    if (nodes.empty()) o.fail("", "selects no node (" + what + ")");
+    return nodes;
+  }
+
+  // Particle layer for traction / silent: body, side, width.
+  BoundaryLayer select_layer(Obj& o, const std::string& name, std::string& what) {
+    const int bi = body_ref(o);
+    const BodySpec& b = bodies_[bi];
+    const std::string side = o.choice("side", kSides);
+    const Edge e = box_edge(b, side);
+    const double width = o.num("width", grid_.h);
+    o.gt("width", width, 0);
+    if (!(width <= e.extent * (1 + 1e-12)))
+      o.fail("width", "must be <= the size of body \"" + b.name + "\" normal to its " + side +
+                          " side (" + fmt(e.extent) + "), got " + fmt(width));
+    BoundaryLayer layer = s_->select_layer(name, bi, e.ex0, e.ey0, e.ex1, e.ey1, e.nx, e.ny, width);
+    what = side + " side of body \"" + b.name + "\", width " + fmt(width);
+    if (layer.ids.empty()) o.fail("", "selects no particle (" + what + ")");
+    return layer;
+  }
+
+  void parse_boundary(Obj o, std::size_t i, Case& c) {
+    const std::string type = o.choice("type", {"fixed", "roller", "traction", "silent"});
+    const std::string where = "for a " + type + " boundary";
+    if (type == "fixed" || type == "roller") {
+      std::vector<std::string> keys = {"type", "name", "grid_side", "box", "body", "side"};
+      if (type == "roller") keys.push_back("component");
+      o.allow(keys, where);
+    } else if (type == "traction") {
+      o.allow({"type", "name", "body", "side", "width", "normal", "tangential", "vector", "time"},
+              where);
+    } else {
+      o.allow({"type", "name", "body", "side", "width", "a", "b", "form"}, where);
+    }
+    const std::string name = o.str("name", type + std::to_string(i));
+    if (name.empty()) o.fail("name", "must not be empty");
+
+    if (type == "fixed" || type == "roller") {
+      NodalConstraint nc;
+      nc.name = name;
+      nc.mask = 3;
+      if (type == "roller") nc.mask = o.choice("component", {"x", "y"}) == "x" ? 1 : 2;
+      nc.nodes = select_nodes(o);
+      o.done();
+      s_->constraints.push_back(std::move(nc));
+      return;
+    }
+
+    if (type == "traction") {
+      const bool scalar = o.has("normal") || o.has("tangential");
+      if (scalar && o.has("vector"))
+        o.fail("vector", "give either normal/tangential or vector, not both");
+      if (!scalar && !o.has("vector"))
+        o.fail("", "missing the traction: give normal and/or tangential, or vector");
+      TractionLoad t;
+      std::string what;
+      t.layer = select_layer(o, name, what);
+      std::string amp;
+      if (scalar) {
+        t.normal = o.num("normal", 0.0);
+        t.tangential = o.num("tangential", 0.0);
+        amp = "normal " + fmt(t.normal) + " Pa, tangential " + fmt(t.tangential) + " Pa";
+      } else {
+        const auto v = o.nums("vector", 2);
+        t.vx = v[0];
+        t.vy = v[1];
+        amp = "vector (" + fmt(t.vx) + ", " + fmt(t.vy) + ") Pa";
+      }
+      if (const ojson* tf = o.find("time")) t.fn = parse_time_function(Obj(ctx_, *tf, o.at("time")));
+      o.done();
+      c.notes.push_back("traction \"" + name + "\" on the " + what + " (" +
+                        std::to_string(t.layer.ids.size()) + " particles): " + amp + " x " +
+                        t.fn.describe());
+      s_->tractions.push_back(std::move(t));
+      return;
+    }
+
+    // silent
+    SilentBoundary sb;
+    std::string what;
+    sb.layer = select_layer(o, name, what);
+    sb.a = o.num("a", 1.0);
+    o.ge("a", sb.a, 0);
+    sb.b = o.num("b", 1.0);
+    o.ge("b", sb.b, 0);
+    sb.form = o.choice("form", {"nodal", "particle"}, "nodal") == "nodal" ? SilentForm::Nodal
+                                                                         : SilentForm::Particle;
+    o.done();
+    // Impedances from the material of each selected particle (ids are permanent; map them to
+    // current indices in case the solver has reordered).
+    std::unordered_map<uint32_t, std::size_t> where_id;
+    where_id.reserve(s_->p.size());
+    for (std::size_t k = 0; k < s_->p.size(); ++k) where_id[s_->p.id[k]] = k;
+    for (uint32_t id : sb.layer.ids) {
+      auto it = where_id.find(id);
+      if (it == where_id.end()) o.fail("", "internal error: layer particle id not found");
+      const Material& m = s_->materials[s_->p.group[it->second]];
+      sb.zn.push_back(sb.a * m.rho * m.cd);
+      sb.zt.push_back(sb.b * m.rho * m.cs);
+    }
+    s_->silents.push_back(std::move(sb));
+  }
+
+  void set_time_step() {
+    const double crit = s_->critical_dt();
+    if (!(crit > 0) || !std::isfinite(crit))
+      ctx_.fail("time", "cannot compute the stability limit (critical dt = " + fmt(crit) + ")");
+    double dt;
+    if (use_cfl_) {
+      dt = dt_or_cfl_ * crit;
+    } else {
+      dt = dt_or_cfl_;
+      if (dt > crit * (1 + 1e-12))
+        ctx_.fail("time.dt", fmt(dt) + " s is above the stability limit " + fmt_down(crit) +
+                                 " s = h / max c_d (CFL " + fmt(dt / crit) +
+                                 " > 1); use dt <= " + fmt_down(crit) + " or set time.cfl");
+    }
+    s_->dt = dt;
+    s_->t = 0;
+  }
+};
+
+Case build_ordered(Ctx& ctx, const ojson& doc) {
+  try {
+    return Builder(ctx, doc).build();
+  } catch (const CaseError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw CaseError(ctx.source + ": not enough memory to build the case");
+  } catch (const std::exception& e) {
+    throw CaseError(ctx.source + ": error while building the case: " + e.what());
+  }
+}
+
+}  // namespace
+
+Case load_case(const std::string& path, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw CaseError(path + ": cannot open file (it is a directory)");
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw CaseError(path + ": cannot open file");
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  if (f.bad()) throw CaseError(path + ": cannot read file");
+  Ctx ctx{path, {}};
+  ojson doc = parse_text(ss.str(), path);
+  for (const auto& o : overrides) apply_override(ctx, doc, o);
+  return build_ordered(ctx, doc);
+}
+
+Case build_case(const nlohmann::json& doc, const std::string& source) {
+  Ctx ctx{source, {}};
+  const ojson ordered(doc);  // nlohmann::json keeps keys sorted; material groups follow that order
+  return build_ordered(ctx, ordered);
+}
+
+}  // namespace smpm

@@ -1,0 +1,344 @@
+// History CSV and HDF5/XDMF particle snapshots (contracts in DESIGN.md and output.hpp).
+//
+// Snapshot layout, one file DIR/<base>.h5:
+//   /step_000000123            group, attributes "time" (double) and "step" (int64)
+//     xyz                      N x 3 double (z = 0), the XDMF geometry
+//     vx vy sxx syy szz sxy J2 eps_p mass volume   N double
+//     body                     N int32
+//     id                       N uint32 (permanent particle id; particles are re-sorted)
+// DIR/<base>.xdmf is an XDMF 3 temporal collection of Polyvertex grids that point into the .h5
+// by relative file name, so the output folder can be moved as a whole. It is rewritten (through
+// a temporary file and a rename) after every snapshot, so a partial run opens in ParaView.
+#include "silentmpm/output.hpp"
+
+#include <hdf5.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "silentmpm/material.hpp"
+
+namespace smpm {
+
+// ------------------------------------------------------------------------------------------------
+// HistoryWriter
+
+HistoryWriter::~HistoryWriter() {
+  if (f_) {
+    std::fclose(f_);
+    f_ = nullptr;
+  }
+}
+
+void HistoryWriter::open(const std::string& path, const std::vector<std::string>& columns) {
+  close();
+  for (const auto& c : columns) {
+    if (c.find_first_of(",\n\r") != std::string::npos)
+      throw std::runtime_error("history column name '" + c + "' contains ',' or a line break");
+  }
+  f_ = std::fopen(path.c_str(), "w");
+  if (!f_)
+    throw std::runtime_error("cannot open history file '" + path +
+                             "' for writing: " + std::strerror(errno));
+  ncol_ = columns.size();
+  std::string header = "time";
+  for (const auto& c : columns) header += "," + c;
+  header += "\n";
+  if (std::fputs(header.c_str(), f_) < 0) {
+    std::fclose(f_);
+    f_ = nullptr;
+    throw std::runtime_error("cannot write to history file '" + path + "'");
+  }
+}
+
+void HistoryWriter::row(double time, const std::vector<double>& values) {
+  if (!f_) throw std::runtime_error("HistoryWriter::row called before open()");
+  if (values.size() != ncol_)
+    throw std::runtime_error("HistoryWriter::row: got " + std::to_string(values.size()) +
+                             " values for " + std::to_string(ncol_) + " columns");
+  std::fprintf(f_, "%.9e", time);
+  for (double v : values) std::fprintf(f_, ",%.9e", v);
+  std::fputc('\n', f_);
+}
+
+void HistoryWriter::close() {
+  if (!f_) return;
+  const bool bad = std::ferror(f_) != 0;
+  const bool close_failed = std::fclose(f_) != 0;
+  f_ = nullptr;
+  ncol_ = 0;
+  if (bad || close_failed) throw std::runtime_error("error writing the history file (disk full?)");
+}
+
+// ------------------------------------------------------------------------------------------------
+// SnapshotWriter
+
+namespace {
+
+// Closes an HDF5 object on scope exit (so a throw in the middle of a snapshot leaks nothing).
+struct H5Handle {
+  hid_t id = -1;
+  herr_t (*closer)(hid_t) = nullptr;
+  H5Handle(hid_t i, herr_t (*c)(hid_t)) : id(i), closer(c) {}
+  ~H5Handle() {
+    if (id >= 0 && closer) closer(id);
+  }
+  H5Handle(const H5Handle&) = delete;
+  H5Handle& operator=(const H5Handle&) = delete;
+};
+
+// The innermost HDF5 error description (e.g. the OS error behind a failed create), if any.
+herr_t innermost_error(unsigned n, const H5E_error2_t* e, void* out) {
+  if (n == 0 && e && e->desc) *static_cast<std::string*>(out) = e->desc;
+  return 0;
+}
+
+[[noreturn]] void h5_fail(const std::string& what, const std::string& file) {
+  std::string detail;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost_error, &detail);
+  H5Eclear2(H5E_DEFAULT);
+  throw std::runtime_error("HDF5: " + what + " in '" + file + "'" +
+                           (detail.empty() ? std::string() : " (" + detail + ")"));
+}
+
+void write_dataset(hid_t group, const char* name, hid_t file_type, hid_t mem_type,
+                   const void* data, std::size_t n, std::size_t ncomp, const std::string& file,
+                   const std::string& group_name) {
+  hsize_t dims[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(ncomp)};
+  H5Handle space(H5Screate_simple(ncomp > 1 ? 2 : 1, dims, nullptr), H5Sclose);
+  if (space.id < 0) h5_fail("cannot create dataspace for '" + group_name + "/" + name + "'", file);
+  H5Handle ds(H5Dcreate2(group, name, file_type, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+              H5Dclose);
+  if (ds.id < 0) h5_fail("cannot create dataset '" + group_name + "/" + name + "'", file);
+  if (n > 0 && H5Dwrite(ds.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+    h5_fail("cannot write dataset '" + group_name + "/" + name + "'", file);
+}
+
+template <class T>
+void write_scalar_attribute(hid_t obj, const char* name, hid_t file_type, hid_t mem_type, T value,
+                            const std::string& file, const std::string& group_name) {
+  H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  if (space.id < 0) h5_fail("cannot create dataspace for attribute '" + std::string(name) + "'", file);
+  H5Handle attr(H5Acreate2(obj, name, file_type, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (attr.id < 0 || H5Awrite(attr.id, mem_type, &value) < 0)
+    h5_fail("cannot write attribute '" + group_name + "@" + name + "'", file);
+}
+
+std::string step_name(long step) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "step_%09ld", step);
+  return buf;
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+struct ScalarField {
+  const char* name;
+  const char* number_type;
+  int precision;
+};
+// Every 1D dataset of a snapshot, in file order; the XDMF lists them all as node attributes.
+constexpr ScalarField kScalarFields[] = {
+    {"vx", "Float", 8},     {"vy", "Float", 8},    {"sxx", "Float", 8},   {"syy", "Float", 8},
+    {"szz", "Float", 8},    {"sxy", "Float", 8},   {"J2", "Float", 8},    {"eps_p", "Float", 8},
+    {"mass", "Float", 8},   {"volume", "Float", 8}, {"body", "Int", 4},   {"id", "UInt", 4},
+};
+
+}  // namespace
+
+SnapshotWriter::~SnapshotWriter() {
+  try {
+    close();
+  } catch (...) {
+    // Destructors must not throw; an explicit close() reports the error.
+  }
+}
+
+void SnapshotWriter::open(const std::string& dir, const std::string& base) {
+  close();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  dir_ = dir.empty() ? std::string(".") : dir;
+  base_ = base;
+  times_.clear();
+  steps_.clear();
+  sizes_.clear();
+  const std::string path = dir_ + "/" + base_ + ".h5";
+
+  // The writer takes no file lock, so h5py or ParaView can look at a running simulation's
+  // snapshots (every snapshot is flushed); readers still lock as usual.
+  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (fapl.id < 0) h5_fail("cannot create a file-access property list", path);
+#if H5_VERSION_GE(1, 10, 7)
+  H5Pset_file_locking(fapl.id, 0, 1);
+#endif
+  const hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id);
+  if (f < 0)
+    h5_fail("cannot create the snapshot file (does the output directory exist and is it "
+            "writable?)",
+            path);
+  file_ = f;
+}
+
+void SnapshotWriter::write(const Particles& p, long step, double time) {
+  const std::string path = dir_ + "/" + base_ + ".h5";
+  if (file_ < 0) throw std::runtime_error("SnapshotWriter::write called before open()");
+  const hid_t file = static_cast<hid_t>(file_);
+  const std::size_t n = p.size();
+  {
+    const std::size_t sizes[] = {p.y.size(),   p.vx.size(),  p.vy.size(),    p.mass.size(),
+                                 p.vol.size(), p.sxx.size(), p.syy.size(),   p.szz.size(),
+                                 p.sxy.size(), p.eps_p.size(), p.id.size(), p.body.size()};
+    for (std::size_t s : sizes)
+      if (s != n)
+        throw std::runtime_error("SnapshotWriter: particle arrays have inconsistent sizes (" +
+                                 std::to_string(s) + " vs " + std::to_string(n) + ")");
+  }
+
+  const std::string gname = step_name(step);
+  // Writing the same step twice replaces the earlier snapshot of that step.
+  std::size_t slot = steps_.size();
+  for (std::size_t k = 0; k < steps_.size(); ++k)
+    if (steps_[k] == step) slot = k;
+  if (slot < steps_.size() && H5Lexists(file, gname.c_str(), H5P_DEFAULT) > 0 &&
+      H5Ldelete(file, gname.c_str(), H5P_DEFAULT) < 0)
+    h5_fail("cannot replace group '/" + gname + "'", path);
+
+  H5Handle group(H5Gcreate2(file, gname.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                 H5Gclose);
+  if (group.id < 0) h5_fail("cannot create group '/" + gname + "'", path);
+  write_scalar_attribute(group.id, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, time, path, gname);
+  write_scalar_attribute(group.id, "step", H5T_STD_I64LE, H5T_NATIVE_INT64,
+                         static_cast<int64_t>(step), path, gname);
+
+  std::vector<double> xyz(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    xyz[3 * i] = p.x[i];
+    xyz[3 * i + 1] = p.y[i];
+    xyz[3 * i + 2] = 0.0;
+  }
+  write_dataset(group.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), n, 3, path, gname);
+  xyz.clear();
+  xyz.shrink_to_fit();
+
+  auto dbl = [&](const char* name, const double* data) {
+    write_dataset(group.id, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data, n, 1, path, gname);
+  };
+  dbl("vx", p.vx.data());
+  dbl("vy", p.vy.data());
+  dbl("sxx", p.sxx.data());
+  dbl("syy", p.syy.data());
+  dbl("szz", p.szz.data());
+  dbl("sxy", p.sxy.data());
+  {
+    std::vector<double> j2(n);
+    for (std::size_t i = 0; i < n; ++i) j2[i] = j2_of(p.sxx[i], p.syy[i], p.szz[i], p.sxy[i]);
+    dbl("J2", j2.data());
+  }
+  dbl("eps_p", p.eps_p.data());
+  dbl("mass", p.mass.data());
+  dbl("volume", p.vol.data());
+  {
+    std::vector<int32_t> body(p.body.begin(), p.body.end());
+    write_dataset(group.id, "body", H5T_STD_I32LE, H5T_NATIVE_INT32, body.data(), n, 1, path,
+                  gname);
+  }
+  write_dataset(group.id, "id", H5T_STD_U32LE, H5T_NATIVE_UINT32, p.id.data(), n, 1, path, gname);
+
+  if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
+
+  if (slot < steps_.size()) {
+    times_[slot] = time;
+    sizes_[slot] = n;
+  } else {
+    steps_.push_back(step);
+    times_.push_back(time);
+    sizes_.push_back(n);
+  }
+  write_xdmf();
+}
+
+void SnapshotWriter::close() {
+  if (file_ < 0) return;
+  const hid_t f = static_cast<hid_t>(file_);
+  file_ = -1;
+  if (H5Fclose(f) < 0) h5_fail("cannot close", dir_ + "/" + base_ + ".h5");
+}
+
+void SnapshotWriter::write_xdmf() const {
+  const std::string path = dir_ + "/" + base_ + ".xdmf";
+  const std::string tmp = path + ".tmp";
+  const std::string h5 = xml_escape(base_ + ".h5");  // relative: the folder moves as a whole
+
+  std::string s;
+  s += "<?xml version=\"1.0\" ?>\n";
+  s += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
+  s += "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n";
+  s += "  <Domain>\n";
+  s += "    <Grid Name=\"" + xml_escape(base_) +
+       "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  char buf[512];
+  for (std::size_t k = 0; k < steps_.size(); ++k) {
+    const std::size_t n = sizes_[k];
+    if (n == 0) continue;  // an empty Polyvertex grid is not readable; the .h5 still has it
+    const std::string g = step_name(steps_[k]);
+    std::snprintf(buf, sizeof buf,
+                  "      <Grid Name=\"%s\" GridType=\"Uniform\">\n"
+                  "        <Time Value=\"%.9e\"/>\n"
+                  "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+                  "NodesPerElement=\"1\"/>\n"
+                  "        <Geometry GeometryType=\"XYZ\">\n"
+                  "          <DataItem Dimensions=\"%zu 3\" NumberType=\"Float\" Precision=\"8\" "
+                  "Format=\"HDF\">%s:/%s/xyz</DataItem>\n"
+                  "        </Geometry>\n",
+                  g.c_str(), times_[k], n, n, h5.c_str(), g.c_str());
+    s += buf;
+    for (const auto& f : kScalarFields) {
+      std::snprintf(buf, sizeof buf,
+                    "        <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Node\">\n"
+                    "          <DataItem Dimensions=\"%zu\" NumberType=\"%s\" Precision=\"%d\" "
+                    "Format=\"HDF\">%s:/%s/%s</DataItem>\n"
+                    "        </Attribute>\n",
+                    f.name, n, f.number_type, f.precision, h5.c_str(), g.c_str(), f.name);
+      s += buf;
+    }
+    s += "      </Grid>\n";
+  }
+  s += "    </Grid>\n";
+  s += "  </Domain>\n";
+  s += "</Xdmf>\n";
+
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f)
+    throw std::runtime_error("cannot open XDMF file '" + tmp + "' for writing: " +
+                             std::strerror(errno));
+  const bool ok = std::fwrite(s.data(), 1, s.size(), f) == s.size();
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot write XDMF file '" + tmp + "'");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string err = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + err);
+  }
+}
+
+}  // namespace smpm

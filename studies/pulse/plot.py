@@ -1,0 +1,119 @@
+"""Figures 5-7 and metrics.json of the pulse study (called by studies/pulse/run).
+
+Reads OUTDIR/<load>_<treatment>/history.csv, plots the stress at A for the three right-side
+treatments, and computes the relative L2 differences against the extended run with the same
+implementation the tests use (`silentmpm compare`).
+"""
+import argparse
+import csv
+import json
+import os
+import subprocess
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+STYLE = {"free": ("tab:red", "--", "free boundary"),
+         "silent": ("tab:blue", "-", "silent boundary"),
+         "extended": ("black", ":", "extended region")}
+FIGURES = [("figure5.png", "compressive", "sxx", r"$\sigma_{xx}$ at A (MPa)",
+            "Longitudinal stress at A, compressive pulse (paper Fig. 5)"),
+           ("figure6.png", "compressive", "syy", r"$\sigma_{yy}$ at A (MPa)",
+            "Lateral stress at A, compressive pulse (paper Fig. 6)"),
+           ("figure7.png", "shear", "sxy", r"$\tau_{xy}$ at A (MPa)",
+            "Shear stress at A, shear pulse (paper Fig. 7)")]
+
+
+def read(path):
+    with open(path) as f:
+        r = csv.reader(f)
+        head = next(r)
+        cols = {h: [] for h in head}
+        for row in r:
+            for h, v in zip(head, row):
+                cols[h].append(float(v))
+    return cols
+
+
+def compare(binary, a, b, col, t0, t1):
+    res = subprocess.run([binary, "compare", a, b, "--column", col, "--from", str(t0),
+                          "--to", str(t1)], capture_output=True, text=True, check=True)
+    return float(res.stdout.strip())
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("out")
+    ap.add_argument("--study", required=True)
+    ap.add_argument("--bin", required=True)
+    args = ap.parse_args()
+    study = json.load(open(args.study))
+    probe = study["probe"]
+    hist = {}
+    for load in study["loads"]:
+        for bc in study["treatments"]:
+            hist[(load, bc)] = os.path.join(args.out, f"{load}_{bc}", "history.csv")
+
+    metrics = {"probe": probe, "pulse": "sin^2-ramped, 200 MPa, 20 us, 2 us ramps",
+               "metric": "relative L2 ||s - s_ext|| / ||s_ext|| of the component at A over the window"}
+    for load, spec in study["loads"].items():
+        t0, t1 = spec["window"]
+        m = {"window_s": [t0, t1], "window_reason": spec["window_reason"]}
+        for k, comp in enumerate(spec["components"]):
+            col = f"{probe}.{comp}"
+            ext = hist[(load, "extended")]
+            entry = {bc: compare(args.bin, hist[(load, bc)], ext, col, t0, t1)
+                     for bc in ("silent", "free")}
+            vals = {"silent_vs_extended": entry["silent"], "free_vs_extended": entry["free"]}
+            if k == 0:
+                m["component"] = comp
+                m.update(vals)
+            else:
+                m[comp] = vals
+        summaries = {bc: json.load(open(os.path.join(args.out, f"{load}_{bc}", "summary.json")))
+                     for bc in study["treatments"]}
+        m["wall_seconds"] = {bc: s["wall_seconds"] for bc, s in summaries.items()}
+        m["particle_updates_per_second"] = {bc: s["particle_updates_per_second"]
+                                            for bc, s in summaries.items()}
+        metrics[load] = m
+
+    for fname, load, comp, ylabel, title in FIGURES:
+        fig, ax = plt.subplots(figsize=(6.4, 4.2))
+        for bc in study["treatments"]:
+            h = read(hist[(load, bc)])
+            color, ls, label = STYLE[bc]
+            ax.plot([t * 1e6 for t in h["time"]], [v / 1e6 for v in h[f"{probe}.{comp}"]],
+                    color=color, ls=ls, lw=1.4, label=label)
+        t1 = study["loads"][load]["window"][1]
+        ax.axvline(t1 * 1e6, color="grey", lw=0.8, alpha=0.6)
+        ax.text(t1 * 1e6, ax.get_ylim()[1], " end of reflection-free window\n of the extended run",
+                fontsize=7, va="top", color="grey")
+        ax.set_xlabel("time (us)")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title, fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="lower right")
+        fig.tight_layout()
+        fig.savefig(os.path.join(args.out, fname), dpi=130)
+        plt.close(fig)
+
+    with open(os.path.join(args.out, "metrics.json"), "w") as f:
+        json.dump(metrics, f, indent=2)
+        f.write("\n")
+
+    print(f"\npulse study: figures and metrics in {args.out}")
+    print(f"{'load':<12} {'component':<10} {'window (us)':<14} {'silent_vs_ext':>14} {'free_vs_ext':>12}")
+    for load, spec in study["loads"].items():
+        m = metrics[load]
+        w = f"0-{m['window_s'][1] * 1e6:.1f}"
+        print(f"{load:<12} {m['component']:<10} {w:<14} {m['silent_vs_extended']:>14.4f} "
+              f"{m['free_vs_extended']:>12.4f}")
+        for comp in spec["components"][1:]:
+            print(f"{'':<12} {comp:<10} {w:<14} {m[comp]['silent_vs_extended']:>14.4f} "
+                  f"{m[comp]['free_vs_extended']:>12.4f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,388 @@
+// Case files: a valid case builds the solver it describes; malformed cases fail with a message
+// naming the key path, both through load_case() and through the CLI (`silentmpm check`).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "silentmpm/case.hpp"
+
+#ifndef SMPM_CLI
+#define SMPM_CLI ""
+#endif
+#ifndef SMPM_SOURCE_DIR
+#define SMPM_SOURCE_DIR "."
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+using ojson = nlohmann::ordered_json;
+
+// A per-process scratch directory, removed at exit.
+struct Scratch {
+  fs::path dir = fs::temp_directory_path() /
+                 ("smpm_test_case_" + std::to_string(static_cast<long>(::getpid())));
+  Scratch() { fs::create_directories(dir); }
+  ~Scratch() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+};
+
+fs::path scratch() {
+  static const Scratch s;
+  return s.dir;
+}
+
+fs::path write_file(const std::string& name, const std::string& text) {
+  const fs::path p = scratch() / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// 10 x 10 cells of 1 mm; a 10 mm x 5 mm tungsten plate (4 particles per cell) on the bottom half;
+// rollers under it, the left grid side fixed, a pulse on its top, a silent layer at its bottom.
+const char* kValid = R"({
+  "title": "small valid case",
+  "grid": { "origin": [0, 0], "size": [0.01, 0.01], "cell": 0.001 },
+  "time": { "end": 1e-6, "cfl": 0.5 },
+  "scheme": { "update": "MUSL", "flip": 1.0, "threads": 1 },
+  "materials": {
+    "tungsten": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 },
+    "soft": { "model": "von_mises", "young": 70e9, "poisson": 0.3, "density": 2700,
+              "yield_stress": 300e6 }
+  },
+  "bodies": [
+    { "name": "plate", "material": "tungsten", "box": [0, 0, 0.01, 0.005],
+      "particles_per_cell": 4 }
+  ],
+  "boundaries": [
+    { "type": "roller", "component": "y", "body": "plate", "side": "bottom" },
+    { "type": "traction", "name": "load", "body": "plate", "side": "top", "width": 0.0005,
+      "normal": -1e8, "time": { "shape": "sin2", "start": 0, "duration": 2e-7, "ramp": 5e-8 } },
+    { "type": "silent", "body": "plate", "side": "bottom", "form": "particle" },
+    { "type": "fixed", "grid_side": "left" }
+  ],
+  "probes": [ { "name": "A", "at": [0.005, 0.0025], "fields": ["sxx", "vy"] } ],
+  "output": { "history_every": 2, "snapshots": 0, "progress": false }
+})";
+
+TEST(CaseLoad, ValidCaseBuilds) {
+  const fs::path file = write_file("valid.json", kValid);
+  const smpm::Case c = smpm::load_case(file.string());
+  ASSERT_TRUE(c.solver);
+  const smpm::Solver& s = *c.solver;
+  EXPECT_EQ(c.title, "small valid case");
+  EXPECT_DOUBLE_EQ(c.t_end, 1e-6);
+  EXPECT_EQ(s.grid.nx, 10);
+  EXPECT_EQ(s.grid.ny, 10);
+  EXPECT_DOUBLE_EQ(s.grid.h, 0.001);
+
+  // Materials in file order; wave speed of tungsten from E, nu, rho.
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].name, "tungsten");
+  EXPECT_EQ(s.materials[1].model, smpm::Model::VonMises);
+  EXPECT_DOUBLE_EQ(s.materials[1].sigma_y, 300e6);
+  EXPECT_NEAR(s.materials[0].cd, 5918.5, 0.1);
+
+  // 10 x 5 cells x 4 particles per cell.
+  EXPECT_EQ(s.p.size(), 200u);
+
+  // dt = cfl * h / c_d (only tungsten is seeded, but the limit covers every material listed).
+  EXPECT_NEAR(s.dt, 0.5 * s.critical_dt(), 1e-12 * s.dt);
+  EXPECT_LE(s.dt, 0.5 * s.grid.h / s.materials[0].cd * (1 + 1e-12));
+
+  // Boundaries: two particle rows per cell; width 0.5 mm holds the top row, the default width
+  // (one cell) the two bottom rows. 11 nodes on a grid line.
+  ASSERT_EQ(s.tractions.size(), 1u);
+  EXPECT_EQ(s.tractions[0].layer.ids.size(), 20u);
+  EXPECT_DOUBLE_EQ(s.tractions[0].normal, -1e8);
+  EXPECT_EQ(s.tractions[0].fn.kind, smpm::TimeFunction::Kind::Sin2Pulse);
+  EXPECT_DOUBLE_EQ(s.tractions[0].fn.ramp, 5e-8);
+  ASSERT_EQ(s.silents.size(), 1u);
+  EXPECT_EQ(s.silents[0].layer.ids.size(), 40u);
+  EXPECT_EQ(s.silents[0].form, smpm::SilentForm::Particle);
+  ASSERT_EQ(s.silents[0].zn.size(), 40u);
+  EXPECT_NEAR(s.silents[0].zn[0], 15000 * s.materials[0].cd, 1e-6 * s.silents[0].zn[0]);
+  for (double ny : s.silents[0].layer.ny) EXPECT_EQ(ny, -1.0);
+  ASSERT_EQ(s.constraints.size(), 2u);
+  EXPECT_EQ(s.constraints[0].name, "roller0");
+  EXPECT_EQ(s.constraints[0].mask, 2);
+  EXPECT_EQ(s.constraints[0].nodes.size(), 11u);
+  EXPECT_EQ(s.constraints[1].name, "fixed3");
+  EXPECT_EQ(s.constraints[1].mask, 3);
+  EXPECT_EQ(s.constraints[1].nodes.size(), 11u);
+
+  EXPECT_EQ(s.opt.scheme, smpm::Scheme::MUSL);
+  EXPECT_EQ(s.opt.threads, 1);
+  ASSERT_EQ(c.probes.size(), 1u);
+  EXPECT_EQ(c.probes[0].name, "A");
+  EXPECT_EQ(c.probes[0].fields, (std::vector<std::string>{"sxx", "vy"}));
+  EXPECT_EQ(c.output.history_every, 2);
+  EXPECT_EQ(c.output.snapshots, 0);
+  EXPECT_FALSE(c.output.progress);
+  ASSERT_EQ(c.notes.size(), 1u);
+  EXPECT_NE(c.notes[0].find("sin^2"), std::string::npos) << c.notes[0];
+}
+
+TEST(CaseLoad, DefaultsAndOverrides) {
+  const fs::path file = write_file("valid_ovr.json", kValid);
+  const smpm::Case c = smpm::load_case(
+      file.string(), {"bodies.0.particles_per_cell=1", "title=renamed", "time.cfl=0.25",
+                      "probes.0.fields=[\"J2\"]", "scheme.update=USL", "boundaries.1.width=0.001"});
+  const smpm::Solver& s = *c.solver;
+  EXPECT_EQ(c.title, "renamed");        // not valid JSON -> taken as a string
+  EXPECT_EQ(s.p.size(), 50u);
+  EXPECT_NEAR(s.dt, 0.25 * s.critical_dt(), 1e-12 * s.dt);
+  EXPECT_EQ(c.probes[0].fields, std::vector<std::string>{"J2"});
+  EXPECT_EQ(s.opt.scheme, smpm::Scheme::USL);
+  EXPECT_EQ(s.tractions[0].layer.ids.size(), 10u);
+}
+
+TEST(CaseLoad, MinimalCaseUsesDefaults) {
+  nlohmann::json j = {
+      {"grid", {{"size", {0.004, 0.002}}, {"cell", 0.001}}},
+      {"time", {{"end", 1e-6}, {"dt", 1e-8}}},
+      {"materials", {{"m", {{"model", "elastic"}, {"young", 1e9}, {"poisson", 0.25},
+                            {"density", 1000}}}}},
+      {"bodies", {{{"name", "b"}, {"material", "m"}, {"box", {0, 0, 0.004, 0.002}}}}}};
+  const smpm::Case c = smpm::build_case(j, "inline");
+  EXPECT_EQ(c.source, "inline");
+  EXPECT_EQ(c.title, "");
+  EXPECT_EQ(c.solver->p.size(), 8u);
+  EXPECT_DOUBLE_EQ(c.solver->dt, 1e-8);
+  EXPECT_EQ(c.solver->opt.scheme, smpm::Scheme::MUSL);
+  EXPECT_DOUBLE_EQ(c.solver->opt.flip, 1.0);
+  EXPECT_EQ(c.output.history_every, 1);
+  EXPECT_EQ(c.output.snapshots, 10);
+  EXPECT_TRUE(c.output.progress);
+  EXPECT_TRUE(c.probes.empty());
+  EXPECT_TRUE(c.solver->constraints.empty());
+}
+
+// The complete example of docs/case-reference.md is a valid case (the reference stays honest).
+TEST(CaseLoad, ReferenceExampleBuilds) {
+  const std::string doc = read_file(fs::path(SMPM_SOURCE_DIR) / "docs" / "case-reference.md");
+  const std::size_t section = doc.find("## Complete example");
+  ASSERT_NE(section, std::string::npos);
+  const std::size_t begin = doc.find("```json\n", section);
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = doc.find("\n```", begin + 8);
+  ASSERT_NE(end, std::string::npos);
+  const fs::path file = write_file("reference_example.json", doc.substr(begin + 8, end - begin - 8));
+  const smpm::Case c = smpm::load_case(file.string());
+  const smpm::Solver& s = *c.solver;
+  EXPECT_EQ(s.p.size(), 50u * 200u);
+  EXPECT_DOUBLE_EQ(s.dt, 4e-8);
+  EXPECT_NEAR(s.dt / s.critical_dt(), 0.237, 0.001);  // REFERENCE.md: CFL 0.237
+  ASSERT_EQ(s.tractions.size(), 1u);
+  EXPECT_EQ(s.tractions[0].layer.ids.size(), 200u);
+  ASSERT_EQ(s.silents.size(), 1u);
+  EXPECT_EQ(s.silents[0].layer.ids.size(), 200u);
+  ASSERT_EQ(c.probes.size(), 1u);
+  EXPECT_EQ(c.notes.size(), 1u);
+}
+
+TEST(CaseLoad, MissingFile) {
+  try {
+    smpm::load_case((scratch() / "does_not_exist.json").string());
+    FAIL() << "no error";
+  } catch (const smpm::CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("does_not_exist.json: cannot open file"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Malformed cases: each is the valid case with one thing wrong.
+struct Bad {
+  std::string name;
+  std::function<void(ojson&)> edit;  // applied to the valid case (unless text is given)
+  std::string expect;                // must appear in the message
+  std::string text;                  // verbatim file content instead of an edit
+  std::vector<std::string> overrides;
+  Bad(std::string n, std::function<void(ojson&)> e, std::string x, std::string t = "",
+      std::vector<std::string> o = {})
+      : name(std::move(n)), edit(std::move(e)), expect(std::move(x)), text(std::move(t)),
+        overrides(std::move(o)) {}
+};
+
+ojson valid_doc() { return ojson::parse(kValid); }
+ojson& bnd(ojson& j, int i) { return j["boundaries"][i]; }
+
+std::vector<Bad> bad_cases() {
+  return {
+      {"bad_json", nullptr, "invalid JSON at line 3",
+       "{\n  \"grid\": { \"size\": [1, 1], \"cell\": 0.1 },\n  \"time\": { \"end\": 1, }\n}\n"},
+      {"duplicate_key", nullptr, "materials.m.young: key given twice",
+       R"({"materials": {"m": {"young": 1, "young": 2}}})"},
+      {"not_an_object", nullptr, "must be a JSON object", "[1, 2, 3]"},
+      {"unknown_top_key", [](ojson& j) { j["gird"] = 1; }, "gird: unknown key"},
+      {"unknown_body_key", [](ojson& j) { j["bodies"][0]["colour"] = "red"; },
+       "bodies[0].colour: unknown key"},
+      {"misspelt_key_suggests",
+       [](ojson& j) {
+         auto& m = j["materials"]["tungsten"];
+         m["poison"] = m["poisson"];
+         m.erase("poisson");
+       },
+       "materials.tungsten.poison: unknown key for model \"elastic\" (did you mean \"poisson\"?)"},
+      {"wrong_type", [](ojson& j) { j["materials"]["tungsten"]["young"] = "411e9"; },
+       "materials.tungsten.young: expected a number, got a string"},
+      {"poisson_half", [](ojson& j) { j["materials"]["tungsten"]["poisson"] = 0.5; },
+       "materials.tungsten.poisson: must be < 0.5"},
+      {"negative_density", [](ojson& j) { j["materials"]["tungsten"]["density"] = -1; },
+       "materials.tungsten.density: must be > 0"},
+      {"missing_grid", [](ojson& j) { j.erase("grid"); }, "grid: missing required key"},
+      {"grid_not_multiple", [](ojson& j) { j["grid"]["size"] = {0.0105, 0.01}; },
+       "grid.size: Lx = 0.0105 is not a multiple"},
+      {"negative_cell", [](ojson& j) { j["grid"]["cell"] = -0.001; }, "grid.cell: must be > 0"},
+      {"dt_above_limit",
+       [](ojson& j) {
+         j["time"].erase("cfl");
+         j["time"]["dt"] = 1e-6;
+       },
+       "time.dt: 1e-06 s is above the stability limit"},
+      {"dt_and_cfl", [](ojson& j) { j["time"]["dt"] = 1e-9; }, "time: give either dt or cfl"},
+      {"cfl_above_one", [](ojson& j) { j["time"]["cfl"] = 1.5; }, "time.cfl: must be <= 1"},
+      {"probe_outside", [](ojson& j) { j["probes"][0]["at"] = {0.02, 0.001}; },
+       "probes[0].at: outside the grid"},
+      {"probe_bad_field", [](ojson& j) { j["probes"][0]["fields"] = {"sxx", "syx"}; },
+       "probes[0].fields[1]: must be one of"},
+      {"body_outside", [](ojson& j) { j["bodies"][0]["box"] = {0, 0, 0.02, 0.005}; },
+       "bodies[0].box: outside the grid"},
+      {"body_box_short", [](ojson& j) { j["bodies"][0]["box"] = {0, 0, 0.01}; },
+       "bodies[0].box: expected an array of 4 numbers, got an array of 3 elements"},
+      {"unknown_material", [](ojson& j) { j["bodies"][0]["material"] = "steel"; },
+       "bodies[0].material: no material named \"steel\""},
+      {"ppc_5", [](ojson& j) { j["bodies"][0]["particles_per_cell"] = 5; },
+       "bodies[0].particles_per_cell: must be 1, 4 or 9, got 5"},
+      {"rectangular_without_duration",
+       [](ojson& j) { bnd(j, 1)["time"] = {{"shape", "rectangular"}}; },
+       "boundaries[1].time.duration: missing required key"},
+      {"table_not_increasing",
+       [](ojson& j) {
+         bnd(j, 1)["time"] = {{"shape", "table"}, {"table", {{0, 0}, {1e-7, 1}, {1e-7, 0}}}};
+       },
+       "boundaries[1].time.table[2]: times must be strictly increasing"},
+      {"von_mises_without_yield",
+       [](ojson& j) { j["materials"]["tungsten"]["model"] = "von_mises"; },
+       "materials.tungsten.yield_stress: missing required key"},
+      {"elastic_with_yield",
+       [](ojson& j) { j["materials"]["tungsten"]["yield_stress"] = 1e9; },
+       "materials.tungsten.yield_stress: not used by model \"elastic\""},
+      {"fixed_selects_no_node",
+       [](ojson& j) { bnd(j, 3) = {{"type", "fixed"}, {"box", {0.0002, 0.0002, 0.0008, 0.0008}}}; },
+       "boundaries[3]: selects no node"},
+      {"traction_selects_no_particle", [](ojson& j) { bnd(j, 1)["width"] = 1e-5; },
+       "boundaries[1]: selects no particle"},
+      {"roller_without_component", [](ojson& j) { bnd(j, 0).erase("component"); },
+       "boundaries[0].component: missing required key"},
+      {"silent_unknown_key", [](ojson& j) { bnd(j, 2)["normal"] = 1; },
+       "boundaries[2].normal: unknown key for a silent boundary"},
+      {"traction_both_forms", [](ojson& j) { bnd(j, 1)["vector"] = {0, 1}; },
+       "boundaries[1].vector: give either normal/tangential or vector"},
+      {"unknown_boundary_body", [](ojson& j) { bnd(j, 2)["body"] = "plat"; },
+       "boundaries[2].body: no body named \"plat\" (did you mean \"plate\"?)"},
+      {"negative_threads", [](ojson& j) { j["scheme"]["threads"] = -2; },
+       "scheme.threads: must be >= 0"},
+      {"override_missing_path", nullptr, "bodies[3]: does not exist", "",
+       {"bodies.3.particles_per_cell=4"}},
+      {"override_bad_value", nullptr,
+       "grid.cell: must be > 0, got -1 (value set by override 'grid.cell=-1')", "",
+       {"grid.cell=-1"}},
+  };
+}
+
+fs::path bad_file(const Bad& b) {
+  return write_file("bad_" + b.name + ".json",
+                    b.text.empty() ? [&] {
+                      ojson j = valid_doc();
+                      if (b.edit) b.edit(j);
+                      return j.dump(2);
+                    }()
+                                   : b.text);
+}
+
+class CaseErrors : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(CaseErrors, NamesTheKeyPath) {
+  const Bad& b = GetParam();
+  const fs::path file = bad_file(b);
+  try {
+    smpm::load_case(file.string(), b.overrides);
+    FAIL() << b.name << ": no error";
+  } catch (const smpm::CaseError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(file.string() + ": ", 0), 0u) << "message must start with the source: "
+                                                      << msg;
+    EXPECT_NE(msg.find(b.expect), std::string::npos)
+        << "expected \"" << b.expect << "\" in\n  " << msg;
+  }
+}
+
+std::string param_name(const ::testing::TestParamInfo<Bad>& info) { return info.param.name; }
+
+INSTANTIATE_TEST_SUITE_P(CaseMalformed, CaseErrors, ::testing::ValuesIn(bad_cases()), param_name);
+
+// ---------------------------------------------------------------------------------------------
+// The same files through the CLI: non-zero exit, the message on stderr.
+struct CliResult {
+  int status;
+  std::string out, err;
+};
+
+CliResult run_cli(const std::string& args, const std::string& tag) {
+  const fs::path out = scratch() / ("cli_" + tag + ".out");
+  const fs::path err = scratch() / ("cli_" + tag + ".err");
+  const std::string cmd = "\"" + std::string(SMPM_CLI) + "\" " + args + " >\"" + out.string() +
+                          "\" 2>\"" + err.string() + "\"";
+  const int status = std::system(cmd.c_str());
+  return {status, read_file(out), read_file(err)};
+}
+
+bool have_cli() { return std::string(SMPM_CLI).size() > 0 && fs::exists(SMPM_CLI); }
+
+class CaseCli : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(CaseCli, CheckFailsWithMessage) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const Bad& b = GetParam();
+  const fs::path file = bad_file(b);
+  std::string args = "check \"" + file.string() + "\"";
+  for (const auto& o : b.overrides) args += " --set '" + o + "'";
+  const CliResult r = run_cli(args, b.name);
+  EXPECT_NE(r.status, 0) << b.name << ": exit status 0; stdout:\n" << r.out;
+  EXPECT_NE(r.err.find(b.expect), std::string::npos)
+      << "expected \"" << b.expect << "\" on stderr, got:\n" << r.err;
+}
+
+INSTANTIATE_TEST_SUITE_P(CaseMalformed, CaseCli, ::testing::ValuesIn(bad_cases()), param_name);
+
+TEST(CaseCliValid, CheckSucceeds) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path file = write_file("valid_cli.json", kValid);
+  const CliResult r = run_cli("check \"" + file.string() + "\"", "valid");
+  EXPECT_EQ(r.status, 0) << "stderr:\n" << r.err;
+}
+
+}  // namespace

@@ -1,0 +1,327 @@
+// Output files: history CSV round trip, the relative-L2 waveform metric against closed forms,
+// and HDF5/XDMF particle snapshots read back through the plain HDF5 C API.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "silentmpm/history.hpp"
+#include "silentmpm/material.hpp"
+#include "silentmpm/output.hpp"
+#include "silentmpm/particles.hpp"
+
+namespace fs = std::filesystem;
+using namespace smpm;
+
+namespace {
+
+// A fresh, empty directory per test, removed afterwards.
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& tag) {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path = fs::temp_directory_path() /
+           ("smpm_" + tag + "_" + std::string(info->name()) + "_" +
+            std::to_string(static_cast<long long>(::getpid())));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string str(const std::string& leaf) const { return (path / leaf).string(); }
+};
+
+std::string slurp(const std::string& file) {
+  std::ifstream in(file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+History sampled(double amplitude, double dt, double t_end) {
+  History h;
+  h.columns = {"A.sxx"};
+  h.data.resize(1);
+  for (long k = 0; k * dt <= t_end + 1e-12; ++k) {
+    const double t = k * dt;
+    h.time.push_back(t);
+    h.data[0].push_back(amplitude * std::sin(t));
+  }
+  return h;
+}
+
+std::vector<double> read_doubles(hid_t file, const std::string& name, std::vector<hsize_t>& dims) {
+  const hid_t ds = H5Dopen2(file, name.c_str(), H5P_DEFAULT);
+  EXPECT_GE(ds, 0) << name;
+  const hid_t space = H5Dget_space(ds);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  dims.assign(rank, 0);
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  hsize_t total = 1;
+  for (auto d : dims) total *= d;
+  std::vector<double> v(total);
+  EXPECT_GE(H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0) << name;
+  H5Sclose(space);
+  H5Dclose(ds);
+  return v;
+}
+
+Particles small_set(std::size_t n, double shift) {
+  Particles p;
+  p.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double s = static_cast<double>(i) + shift;
+    p.x[i] = 0.1 * s;
+    p.y[i] = -0.2 * s;
+    p.vx[i] = 1.0 + s;
+    p.vy[i] = 2.0 - s;
+    p.mass[i] = 3.0 + 0.5 * s;
+    p.vol[i] = 1e-4 * (1.0 + s);
+    p.sxx[i] = 1e6 * s;
+    p.syy[i] = -2e6 * s;
+    p.szz[i] = 0.3e6 * s;
+    p.sxy[i] = 0.7e6 * s;
+    p.eps_p[i] = 1e-3 * s;
+    p.id[i] = static_cast<uint32_t>(100 + i);
+    p.body[i] = static_cast<uint16_t>(i % 2);
+    p.group[i] = 0;
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(OutputHistory, CsvRoundTrip) {
+  TempDir dir("hist");
+  const std::string file = dir.str("history.csv");
+  const std::vector<std::string> cols = {"A.sxx", "A.vx", "energy.kinetic"};
+  std::vector<std::vector<double>> rows;
+  std::vector<double> times;
+  {
+    HistoryWriter w;
+    w.open(file, cols);
+    for (int k = 0; k < 50; ++k) {
+      const double t = 1.234567891e-6 * k;
+      const std::vector<double> v = {-3.3e8 * std::sin(0.1 * k) + 1e-3, 0.5 / (k + 1.0),
+                                     1.0e-12 * k * k};
+      w.row(t, v);
+      times.push_back(t);
+      rows.push_back(v);
+    }
+    EXPECT_THROW(w.row(0.0, {1.0}), std::runtime_error);  // wrong number of values
+    w.close();
+  }
+  // Header line is exactly the contract.
+  std::ifstream in(file);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "time,A.sxx,A.vx,energy.kinetic");
+
+  const History h = read_history(file);
+  ASSERT_EQ(h.columns, cols);
+  ASSERT_EQ(h.time.size(), times.size());
+  for (std::size_t r = 0; r < times.size(); ++r) {
+    EXPECT_NEAR(h.time[r], times[r], 1e-9 * std::abs(times[r]));
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      EXPECT_NEAR(h.data[c][r], rows[r][c], 1e-9 * std::abs(rows[r][c])) << cols[c];
+  }
+  EXPECT_EQ(&h.column("A.vx"), &h.data[1]);
+  EXPECT_THROW(h.column("B.vx"), std::runtime_error);
+}
+
+TEST(OutputHistory, OpenFailureNamesThePath) {
+  HistoryWriter w;
+  const std::string bad = "/nonexistent_dir_smpm/sub/history.csv";
+  try {
+    w.open(bad, {"A.sxx"});
+    FAIL() << "expected a throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+  }
+}
+
+TEST(HistoryRead, MalformedInputNamesFileAndLine) {
+  TempDir dir("histbad");
+  const std::string file = dir.str("bad.csv");
+  {
+    std::ofstream out(file);
+    out << "time,A.sxx\n0.0,1.0\n1.0,abc\n";
+  }
+  try {
+    read_history(file);
+    FAIL() << "expected a throw";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(file + ":3"), std::string::npos) << msg;
+  }
+  {
+    std::ofstream out(file);
+    out << "time,A.sxx\n0.0,1.0,2.0\n";
+  }
+  try {
+    read_history(file);
+    FAIL() << "expected a throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(file + ":2"), std::string::npos) << e.what();
+  }
+  {
+    std::ofstream out(file);
+    out << "t,A.sxx\n0.0,1.0\n";
+  }
+  EXPECT_THROW(read_history(file), std::runtime_error);
+  EXPECT_THROW(read_history(dir.str("missing.csv")), std::runtime_error);
+}
+
+TEST(HistoryRelativeL2, ClosedForms) {
+  // a = sin t, b = 1.1 sin t on different grids: ||a - b|| / ||b|| = 0.1 / 1.1.
+  const History a = sampled(1.0, 0.01, 10.0);
+  const History b = sampled(1.1, 0.0037, 10.0);
+  EXPECT_NEAR(relative_l2(a, b, "A.sxx", 0.0, 9.5), 0.1 / 1.1, 1e-3);
+  // Against itself the difference is exactly zero.
+  EXPECT_EQ(relative_l2(a, a, "A.sxx", 0.0, 10.0), 0.0);
+  // Same waveform, different grids: only interpolation error remains.
+  EXPECT_LT(relative_l2(a, sampled(1.0, 0.0037, 10.0), "A.sxx", 0.5, 9.5), 1e-4);
+  // Empty window, zero reference, missing column.
+  EXPECT_THROW(relative_l2(a, b, "A.sxx", 20.0, 30.0), std::runtime_error);
+  EXPECT_THROW(relative_l2(a, sampled(0.0, 0.01, 10.0), "A.sxx", 0.0, 10.0), std::runtime_error);
+  EXPECT_THROW(relative_l2(a, b, "A.vx", 0.0, 10.0), std::runtime_error);
+}
+
+TEST(OutputSnapshot, WriteAndReadBack) {
+  TempDir dir("snap");
+  const std::size_t n = 7;
+  const Particles p0 = small_set(n, 0.0), p1 = small_set(n, 0.25);
+  const double t0 = 0.0, t1 = 1.5e-5;
+  {
+    SnapshotWriter w;
+    w.open(dir.path.string());
+    w.write(p0, 0, t0);
+    w.write(p1, 123, t1);
+    EXPECT_EQ(w.count(), 2);
+    w.close();
+  }
+  const std::string h5 = dir.str("particles.h5");
+  ASSERT_TRUE(fs::exists(h5));
+  const hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  const char* fields[] = {"vx",  "vy",    "sxx",  "syy",    "szz",  "sxy",
+                          "J2",  "eps_p", "mass", "volume", "body", "id"};
+  for (int s = 0; s < 2; ++s) {
+    const Particles& p = s == 0 ? p0 : p1;
+    const std::string g = s == 0 ? "/step_000000000" : "/step_000000123";
+    // time attribute
+    const hid_t grp = H5Gopen2(f, g.c_str(), H5P_DEFAULT);
+    ASSERT_GE(grp, 0) << g;
+    const hid_t attr = H5Aopen(grp, "time", H5P_DEFAULT);
+    ASSERT_GE(attr, 0);
+    double t = -1;
+    H5Aread(attr, H5T_NATIVE_DOUBLE, &t);
+    EXPECT_EQ(t, s == 0 ? t0 : t1);
+    H5Aclose(attr);
+    H5Gclose(grp);
+
+    std::vector<hsize_t> dims;
+    const auto xyz = read_doubles(f, g + "/xyz", dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{n, 3}));
+    for (std::size_t i = 0; i < n; ++i) {
+      EXPECT_EQ(xyz[3 * i], p.x[i]);
+      EXPECT_EQ(xyz[3 * i + 1], p.y[i]);
+      EXPECT_EQ(xyz[3 * i + 2], 0.0);
+    }
+    const std::vector<const std::vector<double>*> expect = {&p.vx,  &p.vy,  &p.sxx,   &p.syy,
+                                                            &p.szz, &p.sxy, nullptr,  &p.eps_p,
+                                                            &p.mass, &p.vol};
+    for (std::size_t k = 0; k < expect.size(); ++k) {
+      const auto v = read_doubles(f, g + "/" + fields[k], dims);
+      ASSERT_EQ(dims, (std::vector<hsize_t>{n})) << fields[k];
+      for (std::size_t i = 0; i < n; ++i) {
+        const double want =
+            expect[k] ? (*expect[k])[i] : j2_of(p.sxx[i], p.syy[i], p.szz[i], p.sxy[i]);
+        EXPECT_EQ(v[i], want) << fields[k] << " particle " << i;
+      }
+    }
+    // body is stored as 32-bit integers
+    const hid_t ds = H5Dopen2(f, (g + "/body").c_str(), H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    const hid_t type = H5Dget_type(ds);
+    EXPECT_EQ(H5Tget_class(type), H5T_INTEGER);
+    EXPECT_EQ(H5Tget_size(type), 4u);
+    H5Tclose(type);
+    std::vector<int32_t> body(n, -1);
+    H5Dread(ds, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, body.data());
+    H5Dclose(ds);
+    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(body[i], static_cast<int32_t>(p.body[i]));
+  }
+  H5Fclose(f);
+
+  // XDMF sidecar: mentions every dataset, the particle count and each snapshot time.
+  const std::string xdmf = slurp(dir.str("particles.xdmf"));
+  ASSERT_FALSE(xdmf.empty());
+  EXPECT_NE(xdmf.find("CollectionType=\"Temporal\""), std::string::npos);
+  EXPECT_NE(xdmf.find("Polyvertex"), std::string::npos);
+  EXPECT_NE(xdmf.find("NumberOfElements=\"" + std::to_string(n) + "\""), std::string::npos);
+  EXPECT_NE(xdmf.find("particles.h5:/step_000000000/xyz"), std::string::npos);
+  EXPECT_NE(xdmf.find("particles.h5:/step_000000123/xyz"), std::string::npos);
+  for (const char* name : fields) {
+    EXPECT_NE(xdmf.find("Name=\"" + std::string(name) + "\""), std::string::npos) << name;
+    EXPECT_NE(xdmf.find("/step_000000123/" + std::string(name) + "<"), std::string::npos) << name;
+  }
+  for (double t : {t0, t1}) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9e", t);
+    EXPECT_NE(xdmf.find("Time Value=\"" + std::string(buf) + "\""), std::string::npos) << buf;
+  }
+}
+
+TEST(OutputSnapshot, XdmfIsRewrittenAfterEverySnapshot) {
+  TempDir dir("snapx");
+  SnapshotWriter w;
+  w.open(dir.path.string(), "run");
+  w.write(small_set(3, 0.0), 5, 1.0);
+  const std::string first = slurp(dir.str("run.xdmf"));
+  EXPECT_NE(first.find("run.h5:/step_000000005/xyz"), std::string::npos);
+  w.write(small_set(4, 0.0), 9, 2.0);  // before close(): a partial run still opens
+  const std::string second = slurp(dir.str("run.xdmf"));
+  EXPECT_NE(second.find("run.h5:/step_000000009/xyz"), std::string::npos);
+  EXPECT_NE(second.find("NumberOfElements=\"4\""), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir.str("run.xdmf.tmp")));
+  // The flushed file is readable while the writer still holds it open (the writer takes no
+  // file lock, so other processes can read it too; inside this process the access property
+  // lists must agree on locking).
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+#if H5_VERSION_GE(1, 10, 7)
+  H5Pset_file_locking(fapl, 0, 1);
+#endif
+  const hid_t f = H5Fopen(dir.str("run.h5").c_str(), H5F_ACC_RDONLY, fapl);
+  H5Pclose(fapl);
+  EXPECT_GE(f, 0);
+  if (f >= 0) {
+    EXPECT_GT(H5Lexists(f, "/step_000000009", H5P_DEFAULT), 0);
+    H5Fclose(f);
+  }
+  w.close();
+}
+
+TEST(OutputSnapshot, MissingDirectoryThrows) {
+  SnapshotWriter w;
+  const std::string bad = "/nonexistent_dir_smpm/out";
+  try {
+    w.open(bad);
+    FAIL() << "expected a throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(bad + "/particles.h5"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(w.write(small_set(2, 0.0), 0, 0.0), std::runtime_error);  // not open
+}
