@@ -909,10 +909,11 @@ class Builder {
       if (type == "roller") keys.push_back("component");
       o.allow(keys, where);
     } else if (type == "traction") {
-      o.allow({"type", "name", "body", "side", "width", "normal", "tangential", "vector", "time"},
+      o.allow({"type", "name", "body", "side", "width", "normal", "tangential", "vector", "time",
+               "anchor"},
               where);
     } else {
-      o.allow({"type", "name", "body", "side", "width", "a", "b", "form"}, where);
+      o.allow({"type", "name", "body", "side", "width", "a", "b", "form", "anchor"}, where);
     }
     const std::string name = o.str("name", type + std::to_string(i));
     if (name.empty()) o.fail("name", "must not be empty");
@@ -949,6 +950,9 @@ class Builder {
         amp = "vector (" + fmt(t.vx) + ", " + fmt(t.vy) + ") Pa";
       }
       if (const ojson* tf = o.find("time")) t.fn = parse_time_function(Obj(ctx_, *tf, o.at("time")));
+      t.anchor = o.choice("anchor", {"boundary", "particle"}, "boundary") == "boundary"
+                     ? Anchor::Boundary
+                     : Anchor::Particle;
       o.done();
       c.notes.push_back("traction \"" + name + "\" on the " + what + " (" +
                         std::to_string(t.layer.ids.size()) + " particles): " + amp + " x " +
@@ -967,6 +971,11 @@ class Builder {
     o.ge("b", sb.b, 0);
     sb.form = o.choice("form", {"nodal", "particle"}, "nodal") == "nodal" ? SilentForm::Nodal
                                                                          : SilentForm::Particle;
+    // The paper's lagged form is stable only when mapped at the particle (see README).
+    const std::string anchor_default = sb.form == SilentForm::Nodal ? "boundary" : "particle";
+    sb.anchor = o.choice("anchor", {"boundary", "particle"}, anchor_default.c_str()) == "boundary"
+                    ? Anchor::Boundary
+                    : Anchor::Particle;
     o.done();
     // Impedances from the material of each selected particle (ids are permanent; map them to
     // current indices in case the solver has reordered).
