@@ -977,18 +977,8 @@ class Builder {
                     ? Anchor::Boundary
                     : Anchor::Particle;
     o.done();
-    // Impedances from the material of each selected particle (ids are permanent; map them to
-    // current indices in case the solver has reordered).
-    std::unordered_map<uint32_t, std::size_t> where_id;
-    where_id.reserve(s_->p.size());
-    for (std::size_t k = 0; k < s_->p.size(); ++k) where_id[s_->p.id[k]] = k;
-    for (uint32_t id : sb.layer.ids) {
-      auto it = where_id.find(id);
-      if (it == where_id.end()) o.fail("", "internal error: layer particle id not found");
-      const Material& m = s_->materials[s_->p.group[it->second]];
-      sb.zn.push_back(sb.a * m.rho * m.cd);
-      sb.zt.push_back(sb.b * m.rho * m.cs);
-    }
+    // The impedances a rho c_d and b rho c_s of each particle's material are set by
+    // Solver::finalize().
     s_->silents.push_back(std::move(sb));
   }
 

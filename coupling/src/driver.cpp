@@ -49,7 +49,6 @@ class Progress {
     std::fprintf(stderr, "%s  %5.1f%%  step %ld/%ld  %.0f steps/s  %.1f s left%s",
                  tty_ ? "\r" : "", 100.0 * step / total_, step, total_, rate, left,
                  tty_ ? "   " : "\n");
-    printed_ = true;
     if (step >= total_ && tty_) std::fprintf(stderr, "\n");
   }
 
@@ -59,7 +58,6 @@ class Progress {
   bool tty_;
   Clock::time_point t0_;
   double last_ = 0;
-  bool printed_ = false;
 };
 
 }  // namespace
