@@ -64,7 +64,9 @@ void check_arrival_and_plateau(bool shear) {
   // Compression gives sigma_xx = -sigma0; the tangential traction on the left end (s = (0, -1))
   // gives |sigma_xy| = tau.
   EXPECT_NEAR(std::abs(ss / n), c.amplitude, 0.02 * c.amplitude);
-  if (!shear) EXPECT_LT(ss / n, 0.0);
+  if (!shear) {
+    EXPECT_LT(ss / n, 0.0);
+  }
   const double v0 = c.amplitude / (m.rho * cw);
   EXPECT_NEAR(std::abs(sv / n), v0, 0.02 * v0);
 }
