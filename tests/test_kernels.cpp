@@ -141,3 +141,23 @@ TEST_P(TractionSum, EqualsTractionTimesLength) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ParticlesPerCell, TractionSum, ::testing::Values(1, 2, 3));
+
+// A particle that leaves the grid stops the run with an error naming the step, in x and in y.
+TEST(Transfer, ParticleLeavingTheGridIsAnError) {
+  for (int dir = 0; dir < 2; ++dir) {
+    Solver s;
+    s.materials.push_back(tungsten());
+    s.grid.init(0, 0, 1e-3, 10, 10);
+    const double v = 2000.0;  // m/s: crosses the 1 mm margin within 1 us
+    s.seed_rectangle(1e-3, 1e-3, 9e-3, 9e-3, 1, 0, 0, dir == 0 ? v : 0, dir == 1 ? v : 0);
+    s.dt = 0.2 * s.critical_dt();
+    s.finalize();
+    bool thrown = false;
+    try {
+      for (int i = 0; i < 10000; ++i) s.step();
+    } catch (const std::runtime_error& e) {
+      thrown = std::string(e.what()).find("left the grid at step") != std::string::npos;
+    }
+    EXPECT_TRUE(thrown) << "direction " << dir;
+  }
+}

@@ -196,6 +196,7 @@ void Solver::refresh_strip_rows() {
   const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
   strip_lo_.assign(nstrips_, std::numeric_limits<int>::max());
   strip_hi_.assign(nstrips_, std::numeric_limits<int>::min());
+  strip_out_.assign(nstrips_, 0);
   for (int s = 0; s < nstrips_; ++s)
     for (int g = 0; g < G; ++g)
       for (uint32_t k = ranges_[s * G + g][0]; k < ranges_[s * G + g][1]; ++k) {
@@ -504,9 +505,10 @@ void Solver::g2p_velocity(bool remap, bool move) {
   double* X = p.x.data(); double* Y = p.y.data();
   double* VX = p.vx.data(); double* VY = p.vy.data();
   const double* M = p.mass.data();
+  const double x1 = grid.x1();
   auto body = [&](uint32_t b, uint32_t e, int, int s) {
     Bilinear sf;
-    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
+    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min(), out = 0;
     for (uint32_t k = b; k < e; ++k) {
       sf.eval(X[k], Y[k], x0, y0, ih);
       const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
@@ -534,9 +536,11 @@ void Solver::g2p_velocity(bool remap, bool move) {
         Y[k] += DT * wy;
         const int r = static_cast<int>(std::floor((Y[k] - y0) * ih));
         lo = std::min(lo, r); hi = std::max(hi, r);
+        out += !(X[k] >= x0 && X[k] < x1);
       }
     }
     if (move) {
+      strip_out_[s] += out;
       strip_lo_[s] = std::min(strip_lo_[s], lo);
       strip_hi_[s] = std::max(strip_hi_[s], hi);
     }
@@ -544,6 +548,7 @@ void Solver::g2p_velocity(bool remap, bool move) {
   if (move) {
     std::fill(strip_lo_.begin(), strip_lo_.end(), std::numeric_limits<int>::max());
     std::fill(strip_hi_.begin(), strip_hi_.end(), std::numeric_limits<int>::min());
+    std::fill(strip_out_.begin(), strip_out_.end(), 0);
   }
   if (remap) scatter_over_groups(body);
   else parallel_over_groups(body);
@@ -556,8 +561,8 @@ namespace {
 template <Model MODEL>
 double stress_range(uint32_t b, uint32_t e, const Material& mat, const Grid& grid,
                     const double* gx, const double* gy, const double* ux, const double* uy,
-                    double dt, bool move, Particles& p, int& lo, int& hi) {
-  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h;
+                    double dt, bool move, Particles& p, int& lo, int& hi, int& out) {
+  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h, x1 = grid.x1();
   const int nnx = grid.nnx;
   double* X = p.x.data(); double* Y = p.y.data();
   double* V = p.vol.data();
@@ -595,6 +600,7 @@ double stress_range(uint32_t b, uint32_t e, const Material& mat, const Grid& gri
       Y[k] += dt * wy;
       const int r = static_cast<int>(std::floor((Y[k] - y0) * ih));
       lo = std::min(lo, r); hi = std::max(hi, r);
+      out += !(X[k] >= x0 && X[k] < x1);
     }
   }
   return diss;
@@ -607,24 +613,26 @@ void Solver::update_stress_and_position(const std::vector<double>& gx,
   if (move) {
     std::fill(strip_lo_.begin(), strip_lo_.end(), std::numeric_limits<int>::max());
     std::fill(strip_hi_.begin(), strip_hi_.end(), std::numeric_limits<int>::min());
+    std::fill(strip_out_.begin(), strip_out_.end(), 0);
   }
   parallel_over_groups([&](uint32_t b, uint32_t e, int g, int s) {
     if (b == e) return;
-    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
+    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min(), out = 0;
     const Material& mat = materials[g];
     double d = 0;
     switch (mat.model) {
       case Model::Elastic:
         d = stress_range<Model::Elastic>(b, e, mat, grid, gx.data(), gy.data(), grid.vnx.data(),
-                                         grid.vny.data(), dt, move, p, lo, hi);
+                                         grid.vny.data(), dt, move, p, lo, hi, out);
         break;
       case Model::VonMises:
         d = stress_range<Model::VonMises>(b, e, mat, grid, gx.data(), gy.data(),
-                                          grid.vnx.data(), grid.vny.data(), dt, move, p, lo, hi);
+                                          grid.vnx.data(), grid.vny.data(), dt, move, p, lo, hi, out);
         break;
     }
     diss[s] += d;
     if (move) {
+      strip_out_[s] += out;
       strip_lo_[s] = std::min(strip_lo_[s], lo);
       strip_hi_[s] = std::max(strip_hi_[s], hi);
     }
@@ -632,24 +640,17 @@ void Solver::update_stress_and_position(const std::vector<double>& gx,
   for (double d : diss) energy.dissipated += d;
 }
 
+// The passes that move particles count, per strip, the particles outside the grid's columns and
+// track the rows; no extra pass over the particles is needed unless one has left.
 void Solver::check_outside() {
-  // Rows are tracked per strip during the move; columns need a check only when a strip's
-  // rows or any particle left the grid, so do one cheap pass over x here.
   bool bad = false;
   for (int s = 0; s < nstrips_; ++s)
-    if (strip_lo_[s] <= strip_hi_[s] && (strip_lo_[s] < 0 || strip_hi_[s] >= grid.ny)) bad = true;
+    if (strip_out_[s] > 0 ||
+        (strip_lo_[s] <= strip_hi_[s] && (strip_lo_[s] < 0 || strip_hi_[s] >= grid.ny)))
+      bad = true;
   if (!bad) {
-    const double xa = grid.x0, xb = grid.x1();
-    const double* X = p.x.data();
-    const long n = static_cast<long>(p.size());
-    long found = n;
-#pragma omp parallel for reduction(min : found) num_threads(nthreads_)
-    for (long k = 0; k < n; ++k)
-      if (!(X[k] >= xa && X[k] < xb)) found = std::min(found, k);
-    if (found == n) {
-      strips_ok_ = !strips_conflict();
-      return;
-    }
+    strips_ok_ = !strips_conflict();
+    return;
   }
   const long k = first_particle_outside();
   std::ostringstream o;

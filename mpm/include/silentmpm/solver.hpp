@@ -103,6 +103,7 @@ class Solver {
   // ranges_[s * G + g] = [begin, end) of particles of strip s and group g.
   std::vector<std::array<uint32_t, 2>> ranges_;
   std::vector<int> strip_lo_, strip_hi_;  // cell-row range each strip touches
+  std::vector<int> strip_out_;            // particles of each strip outside the grid columns
   std::vector<uint32_t> where_;           // permanent id -> current index
 
   void sort_particles();
