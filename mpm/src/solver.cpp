@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "silentmpm/film.hpp"
 #include "silentmpm/shape.hpp"
 
 namespace smpm {
@@ -25,6 +26,7 @@ const char* model_name(Model m) {
   switch (m) {
     case Model::Elastic: return "elastic";
     case Model::VonMises: return "von_mises";
+    case Model::J2Film: return "j2_softening";
   }
   return "?";
 }
@@ -120,6 +122,7 @@ long Solver::first_particle_outside() const {
 
 void Solver::finalize() {
   nthreads_ = opt.threads > 0 ? opt.threads : omp_get_max_threads();
+  if (contact.multi()) contact.setup(*this);  // splits material groups per body
   nstrips_ = 2 * nthreads_;
   double mmin = std::numeric_limits<double>::infinity();
   for (double m : p.mass) mmin = std::min(mmin, m);
@@ -590,8 +593,12 @@ double stress_range(uint32_t b, uint32_t e, const Material& mat, const Grid& gri
     const double w = 0.5 * (lxy - lyx) * dt;
     const double rxx = 2 * w * sxy, rxy = w * (syy - sxx);
     sxx += rxx; syy -= rxx; sxy += rxy;
-    const double wp = stress_update<MODEL>(mat, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy,
-                                           szz, sxy, EP[k]);
+    double wp;
+    if constexpr (MODEL == Model::J2Film)  // history in extra particle arrays (film.hpp)
+      wp = film_update(mat, p, k, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy, szz, sxy);
+    else
+      wp = stress_update<MODEL>(mat, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy, szz, sxy,
+                                EP[k]);
     SXX[k] = sxx; SYY[k] = syy; SZZ[k] = szz; SXY[k] = sxy;
     V[k] *= (1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt;
     diss += wp * V[k];
@@ -629,6 +636,10 @@ void Solver::update_stress_and_position(const std::vector<double>& gx,
         d = stress_range<Model::VonMises>(b, e, mat, grid, gx.data(), gy.data(),
                                           grid.vnx.data(), grid.vny.data(), dt, move, p, lo, hi, out);
         break;
+      case Model::J2Film:
+        d = stress_range<Model::J2Film>(b, e, mat, grid, gx.data(), gy.data(), grid.vnx.data(),
+                                        grid.vny.data(), dt, move, p, lo, hi, out);
+        break;
     }
     diss[s] += d;
     if (move) {
@@ -663,6 +674,13 @@ void Solver::check_outside() {
 
 void Solver::step() {
   if (!strips_ok_) sort_particles();
+  if (contact.multi()) {  // one velocity field per body: mpm/src/contact.cpp
+    contact.step(*this);
+    t += dt;
+    ++steps;
+    check_outside();
+    return;
+  }
   reset_grid();
   switch (opt.scheme) {
     case Scheme::USL:

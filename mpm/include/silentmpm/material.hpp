@@ -8,9 +8,14 @@
 #include <cmath>
 #include <string>
 
+#include "silentmpm/bifurcation.hpp"
+#include "silentmpm/decohesion.hpp"
+#include "silentmpm/j2soft.hpp"
+
 namespace smpm {
 
-enum class Model { Elastic, VonMises };
+// J2Film: J2 with hardening then softening, bifurcation check and decohesion (film.hpp).
+enum class Model { Elastic, VonMises, J2Film };
 
 const char* model_name(Model m);
 
@@ -19,6 +24,9 @@ struct Material {
   Model model = Model::Elastic;
   double E = 0, nu = 0, rho = 0;
   double sigma_y = 0;  // von Mises yield stress (VonMises only)
+  J2SoftParams j2;          // J2Film only (j2.sigma_y is its yield stress)
+  BifurcationParams bif;    // J2Film only
+  DecohesionParams coh;     // J2Film only
   // Derived (call derive() after setting the inputs).
   double lambda = 0, mu = 0, M = 0, K = 0, cd = 0, cs = 0;
   void derive() {
@@ -28,6 +36,10 @@ struct Material {
     K = lambda + 2.0 / 3.0 * mu;
     cd = std::sqrt(M / rho);
     cs = std::sqrt(mu / rho);
+    if (model == Model::J2Film) {
+      j2.derive(E);
+      if (!(coh.min_strength > 0)) coh.min_strength = 1e-3 * j2.sigma_y;
+    }
   }
   double impedance_p() const { return rho * cd; }
   double impedance_s() const { return rho * cs; }

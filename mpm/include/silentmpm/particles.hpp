@@ -12,6 +12,11 @@ struct Particles {
   std::vector<double> vol;           // current volume V_p (unit thickness)
   std::vector<double> sxx, syy, szz, sxy;  // Cauchy stress
   std::vector<double> eps_p;         // accumulated equivalent plastic strain
+  // Film model history (decohesion.hpp): state, plane normal, smear length, strengths, jump.
+  std::vector<uint8_t> state;        // ParticleState: elastic, plastic, decohesion, separated
+  std::vector<double> dnx, dny;      // normal of the critical plane (0, 0 before bifurcation)
+  std::vector<double> dL, dtnf, dttf;  // smear length, normal and tangential strengths
+  std::vector<double> jump_n, jump_t, ubar;  // jump components, accumulated normalised jump
   std::vector<uint32_t> id;          // permanent id (seeding order); survives re-sorting
   std::vector<uint16_t> body;        // body index
   std::vector<uint16_t> group;       // material group index
@@ -21,7 +26,7 @@ struct Particles {
   // Apply a permutation: new[k] = old[perm[k]].
   void permute(const std::vector<uint32_t>& perm);
   static constexpr std::size_t bytes_per_particle() {
-    return 12 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t);
+    return 20 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t) + sizeof(uint8_t);
   }
 };
 
