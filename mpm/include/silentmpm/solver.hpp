@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "silentmpm/boundary.hpp"
+#include "silentmpm/contact.hpp"
 #include "silentmpm/grid.hpp"
 #include "silentmpm/material.hpp"
 #include "silentmpm/particles.hpp"
@@ -53,6 +54,8 @@ struct ProbeSample {
 };
 
 class Solver {
+  friend class Contact;  // the multi-field step runs the stages below per body
+
  public:
   Grid grid;
   Particles p;
@@ -64,6 +67,7 @@ class Solver {
   double dt = 0, t = 0;
   long steps = 0;
   Energies energy;
+  Contact contact;  // contact of bodies: single velocity field (default) or one per body
 
   // --- setup -------------------------------------------------------------------------------
   // Fill the rectangle [x0, x1] x [y0, y1] with particles on a lattice of n x n per cell

@@ -1,0 +1,369 @@
+// Multi-velocity-field contact (Bardenhagen, Brackbill & Sulsky 2000); see contact.hpp for the
+// algorithm, the choice of normal and the energy accounting.
+//
+// The step reuses the solver's own stages. Per-body nodal fields live here, one array per body
+// and field; to run a solver stage (g2p, stress update) for body b, the solver's nodal arrays and
+// particle ranges are swapped with body b's (O(1) vector swaps), the stage runs over b's
+// particles only (material groups are split per body in setup(), so b's particles are whole
+// ranges), and everything is swapped back. The single-field step is not touched.
+#include "silentmpm/contact.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include "silentmpm/shape.hpp"
+#include "silentmpm/solver.hpp"
+
+namespace smpm {
+
+const char* contact_type_name(ContactType t) {
+  return t == ContactType::Multi ? "multi" : "single";
+}
+
+void Contact::setup(Solver& s) {
+  // Split material groups so that each group holds one body: the first body met in a group keeps
+  // the group, every further body of that group gets a copy of the material.
+  const std::size_t G0 = s.materials.size();
+  std::vector<int> owner(G0, -1);
+  std::map<std::pair<int, int>, int> split;  // (group, body) -> new group
+  int bmax = -1;
+  for (std::size_t k = 0; k < s.p.size(); ++k) {
+    const int g = s.p.group[k], b = s.p.body[k];
+    bmax = std::max(bmax, b);
+    if (owner[g] < 0) owner[g] = b;
+    if (owner[g] == b) continue;
+    auto it = split.find({g, b});
+    if (it == split.end()) {
+      s.materials.push_back(s.materials[g]);
+      it = split.emplace(std::make_pair(g, b), static_cast<int>(s.materials.size() - 1)).first;
+    }
+    s.p.group[k] = static_cast<uint16_t>(it->second);
+  }
+  nb_ = bmax + 1;
+  body_of_group_.assign(s.materials.size(), 0);
+  for (std::size_t g = 0; g < G0; ++g) body_of_group_[g] = std::max(owner[g], 0);
+  for (const auto& [gb, g] : split) body_of_group_[g] = gb.second;
+  const std::size_t n = s.grid.nodes();
+  for (Field* f : {&m_, &px_, &py_, &fx_, &fy_, &gx_, &gy_, &vx_, &vy_, &vnx_, &vny_, &qx_, &qy_})
+    f->assign(nb_, std::vector<double>(n, 0.0));
+  force.assign(nb_, {0.0, 0.0});
+  ranges_.assign(nb_, {});
+  dissipated = 0;
+}
+
+// Per body: the solver's ranges with every group of another body emptied.
+void Contact::body_ranges(Solver& s) {
+  const int G = static_cast<int>(std::max<std::size_t>(1, s.materials.size()));
+  for (int b = 0; b < nb_; ++b) {
+    ranges_[b] = s.ranges_;
+    for (int st = 0; st < s.nstrips_; ++st)
+      for (int g = 0; g < G; ++g)
+        if (body_of_group_[g] != b) ranges_[b][st * G + g] = {0, 0};
+  }
+}
+
+void Contact::swap_in(Solver& s, int b) {
+  Grid& g = s.grid;
+  std::swap(g.m, m_[b]);
+  std::swap(g.vx, vx_[b]);
+  std::swap(g.vy, vy_[b]);
+  std::swap(g.vnx, vnx_[b]);
+  std::swap(g.vny, vny_[b]);
+  std::swap(g.qx, qx_[b]);
+  std::swap(g.qy, qy_[b]);
+  std::swap(s.ranges_, ranges_[b]);
+}
+
+// Run fn() for each body with that body swapped in; fn moves particles, so the strip row and
+// outside counts of the passes are merged.
+template <class Fn>
+void Contact::per_body_moving(Solver& s, Fn&& fn) {
+  const int S = s.nstrips_;
+  std::vector<int> lo(S, std::numeric_limits<int>::max()), hi(S, std::numeric_limits<int>::min()),
+      out(S, 0);
+  for (int b = 0; b < nb_; ++b) {
+    swap_in(s, b);
+    fn();
+    swap_in(s, b);
+    for (int st = 0; st < S; ++st) {
+      lo[st] = std::min(lo[st], s.strip_lo_[st]);
+      hi[st] = std::max(hi[st], s.strip_hi_[st]);
+      out[st] += s.strip_out_[st];
+    }
+  }
+  s.strip_lo_ = lo;
+  s.strip_hi_ = hi;
+  s.strip_out_ = out;
+}
+
+// Per-body masses, momenta, mass gradients and internal forces; their sums go to the solver's
+// (centre of mass) fields. Same strip colouring as the solver's scatters: no two threads write
+// one node.
+void Contact::p2g(Solver& s, bool momentum, bool with_force) {
+  const long n = static_cast<long>(s.grid.nodes());
+  const int nt = s.nthreads_;
+  for (int b = 0; b < nb_; ++b) {
+    double* a[5] = {m_[b].data(), px_[b].data(), py_[b].data(), gx_[b].data(), gy_[b].data()};
+    double* f[2] = {fx_[b].data(), fy_[b].data()};
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (long i = 0; i < n; ++i) {
+      if (momentum)
+        for (double* v : a) v[i] = 0;
+      if (with_force) f[0][i] = f[1][i] = 0;
+    }
+  }
+  const Grid& grid = s.grid;
+  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h;
+  const int nnx = grid.nnx;
+  const Particles& p = s.p;
+  const int G = static_cast<int>(std::max<std::size_t>(1, s.materials.size()));
+  auto strip = [&](int st) {
+    Bilinear sf;
+    for (int g = 0; g < G; ++g) {
+      const uint32_t kb = s.ranges_[st * G + g][0], ke = s.ranges_[st * G + g][1];
+      if (kb == ke) continue;
+      const int b = body_of_group_[g];
+      double* gm = m_[b].data(); double* gpx = px_[b].data(); double* gpy = py_[b].data();
+      double* ggx = gx_[b].data(); double* ggy = gy_[b].data();
+      double* gfx = fx_[b].data(); double* gfy = fy_[b].data();
+      for (uint32_t k = kb; k < ke; ++k) {
+        sf.eval(p.x[k], p.y[k], x0, y0, ih);
+        const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
+        const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
+        if (momentum) {
+          const double mk = p.mass[k], mvx = mk * p.vx[k], mvy = mk * p.vy[k];
+          for (int c = 0; c < 4; ++c) {
+            gm[nodes[c]] += mk * sf.N[c];
+            gpx[nodes[c]] += mvx * sf.N[c];
+            gpy[nodes[c]] += mvy * sf.N[c];
+            ggx[nodes[c]] += mk * sf.dNx[c];
+            ggy[nodes[c]] += mk * sf.dNy[c];
+          }
+        }
+        if (with_force) {
+          const double v = p.vol[k], sxx = p.sxx[k], syy = p.syy[k], sxy = p.sxy[k];
+          for (int c = 0; c < 4; ++c) {
+            gfx[nodes[c]] -= v * (sxx * sf.dNx[c] + sxy * sf.dNy[c]);
+            gfy[nodes[c]] -= v * (sxy * sf.dNx[c] + syy * sf.dNy[c]);
+          }
+        }
+      }
+    }
+  };
+  if (!s.strips_ok_ || nt == 1) {
+    for (int st = 0; st < s.nstrips_; ++st) strip(st);
+  } else {
+    for (int colour = 0; colour < 2; ++colour) {
+#pragma omp parallel for schedule(static, 1) num_threads(nt)
+      for (int st = colour; st < s.nstrips_; st += 2) strip(st);
+    }
+  }
+  // Centre-of-mass fields.
+  Grid& gw = s.grid;
+  const int B = nb_;
+#pragma omp parallel for schedule(static) num_threads(nt)
+  for (long i = 0; i < n; ++i) {
+    if (momentum) {
+      double m = 0, qx = 0, qy = 0;
+      for (int b = 0; b < B; ++b) { m += m_[b][i]; qx += px_[b][i]; qy += py_[b][i]; }
+      gw.m[i] = m; gw.px[i] = qx; gw.py[i] = qy;
+    }
+    if (with_force) {
+      double fx = 0, fy = 0;
+      for (int b = 0; b < B; ++b) { fx += fx_[b][i]; fy += fy_[b][i]; }
+      gw.fx[i] = fx; gw.fy[i] = fy;
+    }
+  }
+}
+
+void Contact::find_contact_nodes(Solver& s) {
+  cnodes_.clear();
+  const long n = static_cast<long>(s.grid.nodes());
+  const double floor = s.mass_floor_;
+  for (long i = 0; i < n; ++i) {
+    int c = 0;
+    for (int b = 0; b < nb_ && c < 2; ++b) c += m_[b][i] > floor;
+    if (c >= 2) cnodes_.push_back(static_cast<uint32_t>(i));
+  }
+  contact_nodes = static_cast<long>(cnodes_.size());
+}
+
+// v_b = p_b / m_b with the constraints (on a node with one body this is the centre-of-mass value).
+void Contact::split_start(Solver& s, Field& vx, Field& vy, const Field& px, const Field& py) {
+  const long n = static_cast<long>(s.grid.nodes());
+  const double floor = s.mass_floor_;
+  const uint8_t* fix = s.grid.fix.data();
+  for (int b = 0; b < nb_; ++b) {
+    const double* m = m_[b].data();
+    const double* qx = px[b].data(); const double* qy = py[b].data();
+    double* ux = vx[b].data(); double* uy = vy[b].data();
+#pragma omp parallel for schedule(static) num_threads(s.nthreads_)
+    for (long i = 0; i < n; ++i) {
+      if (m[i] > floor) {
+        ux[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
+        uy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
+      } else {
+        ux[i] = 0; uy[i] = 0;
+      }
+    }
+  }
+}
+
+// Updated per-body velocities: the centre-of-mass value where one body is present; at contact
+// nodes the centre-of-mass value plus the body's own deviation, then the contact correction.
+void Contact::split_updated(Solver& s) {
+  const long n = static_cast<long>(s.grid.nodes());
+  const double floor = s.mass_floor_, dt = s.dt;
+  const Grid& g = s.grid;
+  for (int b = 0; b < nb_; ++b) {
+    const double* m = m_[b].data();
+    double* ux = vnx_[b].data(); double* uy = vny_[b].data();
+#pragma omp parallel for schedule(static) num_threads(s.nthreads_)
+    for (long i = 0; i < n; ++i) {
+      const bool has = m[i] > floor;
+      ux[i] = has ? g.vnx[i] : 0.0;
+      uy[i] = has ? g.vny[i] : 0.0;
+    }
+  }
+  for (uint32_t i : cnodes_) {
+    double fx = 0, fy = 0;
+    for (int b = 0; b < nb_; ++b) { fx += fx_[b][i]; fy += fy_[b][i]; }
+    const double M = g.m[i];
+    const double cx = (g.px[i] + dt * fx) / M, cy = (g.py[i] + dt * fy) / M;
+    for (int b = 0; b < nb_; ++b) {
+      const double mb = m_[b][i];
+      if (mb <= floor) continue;
+      const double dx = (px_[b][i] + dt * fx_[b][i]) / mb - cx;
+      const double dy = (py_[b][i] + dt * fy_[b][i]) / mb - cy;
+      vnx_[b][i] = (g.fix[i] & 1) ? 0.0 : g.vnx[i] + dx;
+      vny_[b][i] = (g.fix[i] & 2) ? 0.0 : g.vny[i] + dy;
+    }
+  }
+  for (auto& f : force) f = {0.0, 0.0};
+  correct(s, vnx_, vny_, true);
+}
+
+// Contact correction of the fields (vx, vy) at the contact nodes. With count, the impulses are
+// recorded as contact forces and their work on the corrected velocities as dissipated energy.
+void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
+  const double floor = s.mass_floor_, mu = friction;
+  const Grid& g = s.grid;
+  double work = 0;
+  long active = 0;
+  for (uint32_t i : cnodes_) {
+    double M = 0, cx = 0, cy = 0, Gx = 0, Gy = 0;
+    for (int b = 0; b < nb_; ++b) {
+      const double mb = m_[b][i];
+      if (mb <= floor) continue;
+      M += mb;
+      cx += mb * vx[b][i];
+      cy += mb * vy[b][i];
+      Gx += gx_[b][i];
+      Gy += gy_[b][i];
+    }
+    cx /= M; cy /= M;
+    bool any = false;
+    for (int b = 0; b < nb_; ++b) {
+      const double mb = m_[b][i];
+      if (mb <= floor) continue;
+      // Outward normal of body b: its mass gradient minus the others' (= 2 g_b - G).
+      double nx = 2 * gx_[b][i] - Gx, ny = 2 * gy_[b][i] - Gy;
+      if (g.fix[i] & 1) nx = 0;
+      if (g.fix[i] & 2) ny = 0;
+      const double nn = std::hypot(nx, ny);
+      if (!(nn > 0)) continue;
+      nx /= nn; ny /= nn;
+      const double dx = vx[b][i] - cx, dy = vy[b][i] - cy;
+      const double dn = dx * nx + dy * ny;
+      if (dn <= 0) continue;  // separating or sliding apart: no contact force
+      any = true;
+      double ex = -dn * nx, ey = -dn * ny;
+      const double tx = dx - dn * nx, ty = dy - dn * ny;
+      const double tt = std::hypot(tx, ty);
+      if (tt > 0 && mu > 0) {
+        const double r = std::min(mu * dn, tt) / tt;  // stick if mu dn >= |dv_t|, else slide
+        ex -= r * tx;
+        ey -= r * ty;
+      }
+      if (g.fix[i] & 1) ex = 0;
+      if (g.fix[i] & 2) ey = 0;
+      if (count) {
+        // Work of the impulse on the corrected velocity: zero for the normal part (the pair
+        // moves together along n afterwards), impulse times remaining slip for friction.
+        const double ax = vx[b][i] + ex, ay = vy[b][i] + ey;
+        work += mb * (ex * ax + ey * ay);
+        force[b][0] += mb * ex / s.dt;
+        force[b][1] += mb * ey / s.dt;
+      }
+      vx[b][i] += ex;
+      vy[b][i] += ey;
+    }
+    active += any;
+  }
+  if (count) {
+    active_nodes = active;
+    dissipated -= work;
+    s.energy.dissipated -= work;
+  }
+}
+
+void Contact::step(Solver& s) {
+  body_ranges(s);
+  s.reset_grid();
+  if (s.opt.scheme == Scheme::USF) {
+    // Stress first, from each body's start-of-step field (contact-corrected, qx_ as scratch).
+    p2g(s, true, false);
+    find_contact_nodes(s);
+    split_start(s, qx_, qy_, px_, py_);
+    correct(s, qx_, qy_, false);
+    for (int b = 0; b < nb_; ++b) {
+      swap_in(s, b);
+      s.update_stress_and_position(s.grid.qx, s.grid.qy, false);
+      swap_in(s, b);
+    }
+    p2g(s, false, true);
+  } else {
+    p2g(s, true, true);
+    find_contact_nodes(s);
+  }
+  s.apply_loads();
+  s.grid_update();
+  s.boundary_work();
+  split_start(s, vx_, vy_, px_, py_);
+  split_updated(s);
+  switch (s.opt.scheme) {
+    case Scheme::USF:
+      per_body_moving(s, [&] { s.g2p_velocity(false, true); });
+      break;
+    case Scheme::USL:
+      for (int b = 0; b < nb_; ++b) {
+        swap_in(s, b);
+        s.g2p_velocity(false, false);
+        swap_in(s, b);
+      }
+      per_body_moving(s, [&] { s.update_stress_and_position(s.grid.vnx, s.grid.vny, true); });
+      break;
+    case Scheme::MUSL: {
+      const long n = static_cast<long>(s.grid.nodes());
+      for (int b = 0; b < nb_; ++b) {
+        std::fill(qx_[b].begin(), qx_[b].begin() + n, 0.0);
+        std::fill(qy_[b].begin(), qy_[b].begin() + n, 0.0);
+        swap_in(s, b);
+        s.g2p_velocity(true, false);
+        swap_in(s, b);
+      }
+      // Re-mapped momenta -> velocities of each body, corrected like the updated field.
+      split_start(s, qx_, qy_, qx_, qy_);
+      correct(s, qx_, qy_, false);
+      per_body_moving(s, [&] { s.update_stress_and_position(s.grid.qx, s.grid.qy, true); });
+      break;
+    }
+  }
+}
+
+}  // namespace smpm

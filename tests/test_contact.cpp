@@ -1,0 +1,245 @@
+// Contact of bodies (issue 5): 1D plate impact, aluminium flyer on a steel target, rollers on the
+// long sides (uniaxial strain), elastic. Closed forms (REFERENCE.md §4, P-wave impedances
+// Z = rho c_d computed from E, nu, rho):
+//   contact stress     sigma = v0 Z1 Z2 / (Z1 + Z2)        (12.26 MPa per m/s)
+//   contact duration   T_c = 2 d1 / c_d1                     (flyer thickness d1)
+//   rebound velocity   v0 (Z1 - Z2) / (Z1 + Z2)              (multi-velocity contact only)
+// Both contact modes: stress, duration, momentum, no interpenetration. Only the multi-field mode
+// separates.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "silentmpm/solver.hpp"
+
+using namespace smpm;
+
+namespace {
+
+Material aluminium(Model model = Model::Elastic) {
+  Material m;
+  m.name = "aluminium"; m.model = model;
+  m.E = 70e9; m.nu = 0.33; m.rho = 2700; m.sigma_y = 200e6;
+  m.derive();
+  return m;
+}
+
+Material steel(Model model = Model::Elastic) {
+  Material m;
+  m.name = "steel"; m.model = model;
+  m.E = 200e9; m.nu = 0.30; m.rho = 7800; m.sigma_y = 400e6;
+  m.derive();
+  return m;
+}
+
+struct Impact {
+  int flyer_cells = 50;    // d1 / h
+  int target_cells = 160;  // d2 / h: its back-face echo returns after 2 d2 / c2 > t_end
+  int height = 2;          // cells across, rollers on top and bottom
+  int ppc_side = 1;
+  double h = 1e-3;
+  double v0 = 10.0;
+  double cfl = 0.3;
+  ContactType type = ContactType::Multi;
+  double friction = 0;
+  Scheme scheme = Scheme::MUSL;
+  int threads = 1;
+};
+
+// Flyer [-d1, 0] x [0, H] (body 0) moving at v0 onto the target [0, d2] x [0, H] (body 1).
+std::unique_ptr<Solver> make_impact(const Impact& c) {
+  auto s = std::make_unique<Solver>();
+  s->materials.push_back(aluminium());
+  s->materials.push_back(steel());
+  const double d1 = c.flyer_cells * c.h, d2 = c.target_cells * c.h, H = c.height * c.h;
+  s->grid.init(-d1 - 10 * c.h, 0.0, c.h, c.flyer_cells + c.target_cells + 20, c.height);
+  s->seed_rectangle(-d1, 0, 0, H, c.ppc_side, 0, 0, c.v0, 0);
+  s->seed_rectangle(0, 0, d2, H, c.ppc_side, 1, 1, 0, 0);
+  s->constraints.push_back({"bottom", s->nodes_in_box(-1, 0, 1, 0), 2});
+  s->constraints.push_back({"top", s->nodes_in_box(-1, H, 1, H), 2});
+  s->contact.type = c.type;
+  s->contact.friction = c.friction;
+  s->opt.scheme = c.scheme;
+  s->opt.threads = c.threads;
+  s->dt = c.cfl * c.h / std::max(s->materials[0].cd, s->materials[1].cd);
+  s->finalize();
+  return s;
+}
+
+struct Trace {
+  std::vector<double> t, force, s_flyer, s_target, gap;
+  double p0 = 0, max_momentum_error = 0;
+  double min_gap = std::numeric_limits<double>::infinity();
+  double flyer_v = 0;  // mass-weighted mean velocity of the flyer at the end
+};
+
+double momentum_x(const Solver& s) {
+  double q = 0;
+  for (std::size_t k = 0; k < s.p.size(); ++k) q += s.p.mass[k] * s.p.vx[k];
+  return q;
+}
+
+// Right-most flyer particle to left-most target particle (initially one particle spacing).
+double gap(const Solver& s) {
+  double xf = -1e30, xt = 1e30;
+  for (std::size_t k = 0; k < s.p.size(); ++k) {
+    if (s.p.body[k] == 0) xf = std::max(xf, s.p.x[k]);
+    else xt = std::min(xt, s.p.x[k]);
+  }
+  return xt - xf;
+}
+
+Trace run(Solver& s, const Impact& c, double t_end) {
+  Trace tr;
+  tr.p0 = momentum_x(s);
+  const double d1 = c.flyer_cells * c.h, H = c.height * c.h;
+  while (s.t < t_end - 0.5 * s.dt) {
+    s.step();
+    tr.t.push_back(s.t);
+    tr.force.push_back(s.contact.multi() ? -s.contact.force[0][0] / H : 0.0);
+    // Probes at mid-height: the flyer's centre, and 10.5 cells into the target.
+    tr.s_flyer.push_back(s.sample(-0.5 * d1, 0.5 * H).sxx);
+    tr.s_target.push_back(s.sample(10.5 * c.h, 0.5 * H).sxx);
+    const double g = gap(s);
+    tr.gap.push_back(g);
+    tr.min_gap = std::min(tr.min_gap, g);
+    tr.max_momentum_error =
+        std::max(tr.max_momentum_error, std::abs(momentum_x(s) - tr.p0) / std::abs(tr.p0));
+  }
+  double m = 0, q = 0;
+  for (std::size_t k = 0; k < s.p.size(); ++k)
+    if (s.p.body[k] == 0) { m += s.p.mass[k]; q += s.p.mass[k] * s.p.vx[k]; }
+  tr.flyer_v = q / m;
+  return tr;
+}
+
+double mean_over(const std::vector<double>& t, const std::vector<double>& v, double a, double b) {
+  double s = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t[i] >= a && t[i] <= b) { s += v[i]; ++n; }
+  return n ? s / n : std::numeric_limits<double>::quiet_NaN();
+}
+
+struct Oracle {
+  double z1, z2, sigma, tc, rebound, c1, c2;
+};
+
+Oracle oracle(const Impact& c) {
+  const Material a = aluminium(), b = steel();
+  Oracle o;
+  o.z1 = a.impedance_p();
+  o.z2 = b.impedance_p();
+  o.c1 = a.cd;
+  o.c2 = b.cd;
+  o.sigma = c.v0 * o.z1 * o.z2 / (o.z1 + o.z2);
+  o.tc = 2 * c.flyer_cells * c.h / a.cd;
+  o.rebound = c.v0 * (o.z1 - o.z2) / (o.z1 + o.z2);
+  return o;
+}
+
+// First and last time a history is above half its plateau value: the contact duration as the
+// width at half height of the stress pulse.
+std::pair<double, double> half_width(const std::vector<double>& t, const std::vector<double>& v,
+                                     double level) {
+  double t0 = -1, t1 = -1;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (v[i] >= 0.5 * level) {
+      if (t0 < 0) t0 = t[i];
+      t1 = t[i];
+    }
+  return {t0, t1};
+}
+
+}  // namespace
+
+// The oracle itself: 12.26 MPa per m/s from the P-wave impedances (REFERENCE.md §4).
+TEST(ContactOracle, ImpedancesFromConstants) {
+  Impact c;
+  c.v0 = 1.0;
+  const Oracle o = oracle(c);
+  EXPECT_NEAR(o.z1, 1.673e7, 0.001e7);
+  EXPECT_NEAR(o.z2, 4.583e7, 0.001e7);
+  EXPECT_NEAR(o.sigma, 12.26e6, 0.01e6);
+}
+
+// Multi-velocity-field contact: contact stress (from the contact force and from the stress in
+// both plates), duration, rebound, momentum, no interpenetration.
+TEST(ContactImpact, MultiFieldRebounds) {
+  Impact c;
+  const Oracle o = oracle(c);
+  auto s = make_impact(c);
+  const double t_end = 2.8 * o.tc;
+  const Trace tr = run(*s, c, t_end);
+  // Contact pressure from the contact impulses, mean over the middle of the contact.
+  const double pc = mean_over(tr.t, tr.force, 0.2 * o.tc, 0.8 * o.tc);
+  EXPECT_NEAR(pc, o.sigma, 0.03 * o.sigma);
+  // Stress in the flyer (centre: loaded from d1/(2 c1) to 3 d1/(2 c1)) and in the target.
+  const double d1 = c.flyer_cells * c.h, xt = 10.5 * c.h;
+  const double sf = mean_over(tr.t, tr.s_flyer, 0.35 * o.tc, 0.65 * o.tc);
+  EXPECT_NEAR(-sf, o.sigma, 0.03 * o.sigma) << "flyer";
+  const double st = mean_over(tr.t, tr.s_target, xt / o.c2 + 0.2 * o.tc, xt / o.c2 + 0.8 * o.tc);
+  EXPECT_NEAR(-st, o.sigma, 0.03 * o.sigma) << "target";
+  (void)d1;
+  // Duration: width at half height of the contact pressure.
+  const auto [ta, tb] = half_width(tr.t, tr.force, o.sigma);
+  EXPECT_NEAR(tb - ta, o.tc, 0.05 * o.tc);
+  // After the release the contact stays open: no force in the last third.
+  EXPECT_LT(std::abs(mean_over(tr.t, tr.force, 1.8 * o.tc, t_end)), 1e-3 * o.sigma);
+  // Rebound of the flyer (mean velocity; it rings but its momentum is fixed once free).
+  EXPECT_NEAR(tr.flyer_v, o.rebound, 0.05 * std::abs(o.rebound));
+  // The gap opens at about the rebound speed (the target face is at rest once the pulse left).
+  const double g0 = c.h, opened = tr.gap.back() - g0;
+  const double expect = -o.rebound * (t_end - o.tc);
+  EXPECT_GT(opened, 0.5 * expect);
+  EXPECT_LT(opened, 1.5 * expect);
+  EXPECT_LT(tr.max_momentum_error, 1e-10);
+  EXPECT_GT(tr.min_gap, 0.0);  // no particle of one body passes one of the other
+  // Frictionless contact does no work: kinetic + elastic energy is conserved to 1 %.
+  s->update_energies();
+  EXPECT_LT(std::abs(s->contact.dissipated), 1e-9 * s->energy.initial);
+  EXPECT_LT(std::abs(s->energy.imbalance()), 0.01 * s->energy.initial);
+  std::printf("multi: contact pressure %.4g (closed form %.4g), flyer %.4g, target %.4g MPa; "
+              "duration %.4g us (2d/c %.4g); rebound %.4g m/s (closed form %.4g); gap opened "
+              "%.3g m (expected about %.3g); momentum error %.2g; energy: dissipated by contact "
+              "%.3g J/m, imbalance %.3g of the initial %.4g J/m\n",
+              pc / 1e6, o.sigma / 1e6, -sf / 1e6, -st / 1e6, (tb - ta) * 1e6, o.tc * 1e6,
+              tr.flyer_v, o.rebound, opened, expect, tr.max_momentum_error,
+              s->contact.dissipated, (s->update_energies(), s->energy.imbalance()),
+              s->energy.initial);
+}
+
+// The paper's single velocity field: same stress and duration, the bodies stay together.
+TEST(ContactImpact, SingleFieldSticks) {
+  Impact c;
+  c.type = ContactType::Single;
+  const Oracle o = oracle(c);
+  auto s = make_impact(c);
+  const double t_end = 2.8 * o.tc;
+  const Trace tr = run(*s, c, t_end);
+  const double xt = 10.5 * c.h;
+  const double sf = mean_over(tr.t, tr.s_flyer, 0.35 * o.tc, 0.65 * o.tc);
+  EXPECT_NEAR(-sf, o.sigma, 0.03 * o.sigma) << "flyer";
+  const double st = mean_over(tr.t, tr.s_target, xt / o.c2 + 0.2 * o.tc, xt / o.c2 + 0.8 * o.tc);
+  EXPECT_NEAR(-st, o.sigma, 0.03 * o.sigma) << "target";
+  // Duration from the compressive pulse that the contact sends into the target.
+  std::vector<double> comp(tr.s_target.size());
+  for (std::size_t i = 0; i < comp.size(); ++i) comp[i] = -tr.s_target[i];
+  const auto [ta, tb] = half_width(tr.t, comp, o.sigma);
+  EXPECT_NEAR(tb - ta, o.tc, 0.05 * o.tc);
+  // No separation: the gap stays one particle spacing (up to elastic strain), the flyer does not
+  // rebound.
+  EXPECT_NEAR(tr.gap.back(), c.h, 0.01 * c.h);
+  EXPECT_GT(tr.flyer_v - o.rebound, 0.5 * std::abs(o.rebound));
+  EXPECT_LT(tr.max_momentum_error, 1e-10);
+  EXPECT_GT(tr.min_gap, 0.0);
+  std::printf("single: flyer %.4g, target %.4g MPa (closed form %.4g); duration %.4g us (2d/c "
+              "%.4g); flyer velocity %.4g m/s; gap %.5g h; momentum error %.2g\n",
+              -sf / 1e6, -st / 1e6, o.sigma / 1e6, (tb - ta) * 1e6, o.tc * 1e6, tr.flyer_v,
+              tr.gap.back() / c.h, tr.max_momentum_error);
+}
