@@ -12,6 +12,7 @@
 //   * build         the sections in dependency order: grid, time, scheme, output, materials,
 //                   bodies, probes, seeding, boundaries, finalize, time step.
 #include "silentmpm/case.hpp"
+#include "silentmpm/geometry.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -457,6 +458,7 @@ struct BodySpec {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   int ppc = 1;
   double vx = 0, vy = 0;
+  int surface = -1;  // body from a gmsh physical surface: index into Geometry::surfaces
 };
 
 const std::vector<std::string> kSides = {"left", "right", "bottom", "top"};
@@ -494,17 +496,102 @@ GridSpec parse_grid(Obj g) {
   return s;
 }
 
+// Keys of model "j2_softening" (the tungsten film of REFERENCE.md §5; docs/case-reference.md).
+const std::vector<std::string> kFilmKeys = {"yield_stress", "peak_stress", "hardening_modulus",
+                                            "softening_modulus", "moduli", "bifurcation",
+                                            "decohesion"};
+
+void parse_film_model(Obj& m, Material& mat) {
+  J2SoftParams& j = mat.j2;
+  j.sigma_y = m.num("yield_stress");
+  m.gt("yield_stress", j.sigma_y, 0);
+  j.sigma_peak = m.num("peak_stress");
+  if (!(j.sigma_peak >= j.sigma_y))
+    m.fail("peak_stress", "must be >= yield_stress = " + fmt(j.sigma_y) + ", got " + fmt(j.sigma_peak));
+  j.E_h = m.num("hardening_modulus");
+  m.gt("hardening_modulus", j.E_h, 0);
+  j.E_s = m.num("softening_modulus");
+  m.gt("softening_modulus", j.E_s, 0);
+  j.reading = m.choice("moduli", {"plastic", "tangent"}, "plastic") == "plastic"
+                  ? ModuliReading::Plastic
+                  : ModuliReading::Tangent;
+  if (j.reading == ModuliReading::Tangent) {
+    const double E = m.num("young");
+    if (!(j.E_h < E))
+      m.fail("hardening_modulus", "must be < young = " + fmt(E) +
+                                      " with moduli \"tangent\", got " + fmt(j.E_h));
+  }
+  mat.sigma_y = j.sigma_y;
+  if (const ojson* b = m.find("bifurcation")) {
+    Obj o(m.ctx(), *b, m.at("bifurcation"));
+    o.allow({"enabled", "step_deg", "tie_break", "tie_tolerance"});
+    mat.bif.enabled = o.boolean("enabled", true);
+    mat.bif.step_deg = o.num("step_deg", 1.0);
+    o.gt("step_deg", mat.bif.step_deg, 0.05);
+    o.le("step_deg", mat.bif.step_deg, 10);
+    mat.bif.tie = o.choice("tie_break", {"smallest_angle", "largest_angle"}, "smallest_angle") ==
+                          "smallest_angle"
+                      ? TieBreak::SmallestAngle
+                      : TieBreak::LargestAngle;
+    mat.bif.tie_tolerance = o.num("tie_tolerance", 1e-9);
+    o.ge("tie_tolerance", mat.bif.tie_tolerance, 0);
+    o.done();
+  }
+  if (const ojson* d = m.find("decohesion")) {
+    Obj o(m.ctx(), *d, m.at("decohesion"));
+    o.allow({"enabled", "normal_critical_jump", "tangential_critical_jump", "smear_length",
+             "compressed_normal_strength", "min_strength", "snap_back_factor"});
+    DecohesionParams& c = mat.coh;
+    c.enabled = o.boolean("enabled", true);
+    c.u_nf = o.num("normal_critical_jump", 10e-9);
+    o.gt("normal_critical_jump", c.u_nf, 0);
+    c.u_tf = o.num("tangential_critical_jump", 10e-9);
+    o.gt("tangential_critical_jump", c.u_tf, 0);
+    if (const ojson* L = o.find("smear_length")) {
+      if (L->is_string()) {
+        if (L->get<std::string>() != "particle")
+          o.fail("smear_length", "must be a length in m or \"particle\", got \"" +
+                                     L->get<std::string>() + "\"");
+        c.smear_length = 0;
+      } else {
+        c.smear_length = o.num("smear_length");
+        o.gt("smear_length", c.smear_length, 0);
+      }
+    }
+    if (const ojson* S = o.find("compressed_normal_strength")) {
+      if (S->is_string()) {
+        if (S->get<std::string>() != "shear")
+          o.fail("compressed_normal_strength",
+                 "must be a stress in Pa or \"shear\", got \"" + S->get<std::string>() + "\"");
+        c.compressed_normal_strength = 0;
+      } else {
+        c.compressed_normal_strength = o.num("compressed_normal_strength");
+        o.gt("compressed_normal_strength", c.compressed_normal_strength, 0);
+      }
+    }
+    c.min_strength = o.num("min_strength", 1e-3 * j.sigma_y);
+    o.gt("min_strength", c.min_strength, 0);
+    c.snap_back_factor = o.num("snap_back_factor", 0.5);
+    o.gt("snap_back_factor", c.snap_back_factor, 0);
+    o.lt("snap_back_factor", c.snap_back_factor, 1);
+    o.done();
+  }
+}
+
 Material parse_material(const Ctx& ctx, const std::string& name, const ojson& j) {
   Obj m(ctx, j, "materials." + name);
-  const std::string model = m.choice("model", {"elastic", "von_mises"});
+  const std::string model = m.choice("model", {"elastic", "von_mises", "j2_softening"});
   if (model == "elastic" && m.has("yield_stress"))
     m.fail("yield_stress", "not used by model \"elastic\" (use \"von_mises\" for plasticity)");
   std::vector<std::string> keys = {"model", "young", "poisson", "density"};
   if (model == "von_mises") keys.push_back("yield_stress");
+  if (model == "j2_softening") keys.insert(keys.end(), kFilmKeys.begin(), kFilmKeys.end());
   m.allow(keys, "for model \"" + model + "\"");
   Material mat;
   mat.name = name;
-  mat.model = model == "elastic" ? Model::Elastic : Model::VonMises;
+  mat.model = model == "elastic"     ? Model::Elastic
+              : model == "von_mises" ? Model::VonMises
+                                     : Model::J2Film;
   mat.E = m.num("young");
   m.gt("young", mat.E, 0);
   mat.nu = m.num("poisson");
@@ -516,6 +603,7 @@ Material parse_material(const Ctx& ctx, const std::string& name, const ojson& j)
     mat.sigma_y = m.num("yield_stress");
     m.gt("yield_stress", mat.sigma_y, 0);
   }
+  if (mat.model == Model::J2Film) parse_film_model(m, mat);
   m.done();
   mat.derive();
   return mat;
@@ -633,8 +721,8 @@ class Builder {
     if (!doc_.is_object())
       ctx_.fail("", "a case file must be a JSON object {...}, got " + a_type(doc_));
     Obj top(ctx_, doc_, "");
-    top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes",
-               "output"});
+    top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes", "geometry",
+               "output", "contact"});
     for (const char* k : {"grid", "time", "materials", "bodies"})
       if (!top.has(k)) top.fail(k, "missing required key");
 
@@ -644,8 +732,10 @@ class Builder {
     grid_ = parse_grid(top.obj("grid"));
     parse_time(top.obj("time"), c);
     if (const ojson* s = top.find("scheme")) parse_scheme(Obj(ctx_, *s, "scheme"));
+    if (const ojson* ct = top.find("contact")) parse_contact(Obj(ctx_, *ct, "contact"), c);
     if (const ojson* o = top.find("output")) parse_output(Obj(ctx_, *o, "output"), c.output);
     parse_materials(top);
+    if (const ojson* g = top.find("geometry")) parse_geometry(Obj(ctx_, *g, "geometry"));
     parse_bodies(top.array("bodies"));
     if (const ojson* p = top.find("probes")) parse_probes(*p, c);
     // Boundaries select seeded particles and nodes, so they are built after seeding.
@@ -663,7 +753,7 @@ class Builder {
     if (out >= 0) {
       const auto k = static_cast<std::size_t>(out);
       const int b = s_->p.body[k];
-      ctx_.fail(index_path("bodies", b) + ".box",
+      ctx_.fail(index_path("bodies", b) + (bodies_[b].surface >= 0 ? ".surface" : ".box"),
                 "particle at (" + fmt(s_->p.x[k]) + ", " + fmt(s_->p.y[k]) +
                     ") is outside the grid " + grid_.describe());
     }
@@ -680,6 +770,7 @@ class Builder {
   std::vector<Material> materials_;
   std::map<std::string, int> material_index_;
   std::vector<BodySpec> bodies_;
+  std::unique_ptr<Geometry> geo_;  // the "geometry" key (case_geometry.cpp)
   bool use_cfl_ = false;
   double dt_or_cfl_ = 0;
 
@@ -702,6 +793,22 @@ class Builder {
       t.gt("dt", dt_or_cfl_, 0);
     }
     t.done();
+  }
+
+  // "contact": {"type": "single" | "multi", "friction": mu}; friction only with multi.
+  void parse_contact(Obj o, Case& c) {
+    o.allow({"type", "friction"});
+    const std::string type = o.choice("type", {"single", "multi"}, "single");
+    s_->contact.type = type == "multi" ? ContactType::Multi : ContactType::Single;
+    if (o.has("friction") && type != "multi")
+      o.fail("friction", "friction needs \"type\": \"multi\" (a single velocity field has "
+                         "no slip)");
+    s_->contact.friction = o.num("friction", 0.0);
+    o.ge("friction", s_->contact.friction, 0);
+    o.done();
+    if (type == "multi")
+      c.notes.push_back("contact: one velocity field per body, Coulomb friction " +
+                        fmt(s_->contact.friction));
   }
 
   void parse_scheme(Obj s) {
@@ -758,7 +865,7 @@ class Builder {
     const double tol = 1e-6 * grid_.h;
     for (std::size_t i = 0; i < arr.size(); ++i) {
       Obj o(ctx_, arr[i], index_path("bodies", i));
-      o.allow({"name", "material", "box", "particles_per_cell", "velocity"});
+      o.allow({"name", "material", "box", "surface", "particles_per_cell", "velocity"});
       BodySpec b;
       b.name = o.str("name");
       if (b.name.empty()) o.fail("name", "must not be empty");
@@ -771,7 +878,9 @@ class Builder {
                                suggestion(mat, material_names()) +
                                "; defined: " + join(material_names()));
       b.material = it->second;
-      const auto box = o.nums("box", 4);
+      std::vector<double> box;
+      if (o.has("surface")) box = body_surface(o, b);  // a gmsh surface: box = its extent
+      else box = o.nums("box", 4);
       b.x0 = box[0], b.y0 = box[1], b.x1 = box[2], b.y1 = box[3];
       if (!(b.x1 > b.x0)) o.fail("box", "x1 must be > x0, got " + fmt_list(box));
       if (!(b.y1 > b.y0)) o.fail("box", "y1 must be > y0, got " + fmt_list(box));
@@ -822,9 +931,13 @@ class Builder {
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
       const auto& b = bodies_[i];
       const int n = b.ppc == 1 ? 1 : b.ppc == 4 ? 2 : 3;
-      const std::size_t added = s_->seed_rectangle(b.x0, b.y0, b.x1, b.y1, n, b.material,
-                                                   static_cast<int>(i), b.vx, b.vy);
-      if (added == 0) ctx_.fail(index_path("bodies", i) + ".box", "seeds no particle");
+      const std::size_t added =
+          b.surface >= 0 ? seed_body_surface(i, n)
+                         : s_->seed_rectangle(b.x0, b.y0, b.x1, b.y1, n, b.material,
+                                              static_cast<int>(i), b.vx, b.vy);
+      if (added == 0)
+        ctx_.fail(index_path("bodies", i) + (b.surface >= 0 ? ".surface" : ".box"),
+                  "seeds no particle");
     }
   }
 
@@ -838,15 +951,17 @@ class Builder {
 
   // Nodes for fixed / roller: exactly one of grid_side, box, body + side.
   std::vector<uint32_t> select_nodes(Obj& o) {
-    const int forms = o.has("grid_side") + o.has("box") + o.has("body");
+    const int forms = o.has("grid_side") + o.has("box") + o.has("body") + o.has("curve");
     if (forms == 0)
-      o.fail("", "needs a node selection: one of grid_side, box, or body + side");
-    if (forms > 1) o.fail("", "give only one node selection: grid_side, box, or body + side");
+      o.fail("", "needs a node selection: one of grid_side, box, body + side, or curve");
+    if (forms > 1)
+      o.fail("", "give only one node selection: grid_side, box, body + side, or curve");
     if (o.has("side") && !o.has("body"))
       o.fail("side", "only used with body (use grid_side for an edge of the grid)");
     const double tol = 1e-6 * grid_.h;
     double x0, y0, x1, y1;
     std::string what;
+    if (o.has("curve")) return curve_nodes(o);  // a gmsh physical curve (case_geometry.cpp)
     if (o.has("grid_side")) {
       const std::string side = o.choice("grid_side", kSides);
       x0 = side == "right" ? grid_.x1() : grid_.x0;
@@ -888,6 +1003,7 @@ class Builder {
   BoundaryLayer select_layer(Obj& o, const std::string& name, std::string& what) {
     const int bi = body_ref(o);
     const BodySpec& b = bodies_[bi];
+    if (o.has("curve") || b.surface >= 0) return curve_layer(o, bi, name, what);
     const std::string side = o.choice("side", kSides);
     const Edge e = box_edge(b, side);
     const double width = o.num("width", grid_.h);
@@ -905,15 +1021,16 @@ class Builder {
     const std::string type = o.choice("type", {"fixed", "roller", "traction", "silent"});
     const std::string where = "for a " + type + " boundary";
     if (type == "fixed" || type == "roller") {
-      std::vector<std::string> keys = {"type", "name", "grid_side", "box", "body", "side"};
+      std::vector<std::string> keys = {"type", "name", "grid_side", "box", "body", "side", "curve"};
       if (type == "roller") keys.push_back("component");
       o.allow(keys, where);
     } else if (type == "traction") {
-      o.allow({"type", "name", "body", "side", "width", "normal", "tangential", "vector", "time",
-               "anchor"},
+      o.allow({"type", "name", "body", "side", "curve", "width", "normal", "tangential", "vector",
+               "time", "anchor"},
               where);
     } else {
-      o.allow({"type", "name", "body", "side", "width", "a", "b", "form", "anchor"}, where);
+      o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor"},
+              where);
     }
     const std::string name = o.str("name", type + std::to_string(i));
     if (name.empty()) o.fail("name", "must not be empty");
@@ -980,6 +1097,111 @@ class Builder {
     // The impedances a rho c_d and b rho c_s of each particle's material are set by
     // Solver::finalize().
     s_->silents.push_back(std::move(sb));
+  }
+
+  // ---- gmsh geometry: the "geometry" key, bodies from physical surfaces, boundaries from
+  // physical curves (the work is done in geometry.cpp / geometry_mpm.cpp).
+  void parse_geometry(Obj o) {
+    o.allow({"file", "size"});
+    std::string file = o.str("file");
+    if (file.empty()) o.fail("file", "must not be empty");
+    namespace fs = std::filesystem;
+    if (fs::path(file).is_relative()) file = (fs::path(ctx_.source).parent_path() / file).string();
+    const double size = o.num("size", 0.5 * grid_.h);
+    o.gt("size", size, 0);
+    o.done();
+    try {
+      geo_ = std::make_unique<Geometry>(load_geometry(file, size));
+    } catch (const GeometryError& e) {
+      o.fail("file", e.what());
+    }
+  }
+
+  // A physical group named by its tag (integer) or its name (string); returns its index.
+  int geometry_group(Obj& o, const std::string& key, bool surface) {
+    const char* kind = surface ? "physical surface" : "physical curve";
+    if (!geo_) o.fail(key, "needs the top-level key \"geometry\" (the gmsh file that defines the " + std::string(kind) + ")");
+    const ojson& v = o.need(key);
+    int idx = -1;
+    std::string what;
+    if (v.is_string()) {
+      const std::string name = v.get<std::string>();
+      idx = surface ? geo_->find_surface(name) : geo_->find_curve(name);
+      what = std::string(kind) + " named \"" + name + "\"";
+    } else {
+      const long tag = as_integer(ctx_, v, o.at(key));
+      idx = surface ? geo_->find_surface(static_cast<int>(tag)) : geo_->find_curve(static_cast<int>(tag));
+      what = std::string(kind) + " " + std::to_string(tag);
+    }
+    if (idx < 0)
+      o.fail(key, geo_->file + ": no " + what + "; defined: " +
+                      (surface ? geo_->list_surfaces() : geo_->list_curves()));
+    return idx;
+  }
+
+  // bodies[i].surface: returns the surface's extent [x0, y0, x1, y1].
+  std::vector<double> body_surface(Obj& o, BodySpec& b) {
+    if (o.has("box")) o.fail("surface", "give either box or surface, not both");
+    b.surface = geometry_group(o, "surface", true);
+    const auto& S = geo_->surfaces[b.surface];
+    const auto e = geo_->bounds(S);
+    const double tol = 1e-6 * grid_.h;
+    if (e[0] < grid_.x0 - tol || e[2] > grid_.x1() + tol || e[1] < grid_.y0 - tol ||
+        e[3] > grid_.y1() + tol)
+      o.fail("surface", geo_->file + ": " + Geometry::label("physical surface", S.tag, S.name) +
+                            " is partly outside the grid " + grid_.describe() + ": its extent is " +
+                            fmt_list({e[0], e[1], e[2], e[3]}));
+    return {e[0], e[1], e[2], e[3]};
+  }
+
+  std::size_t seed_body_surface(std::size_t i, int n) {
+    const BodySpec& b = bodies_[i];
+    try {
+      return seed_surface(*s_, *geo_, geo_->surfaces[b.surface], n, b.material,
+                          static_cast<int>(i), b.vx, b.vy);
+    } catch (const GeometryError& e) {
+      ctx_.fail(index_path("bodies", i) + ".surface", e.what());
+    }
+  }
+
+  // Fixed / roller on a curve: the grid nodes within h/2 of it.
+  std::vector<uint32_t> curve_nodes(Obj& o) {
+    const int ci = geometry_group(o, "curve", false);
+    const auto& C = geo_->curves[ci];
+    auto nodes = nodes_near_curve(*s_, *geo_, C, 0.5 * grid_.h);
+    if (nodes.empty())
+      o.fail("curve", geo_->file + ": " + Geometry::label("physical curve", C.tag, C.name) +
+                          " selects no grid node (nodes within h/2 = " + fmt(0.5 * grid_.h) +
+                          " of the curve)");
+    return nodes;
+  }
+
+  // Traction / silent layer on a curve: the particles of the body within `width` of it.
+  BoundaryLayer curve_layer(Obj& o, int bi, const std::string& name, std::string& what) {
+    const BodySpec& b = bodies_[bi];
+    if (!o.has("curve"))
+      o.fail("side", "body \"" + b.name + "\" comes from a gmsh surface: give its boundary as "
+                     "\"curve\" (a physical curve) instead of \"side\"");
+    if (o.has("side")) o.fail("side", "give either side or curve, not both");
+    const int ci = geometry_group(o, "curve", false);
+    const auto& C = geo_->curves[ci];
+    const double width = o.num("width", grid_.h);
+    o.gt("width", width, 0);
+    BodyRegion region;
+    if (b.surface >= 0) region.surface = &geo_->surfaces[b.surface];
+    region.x0 = b.x0, region.y0 = b.y0, region.x1 = b.x1, region.y1 = b.y1;
+    const std::string label = Geometry::label("physical curve", C.tag, C.name);
+    BoundaryLayer layer;
+    try {
+      layer = select_curve_layer(*s_, *geo_, C, region, bi, width, name);
+    } catch (const GeometryError& e) {
+      o.fail("curve", std::string(e.what()) + " (body \"" + b.name + "\")");
+    }
+    what = label + " of body \"" + b.name + "\", width " + fmt(width);
+    if (layer.ids.empty())
+      o.fail("curve", geo_->file + ": " + label + " selects no particle of body \"" + b.name +
+                          "\" (none within width " + fmt(width) + " of the curve)");
+    return layer;
   }
 
   void set_time_step() {

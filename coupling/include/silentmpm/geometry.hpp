@@ -1,0 +1,101 @@
+#pragma once
+// gmsh geometries for MPM bodies and boundary sets.
+//
+//  * load_geometry() opens a gmsh `.geo` (meshed in 2D through the gmsh C++ API, with the mesh
+//    size variable `h` set to the size asked for) or a `.msh` file, and returns the first-order
+//    triangles/quadrangles of every physical surface and the line segments of every physical
+//    curve. gmsh itself stays inside geometry.cpp: this header does not include gmsh.h.
+//  * seed_surface() fills a physical surface with particles on the grid lattice (n x n per
+//    cell, at the sub-cell positions Solver::seed_rectangle uses for a grid-aligned box), keeping
+//    the lattice points inside the surface's elements.
+//  * select_curve_layer() picks the particles of a body within a depth of a physical curve, each
+//    with the outward normal of the curve at its closest point and the boundary-length weight of
+//    BoundaryLayer (sum of weights = curve length exactly).
+//  * nodes_near_curve() picks the grid nodes within a distance of a physical curve (fixed and
+//    roller conditions).
+//
+// Errors throw GeometryError with a message that names the file and the physical group.
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "silentmpm/boundary.hpp"
+
+namespace smpm {
+
+class Solver;
+
+struct GeometryError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Geometry {
+  struct Surface {
+    int tag = 0;
+    std::string name;
+    // Node indices of each element; [3] = -1 for a triangle.
+    std::vector<std::array<int, 4>> elems;
+  };
+  struct Curve {
+    int tag = 0;
+    std::string name;
+    std::vector<std::array<int, 2>> segs;  // node indices of each 2-node line
+  };
+
+  std::string file;                  // as given (for messages)
+  std::vector<double> x, y;          // node coordinates (z ignored; must be 0)
+  std::vector<Surface> surfaces;     // physical surfaces, ordered by tag
+  std::vector<Curve> curves;         // physical curves, ordered by tag
+
+  // Index into surfaces / curves, or -1.
+  int find_surface(int tag) const;
+  int find_surface(const std::string& name) const;
+  int find_curve(int tag) const;
+  int find_curve(const std::string& name) const;
+  // `1 "aluminium", 2 "steel"` for messages.
+  std::string list_surfaces() const;
+  std::string list_curves() const;
+  // "physical surface 2 \"steel\"" for messages.
+  static std::string label(const char* kind, int tag, const std::string& name);
+
+  double area(const Surface& s) const;
+  std::array<double, 4> bounds(const Surface& s) const;  // xmin, ymin, xmax, ymax
+  double length(const Curve& c) const;
+};
+
+// Read a .geo (meshed with mesh size `size`; size <= 0 keeps the file's own `h`) or a .msh.
+// Throws GeometryError "<file>: ..." for an unreadable, empty or unparsable file, a file without
+// physical surfaces, second-order or unsupported elements, or a geometry outside the z = 0 plane.
+Geometry load_geometry(const std::string& file, double size);
+
+// Lattice seeding of surface `s` into solver `sol` (grid already initialised, materials set):
+// points grid.x0 + (i + 1/2) h / n, grid.y0 + (j + 1/2) h / n inside an element, volume
+// (h / n)^2, mass rho (h / n)^2. Returns the number of particles added. Throws GeometryError if
+// the surface reaches outside the grid.
+std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface& s, int n_per_side,
+                         int group, int body, double vx0, double vy0);
+
+// Which side of a curve the body lies on: the body's surface (for a body seeded from the
+// geometry) or its box.
+struct BodyRegion {
+  const Geometry::Surface* surface = nullptr;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // box, when surface is null
+};
+
+// Particles of `body` within `depth` of curve `c` (distance to the discretised curve < depth,
+// closest point not beyond an open end of the curve). Normals: each segment's outward normal
+// (away from the body), blended linearly along the segment towards the mean normal at vertices
+// where the curve turns by less than 30 degrees (exactly radial on a discretised circle);
+// corners keep the normal of each side. Weights w = V_p L / sum V_p with L the curve length.
+// Throws GeometryError if the curve does not bound the body (body on neither or both sides).
+BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geometry::Curve& c,
+                                 const BodyRegion& region, int body, double depth,
+                                 const std::string& name);
+
+// Grid nodes within `tol` of curve `c` (closest point not beyond an open end, to 1e-6 h).
+std::vector<uint32_t> nodes_near_curve(const Solver& sol, const Geometry& g,
+                                       const Geometry::Curve& c, double tol);
+
+}  // namespace smpm

@@ -1,0 +1,318 @@
+// Reading gmsh geometries (.geo meshed through the gmsh C++ API, or .msh) into plain arrays:
+// node coordinates, the elements of each physical surface, the segments of each physical curve.
+// The only file of the project outside fem/ that includes gmsh.h.
+#include "silentmpm/geometry.hpp"
+
+#include <gmsh.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <unordered_map>
+
+namespace smpm {
+
+// ---------------------------------------------------------------------------------------------
+// Geometry queries.
+
+namespace {
+template <class V>
+int find_tag(const V& v, int tag) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (v[i].tag == tag) return static_cast<int>(i);
+  return -1;
+}
+template <class V>
+int find_name(const V& v, const std::string& name) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!name.empty() && v[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+template <class V>
+std::string list_groups(const V& v) {
+  if (v.empty()) return "none";
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    s += (i ? ", " : "") + std::to_string(v[i].tag);
+    if (!v[i].name.empty()) s += " \"" + v[i].name + "\"";
+  }
+  return s;
+}
+}  // namespace
+
+int Geometry::find_surface(int tag) const { return find_tag(surfaces, tag); }
+int Geometry::find_surface(const std::string& name) const { return find_name(surfaces, name); }
+int Geometry::find_curve(int tag) const { return find_tag(curves, tag); }
+int Geometry::find_curve(const std::string& name) const { return find_name(curves, name); }
+std::string Geometry::list_surfaces() const { return list_groups(surfaces); }
+std::string Geometry::list_curves() const { return list_groups(curves); }
+
+std::string Geometry::label(const char* kind, int tag, const std::string& name) {
+  return std::string(kind) + " " + std::to_string(tag) + (name.empty() ? "" : " \"" + name + "\"");
+}
+
+double Geometry::area(const Surface& s) const {
+  double a = 0;
+  for (const auto& e : s.elems) {
+    const int n = e[3] < 0 ? 3 : 4;
+    double twice = 0;  // shoelace
+    for (int k = 0; k < n; ++k) {
+      const int i = e[k], j = e[(k + 1) % n];
+      twice += x[i] * y[j] - x[j] * y[i];
+    }
+    a += 0.5 * std::fabs(twice);
+  }
+  return a;
+}
+
+std::array<double, 4> Geometry::bounds(const Surface& s) const {
+  std::array<double, 4> b = {HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (const auto& e : s.elems)
+    for (int k = 0; k < 4; ++k) {
+      if (e[k] < 0) continue;
+      b[0] = std::min(b[0], x[e[k]]);
+      b[1] = std::min(b[1], y[e[k]]);
+      b[2] = std::max(b[2], x[e[k]]);
+      b[3] = std::max(b[3], y[e[k]]);
+    }
+  return b;
+}
+
+double Geometry::length(const Curve& c) const {
+  double L = 0;
+  for (const auto& s : c.segs) L += std::hypot(x[s[1]] - x[s[0]], y[s[1]] - y[s[0]]);
+  return L;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loading.
+
+namespace {
+
+std::string fmt17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+std::string lower_ext(const std::string& file) {
+  std::string e = std::filesystem::path(file).extension().string();
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+// The gmsh API is one global state: one load at a time, initialised and finalised around it.
+std::mutex& gmsh_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+struct GmshSession {
+  explicit GmshSession(const std::vector<std::string>& args) {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    gmsh::initialize(static_cast<int>(args.size()), argv.data(), /*readConfigFiles=*/false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::logger::start();
+  }
+  ~GmshSession() {
+    try {
+      gmsh::logger::stop();
+      gmsh::finalize();
+    } catch (...) {
+    }
+  }
+  // First "Error" line of the gmsh log since the session started, without its prefix.
+  static std::string first_error() {
+    std::vector<std::string> log;
+    gmsh::logger::get(log);
+    for (const auto& l : log)
+      if (l.rfind("Error", 0) == 0) {
+        std::size_t p = l.find(':');
+        std::string m = p == std::string::npos ? l : l.substr(p + 1);
+        m.erase(0, m.find_first_not_of(' '));
+        return m;
+      }
+    return "";
+  }
+};
+
+// Run a gmsh call; turn every way gmsh reports failure (a thrown std::string, an exception, an
+// "Error" in the log) into a GeometryError.
+template <class Fn>
+void gmsh_call(const std::string& file, const char* what, Fn&& fn) {
+  std::string err;
+  try {
+    fn();
+  } catch (const std::string& s) {
+    err = s;
+  } catch (const std::exception& e) {
+    err = e.what();
+  } catch (...) {
+    err = "unknown gmsh error";
+  }
+  if (err.empty()) err = GmshSession::first_error();
+  if (!err.empty()) throw GeometryError(file + ": gmsh could not " + what + ": " + err);
+}
+
+std::string element_name(int type) {
+  std::string name;
+  int dim, order, nn, npn;
+  std::vector<double> lc;
+  try {
+    gmsh::model::mesh::getElementProperties(type, name, dim, order, nn, lc, npn);
+  } catch (...) {
+    return "type " + std::to_string(type);
+  }
+  return "\"" + name + "\" (gmsh type " + std::to_string(type) + ")";
+}
+
+int element_order(int type) {
+  std::string name;
+  int dim, order = 1, nn, npn;
+  std::vector<double> lc;
+  try {
+    gmsh::model::mesh::getElementProperties(type, name, dim, order, nn, lc, npn);
+  } catch (...) {
+  }
+  return order;
+}
+
+}  // namespace
+
+Geometry load_geometry(const std::string& file, double size) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw GeometryError(file + ": cannot open file (it does not exist)");
+  if (fs::is_directory(file, ec)) throw GeometryError(file + ": cannot open file (it is a directory)");
+  {
+    std::ifstream f(file, std::ios::binary);
+    if (!f) throw GeometryError(file + ": cannot open file (not readable)");
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    const std::string text = ss.str();
+    if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+      throw GeometryError(file + ": the file is empty");
+  }
+  const std::string ext = lower_ext(file);
+  const bool geo = ext == ".geo";
+  if (!geo && ext != ".msh")
+    throw GeometryError(file + ": unsupported file type \"" + ext +
+                        "\" (give a gmsh .geo or .msh file)");
+
+  std::lock_guard<std::mutex> lock(gmsh_mutex());
+  std::vector<std::string> args = {"silentmpm"};
+  if (geo && size > 0) args.insert(args.end(), {"-setnumber", "h", fmt17(size)});
+  GmshSession session(args);
+
+  gmsh_call(file, geo ? "read the geometry" : "read the mesh", [&] { gmsh::open(file); });
+  if (geo) {
+    if (size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", size);
+    gmsh_call(file, "mesh the geometry", [&] { gmsh::model::mesh::generate(2); });
+  }
+
+  Geometry g;
+  g.file = file;
+  gmsh::vectorpair groups;
+  gmsh_call(file, "list the physical groups", [&] { gmsh::model::getPhysicalGroups(groups); });
+  bool any = false;
+  for (const auto& dt : groups) any = any || dt.first == 1 || dt.first == 2;
+  if (!any)
+    throw GeometryError(file + ": defines no physical surface or physical curve (name the bodies "
+                               "and boundaries with Physical Surface / Physical Curve)");
+
+  // Nodes.
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coord, pcoord;
+  gmsh_call(file, "read the nodes", [&] { gmsh::model::mesh::getNodes(node_tags, coord, pcoord); });
+  std::unordered_map<std::size_t, int> index;
+  index.reserve(node_tags.size());
+  double scale = 0;
+  for (std::size_t k = 0; k < node_tags.size(); ++k)
+    scale = std::max({scale, std::fabs(coord[3 * k]), std::fabs(coord[3 * k + 1])});
+  for (std::size_t k = 0; k < node_tags.size(); ++k) {
+    if (std::fabs(coord[3 * k + 2]) > 1e-9 * std::max(scale, 1e-300))
+      throw GeometryError(file + ": node " + std::to_string(node_tags[k]) + " has z = " +
+                          fmt17(coord[3 * k + 2]) + "; a 2D geometry must lie in the plane z = 0");
+    index[node_tags[k]] = static_cast<int>(g.x.size());
+    g.x.push_back(coord[3 * k]);
+    g.y.push_back(coord[3 * k + 1]);
+  }
+  auto node = [&](std::size_t tag, const std::string& where) {
+    auto it = index.find(tag);
+    if (it == index.end())
+      throw GeometryError(file + ": " + where + ": element refers to unknown node " +
+                          std::to_string(tag));
+    return it->second;
+  };
+
+  for (const auto& [dim, tag] : groups) {
+    if (dim != 1 && dim != 2) continue;
+    std::string name;
+    gmsh::model::getPhysicalName(dim, tag, name);
+    const std::string where = Geometry::label(dim == 2 ? "physical surface" : "physical curve", tag, name);
+    std::vector<int> entities;
+    gmsh::model::getEntitiesForPhysicalGroup(dim, tag, entities);
+    Geometry::Surface surf;
+    Geometry::Curve curve;
+    for (int ent : entities) {
+      std::vector<int> types;
+      std::vector<std::vector<std::size_t>> etags, ntags;
+      gmsh_call(file, "read the elements", [&] {
+        gmsh::model::mesh::getElements(types, etags, ntags, dim, ent);
+      });
+      for (std::size_t t = 0; t < types.size(); ++t) {
+        const int type = types[t];
+        const bool ok = dim == 2 ? (type == 2 || type == 3) : type == 1;
+        if (!ok) {
+          const int order = element_order(type);
+          throw GeometryError(
+              file + ": " + where + ": " +
+              (order >= 2 ? "second-order element " : "unsupported element ") + element_name(type) +
+              "; only first-order " +
+              (dim == 2 ? "triangles and quadrangles" : "2-node lines") +
+              " are supported (remove Mesh.ElementOrder / high-order settings)");
+        }
+        const std::vector<std::size_t>& nt = ntags[t];
+        if (dim == 2) {
+          const int nn = type == 2 ? 3 : 4;
+          for (std::size_t e = 0; e + nn <= nt.size(); e += nn) {
+            std::array<int, 4> el = {-1, -1, -1, -1};
+            for (int k = 0; k < nn; ++k) el[k] = node(nt[e + k], where);
+            surf.elems.push_back(el);
+          }
+        } else {
+          for (std::size_t e = 0; e + 2 <= nt.size(); e += 2)
+            curve.segs.push_back({node(nt[e], where), node(nt[e + 1], where)});
+        }
+      }
+    }
+    if (dim == 2) {
+      if (surf.elems.empty())
+        throw GeometryError(file + ": " + where + " has no elements" +
+                            (geo ? " (is the surface meshed?)" : ""));
+      surf.tag = tag;
+      surf.name = name;
+      g.surfaces.push_back(std::move(surf));
+    } else {
+      if (curve.segs.empty())
+        throw GeometryError(file + ": " + where + " has no line elements" +
+                            (geo ? " (is the curve part of a meshed surface?)" : ""));
+      curve.tag = tag;
+      curve.name = name;
+      g.curves.push_back(std::move(curve));
+    }
+  }
+  auto by_tag = [](const auto& a, const auto& b) { return a.tag < b.tag; };
+  std::sort(g.surfaces.begin(), g.surfaces.end(), by_tag);
+  std::sort(g.curves.begin(), g.curves.end(), by_tag);
+  return g;
+}
+
+}  // namespace smpm
