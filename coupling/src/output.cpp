@@ -6,6 +6,8 @@
 //     vx vy sxx syy szz sxy J2 eps_p mass volume   N double
 //     body                     N int32
 //     id                       N uint32 (permanent particle id; particles are re-sorted)
+//     state                    N int32 (film model: 0 elastic, 1 plastic, 2 decohesion, 3 separated)
+//     normal_x normal_y jump_n jump_t ubar   N double (film model: critical plane and jump)
 // DIR/<base>.xdmf is an XDMF 3 temporal collection of Polyvertex grids that point into the .h5
 // by relative file name, so the output folder can be moved as a whole. It is rewritten (through
 // a temporary file and a rename) after every snapshot, so a partial run opens in ParaView.
@@ -159,6 +161,10 @@ constexpr ScalarField kScalarFields[] = {
     {"vx", "Float", 8},     {"vy", "Float", 8},    {"sxx", "Float", 8},   {"syy", "Float", 8},
     {"szz", "Float", 8},    {"sxy", "Float", 8},   {"J2", "Float", 8},    {"eps_p", "Float", 8},
     {"mass", "Float", 8},   {"volume", "Float", 8}, {"body", "Int", 4},   {"id", "UInt", 4},
+    // Film model (decohesion.hpp): state 0 elastic, 1 plastic, 2 decohesion, 3 separated;
+    // normal of the critical plane (0, 0 before bifurcation); jump; accumulated normalised jump.
+    {"state", "Int", 4},    {"normal_x", "Float", 8}, {"normal_y", "Float", 8},
+    {"jump_n", "Float", 8}, {"jump_t", "Float", 8},   {"ubar", "Float", 8},
 };
 
 }  // namespace
@@ -204,7 +210,9 @@ void SnapshotWriter::write(const Particles& p, long step, double time) {
   {
     const std::size_t sizes[] = {p.y.size(),   p.vx.size(),  p.vy.size(),    p.mass.size(),
                                  p.vol.size(), p.sxx.size(), p.syy.size(),   p.szz.size(),
-                                 p.sxy.size(), p.eps_p.size(), p.id.size(), p.body.size()};
+                                 p.sxy.size(), p.eps_p.size(), p.id.size(), p.body.size(),
+                                 p.state.size(), p.dnx.size(), p.dny.size(), p.jump_n.size(),
+                                 p.jump_t.size(), p.ubar.size()};
     for (std::size_t s : sizes)
       if (s != n)
         throw std::runtime_error("SnapshotWriter: particle arrays have inconsistent sizes (" +
@@ -260,6 +268,17 @@ void SnapshotWriter::write(const Particles& p, long step, double time) {
                   gname);
   }
   write_dataset(group.id, "id", H5T_STD_U32LE, H5T_NATIVE_UINT32, p.id.data(), n, 1, path, gname);
+  {
+    std::vector<int32_t> state(n, 0);
+    for (std::size_t i = 0; i < n && i < p.state.size(); ++i) state[i] = p.state[i];
+    write_dataset(group.id, "state", H5T_STD_I32LE, H5T_NATIVE_INT32, state.data(), n, 1, path,
+                  gname);
+  }
+  dbl("normal_x", p.dnx.data());
+  dbl("normal_y", p.dny.data());
+  dbl("jump_n", p.jump_n.data());
+  dbl("jump_t", p.jump_t.data());
+  dbl("ubar", p.ubar.data());
 
   if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
 
