@@ -1,0 +1,169 @@
+#pragma once
+// The deal.II far-field: 2D plane-strain linear elastodynamics on a gmsh quad mesh.
+//
+// This header has no deal.II include (the implementation sits behind a pointer), so the driver,
+// the tests and the coupling code include it cheaply.
+//
+// Discretisation
+//   * FE_Q(1) or FE_Q(2) for both displacement components; degrees of freedom are numbered by
+//     node, dof = 2 node + component, so every per-node array below is indexed by node.
+//   * Diagonal (lumped) mass from Gauss-Lobatto nodal quadrature, stiffness K from full Gauss
+//     quadrature, stored node-block-wise (2x2 blocks) in a compressed sparse row layout; the
+//     internal force -K u is one OpenMP-parallel sparse matrix-vector product.
+//   * Explicit central difference with the semi-implicit Lysmer-Kuhlemeyer dashpot at the node:
+//       (M + dt/2 C) v^{n+1/2} = (M - dt/2 C) v^{n-1/2} + dt (f_ext^n - K u^n),
+//       u^{n+1} = u^n + dt v^{n+1/2},
+//     with C one 2x2 block per boundary node, C = rho l [a c_d n n^T + b c_s (I - n n^T)] from
+//     Gauss-Lobatto face quadrature (a corner node sums its two faces).
+//   * Energies: kinetic 1/2 v^{n+1/2} M v^{n+1/2} and elastic 1/2 u^n K u^{n+1} are the pair the
+//     central-difference scheme conserves exactly, so kinetic + elastic + absorbed - external work
+//     is zero to round-off (absorbed = sum dt vbar C vbar, external = sum dt f_ext^n vbar, with
+//     vbar = (v^{n-1/2} + v^{n+1/2}) / 2).
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "silentmpm/material.hpp"
+#include "silentmpm/solver.hpp"  // Energies
+#include "silentmpm/time_function.hpp"
+
+namespace smpm::fem {
+
+// Any problem with a mesh or an FEM input. The message is complete (it names the file or group).
+struct FemError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// ---- meshes ----------------------------------------------------------------------------------
+// A mesh read through gmsh: a .geo is meshed (its `DefineConstant[ h = {..., Name
+// "Parameters/h"} ]` set to `size` when size > 0), a .msh is read as is. Only first-order
+// quadrilaterals are accepted. Physical surfaces give material ids, physical curves boundary ids.
+struct PhysicalGroup {
+  int tag = 0;
+  std::string name;
+};
+
+struct Mesh {
+  std::string file;        // as given
+  double size = 0;         // mesh size asked for (.geo), 0 = the file's default
+  std::string msh;         // ASCII MSH 4.1 text, all quads, physical groups of dim 1 and 2 only
+  std::vector<PhysicalGroup> surfaces, curves;
+  std::size_t quads = 0;   // number of quadrilateral elements
+  const PhysicalGroup* surface(int tag) const;
+  const PhysicalGroup* curve(int tag) const;
+  // Tag of the group named `name` (or written as its number), -1 if absent.
+  int surface_tag(const std::string& name_or_tag) const;
+  int curve_tag(const std::string& name_or_tag) const;
+};
+
+// Reads or meshes `file` (".geo" or ".msh"). Throws FemError naming the file.
+Mesh load_mesh(const std::string& file, double size);
+
+// ---- model -------------------------------------------------------------------------------------
+struct Boundary {
+  enum class Kind { Dashpot, Traction, Fixed, Roller };
+  Kind kind = Kind::Fixed;
+  std::string name;
+  std::vector<int> curves;     // physical curve tags (boundary ids)
+  // Dashpot: coefficients of the LK dashpot (a = b = 1: standard).
+  double a = 1, b = 1;
+  // Traction: f(t) * (normal n + tangential s + (vx, vy)), n outward normal, s = (-n_y, n_x).
+  double normal = 0, tangential = 0, vx = 0, vy = 0;
+  TimeFunction fn;
+  // Roller: the component held at zero (0 = x, 1 = y).
+  int component = 0;
+};
+
+struct Spec {
+  Mesh mesh;
+  int degree = 1;                          // 1 or 2
+  std::vector<Material> materials;         // elastic materials
+  std::map<int, int> region_material;      // physical surface tag -> index into materials
+  std::vector<Boundary> boundaries;
+  int threads = 0;                         // 0: OpenMP default
+};
+
+// What a probe reads at a point: stresses, velocity, div u and curl u = du_y/dx - du_x/dy.
+struct Sample {
+  double sxx = 0, syy = 0, szz = 0, sxy = 0, j2 = 0, vx = 0, vy = 0, div = 0, curl = 0;
+};
+
+class Solver {
+ public:
+  // Builds the mesh, the degrees of freedom, the lumped mass, K, the dashpot blocks and the
+  // traction load vectors. Throws FemError on a bad model (unknown group, no material...).
+  explicit Solver(const Spec& spec);
+  ~Solver();
+  Solver(const Solver&) = delete;
+  Solver& operator=(const Solver&) = delete;
+
+  double dt = 0, t = 0;
+  long steps = 0;
+  Energies energy;
+
+  // Sizes.
+  std::size_t nodes() const;
+  std::size_t dofs() const { return 2 * nodes(); }
+  std::size_t cells() const;
+  int degree() const;
+  int thread_count() const;
+  // Bounding box of the mesh: x0, y0, x1, y1.
+  std::array<double, 4> bounds() const;
+
+  // Stability: the element bound 2 / sqrt(max over elements of lambda_max(M_e^-1 K_e)), which
+  // never exceeds the true critical step of the assembled undamped system.
+  double critical_dt() const;
+  // Sets dt (throws FemError if dt > critical_dt()) and prepares the dashpot update.
+  void set_dt(double dt);
+
+  // One explicit step.
+  void step();
+
+  // Probes: add_probe returns the probe index, or -1 if the point is outside the mesh.
+  int add_probe(double x, double y);
+  std::vector<Sample> sample() const;
+  // Updates `energy` (kinetic, elastic; absorbed and external work accumulate in step()).
+  void update_energies();
+
+  // HDF5 + XDMF snapshots through DataOut: DIR/BASE_NNNNN.h5 and DIR/BASE.xdmf (rewritten each
+  // call with every snapshot so far). Fields: displacement, velocity, stress (xx, yy, zz, xy),
+  // material id.
+  void write_snapshot(const std::string& dir, const std::string& base);
+  int snapshot_count() const;
+
+  // --- access for coupling (issue 7) and tests ---------------------------------------------
+  const std::vector<double>& node_x() const;
+  const std::vector<double>& node_y() const;
+  const std::vector<double>& mass() const;          // lumped nodal mass (per component)
+  std::vector<double>& displacement();               // 2 per node, interleaved
+  std::vector<double>& velocity();                   // 2 per node, v^{n+1/2}
+  // f = -K u (2 per node). u and f must not alias.
+  void internal_force(const double* u, double* f) const;
+  struct DashpotBlock {
+    std::uint32_t node;
+    double cxx, cxy, cyy;
+  };
+  const std::vector<DashpotBlock>& dashpots() const;
+  // Constraint mask per node: bit 0 = x held, bit 1 = y held.
+  const std::vector<std::uint8_t>& constraint_mask() const;
+  // External nodal force f_ext(t) (2 per node) into f (overwrites).
+  void external_force(double time, double* f) const;
+  // Advance u by dt * v for a given velocity field (2 per node).
+  void advance_displacement(const double* v, double dt_);
+  // Nodes on the given boundary ids (physical curve tags), sorted.
+  std::vector<std::uint32_t> boundary_nodes(const std::vector<int>& curves) const;
+
+  // Human-readable lines describing the model (mesh, dofs, boundaries).
+  std::vector<std::string> describe() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace smpm::fem

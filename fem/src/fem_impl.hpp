@@ -1,0 +1,83 @@
+#pragma once
+// Internal state of fem::Solver, shared by the deal.II setup (fem_setup.cpp) and the plain-C++
+// time-stepping kernels (fem_kernels.cpp). No deal.II include here: the deal.II objects live in
+// `Deal`, complete only in fem_setup.cpp.
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "silentmpm/fem.hpp"
+
+namespace smpm::fem {
+
+struct Deal;  // Triangulation, DoFHandler, FE, snapshot bookkeeping (fem_setup.cpp)
+
+struct Solver::Impl {
+  Impl();
+  ~Impl();  // in fem_setup.cpp, where Deal is complete
+
+  Spec spec;
+  int degree = 1;
+  int threads = 1;
+  std::size_t n_cells = 0;
+  std::array<double, 4> box{{0, 0, 0, 0}};
+
+  // Per node.
+  std::vector<double> x, y, mass, inv_mass;
+  std::vector<std::uint8_t> mask;         // bit 0: x held, bit 1: y held
+  std::vector<std::int32_t> dash_of_node; // index into dash, or -1
+
+  // Per dof (2 per node, interleaved).
+  std::vector<double> u, v, ku, fext;
+
+  // Stiffness, node-block CSR: row i has blocks k in [rowptr[i], rowptr[i+1]), column col[k],
+  // values val[4k..4k+3] = Kxx, Kxy, Kyx, Kyy.
+  std::vector<std::uint64_t> rowptr;
+  std::vector<std::uint32_t> col;
+  std::vector<double> val;
+
+  // Dashpots and their prepared update (set_dt): v+ = P (m - dt/2 C) v- + P dt f, P = (m + dt/2 C)^-1
+  // restricted to the free components.
+  std::vector<Solver::DashpotBlock> dash;
+  struct DashOp {
+    double pxx, pxy, pyx, pyy;  // P
+    double qxx, qxy, qyx, qyy;  // P (m - dt/2 C)
+  };
+  std::vector<DashOp> dash_op;
+  double prepared_dt = -1;
+
+  // Traction loads: f_ext(t) = sum_l fn_l(t) F_l, F_l sparse over its nodes.
+  struct Load {
+    TimeFunction fn;
+    std::vector<std::uint32_t> nodes;
+    std::vector<double> f;  // 2 per listed node
+  };
+  std::vector<Load> loads;
+
+  // Nodes per boundary id (physical curve tag).
+  std::map<int, std::vector<std::uint32_t>> curve_nodes;
+
+  double crit_dt = 0;
+  bool ku_valid = false;  // ku holds K u for the current u
+
+  // Probes: shape values and gradients of the cell's dofs at the point.
+  struct Probe {
+    double x, y;
+    std::vector<std::uint32_t> dofs;
+    std::vector<std::uint8_t> comp;
+    std::vector<double> N, dx, dy;
+    double lambda, mu, E, nu;
+  };
+  std::vector<Probe> probes;
+
+  std::unique_ptr<Deal> deal;
+  int snapshots = 0;
+};
+
+// Largest eigenvalue of the symmetric n x n matrix a (row-major; destroyed), cyclic Jacobi.
+double symmetric_max_eigenvalue(std::vector<double>& a, int n);
+
+}  // namespace smpm::fem

@@ -1,0 +1,259 @@
+// Time stepping of the FEM far-field: plain arrays, OpenMP, no deal.II (compiled with -O3).
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "fem_impl.hpp"
+
+namespace smpm::fem {
+
+namespace {
+std::string fmt(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+}  // namespace
+
+double symmetric_max_eigenvalue(std::vector<double>& a, int n) {
+  for (int sweep = 0; sweep < 100; ++sweep) {
+    double off = 0, diag = 0;
+    for (int p = 0; p < n; ++p) {
+      diag += a[p * n + p] * a[p * n + p];
+      for (int q = p + 1; q < n; ++q) off += a[p * n + q] * a[p * n + q];
+    }
+    if (off <= 1e-30 * diag) break;
+    for (int p = 0; p < n; ++p)
+      for (int q = p + 1; q < n; ++q) {
+        const double apq = a[p * n + q];
+        if (std::fabs(apq) <= 1e-300) continue;
+        const double theta = (a[q * n + q] - a[p * n + p]) / (2 * apq);
+        const double tt = (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1));
+        const double c = 1 / std::sqrt(tt * tt + 1), s = tt * c;
+        for (int k = 0; k < n; ++k) {  // columns p, q
+          const double akp = a[k * n + p], akq = a[k * n + q];
+          a[k * n + p] = c * akp - s * akq;
+          a[k * n + q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < n; ++k) {  // rows p, q
+          const double apk = a[p * n + k], aqk = a[q * n + k];
+          a[p * n + k] = c * apk - s * aqk;
+          a[q * n + k] = s * apk + c * aqk;
+        }
+      }
+  }
+  double m = a[0];
+  for (int p = 1; p < n; ++p) m = std::max(m, a[p * n + p]);
+  return m;
+}
+
+std::size_t Solver::nodes() const { return impl_->x.size(); }
+std::size_t Solver::cells() const { return impl_->n_cells; }
+int Solver::degree() const { return impl_->degree; }
+int Solver::thread_count() const { return impl_->threads; }
+std::array<double, 4> Solver::bounds() const { return impl_->box; }
+double Solver::critical_dt() const { return impl_->crit_dt; }
+int Solver::snapshot_count() const { return impl_->snapshots; }
+const std::vector<double>& Solver::node_x() const { return impl_->x; }
+const std::vector<double>& Solver::node_y() const { return impl_->y; }
+const std::vector<double>& Solver::mass() const { return impl_->mass; }
+std::vector<double>& Solver::displacement() {
+  impl_->ku_valid = false;
+  return impl_->u;
+}
+std::vector<double>& Solver::velocity() { return impl_->v; }
+const std::vector<Solver::DashpotBlock>& Solver::dashpots() const { return impl_->dash; }
+const std::vector<std::uint8_t>& Solver::constraint_mask() const { return impl_->mask; }
+
+std::vector<std::uint32_t> Solver::boundary_nodes(const std::vector<int>& curves) const {
+  std::vector<std::uint32_t> out;
+  for (int c : curves) {
+    auto it = impl_->curve_nodes.find(c);
+    if (it != impl_->curve_nodes.end()) out.insert(out.end(), it->second.begin(), it->second.end());
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+void Solver::internal_force(const double* __restrict u, double* __restrict f) const {
+  const Impl& m = *impl_;
+  const std::int64_t n = static_cast<std::int64_t>(m.x.size());
+  const std::uint64_t* __restrict rp = m.rowptr.data();
+  const std::uint32_t* __restrict cl = m.col.data();
+  const double* __restrict kv = m.val.data();
+#pragma omp parallel for schedule(static) num_threads(m.threads)
+  for (std::int64_t i = 0; i < n; ++i) {
+    double fx = 0, fy = 0;
+    for (std::uint64_t k = rp[i]; k < rp[i + 1]; ++k) {
+      const double ux = u[2 * cl[k]], uy = u[2 * cl[k] + 1];
+      const double* b = kv + 4 * k;
+      fx += b[0] * ux + b[1] * uy;
+      fy += b[2] * ux + b[3] * uy;
+    }
+    f[2 * i] = -fx;
+    f[2 * i + 1] = -fy;
+  }
+}
+
+void Solver::external_force(double time, double* f) const {
+  std::fill(f, f + dofs(), 0.0);
+  for (const auto& l : impl_->loads) {
+    const double s = l.fn(time);
+    if (s == 0) continue;
+    for (std::size_t k = 0; k < l.nodes.size(); ++k) {
+      f[2 * l.nodes[k]] += s * l.f[2 * k];
+      f[2 * l.nodes[k] + 1] += s * l.f[2 * k + 1];
+    }
+  }
+}
+
+void Solver::advance_displacement(const double* v, double h) {
+  Impl& m = *impl_;
+  const std::int64_t n = static_cast<std::int64_t>(m.u.size());
+#pragma omp parallel for schedule(static) num_threads(m.threads)
+  for (std::int64_t i = 0; i < n; ++i) m.u[i] += h * v[i];
+  m.ku_valid = false;
+}
+
+void Solver::set_dt(double h) {
+  Impl& m = *impl_;
+  if (!(h > 0) || !std::isfinite(h)) throw FemError("FEM: time step must be > 0, got " + fmt(h));
+  if (h > m.crit_dt * (1 + 1e-12))
+    throw FemError("FEM: time step " + fmt(h) + " s is above the stability limit " +
+                   fmt(m.crit_dt) + " s (element bound, CFL " + fmt(h / m.crit_dt) + " > 1)");
+  dt = h;
+  m.dash_op.resize(m.dash.size());
+  for (std::size_t k = 0; k < m.dash.size(); ++k) {
+    const auto& d = m.dash[k];
+    const double ms = m.mass[d.node];
+    const std::uint8_t mk = m.mask[d.node];
+    // A = m I + h/2 C, B = m I - h/2 C, restricted to free components.
+    double axx = ms + 0.5 * h * d.cxx, axy = 0.5 * h * d.cxy, ayy = ms + 0.5 * h * d.cyy;
+    double bxx = ms - 0.5 * h * d.cxx, bxy = -0.5 * h * d.cxy, byy = ms - 0.5 * h * d.cyy;
+    Impl::DashOp op{};
+    if (mk == 3) {
+      // both held: P = 0
+    } else if (mk & 1) {  // x held: v_x = 0, solve the y row
+      op.pyy = 1 / ayy;
+      op.qyy = byy / ayy;
+    } else if (mk & 2) {
+      op.pxx = 1 / axx;
+      op.qxx = bxx / axx;
+    } else {
+      const double det = axx * ayy - axy * axy;
+      op.pxx = ayy / det;
+      op.pxy = -axy / det;
+      op.pyx = -axy / det;
+      op.pyy = axx / det;
+      op.qxx = op.pxx * bxx + op.pxy * bxy;
+      op.qxy = op.pxx * bxy + op.pxy * byy;
+      op.qyx = op.pyx * bxx + op.pyy * bxy;
+      op.qyy = op.pyx * bxy + op.pyy * byy;
+    }
+    (void)axy;
+    m.dash_op[k] = op;
+  }
+  m.prepared_dt = h;
+}
+
+void Solver::step() {
+  Impl& m = *impl_;
+  if (m.prepared_dt != dt) set_dt(dt);
+  const std::int64_t n = static_cast<std::int64_t>(m.x.size());
+  // Internal force at u^n (reused from update_energies when still valid).
+  if (!m.ku_valid) internal_force(m.u.data(), m.ku.data());
+  // m.ku holds -K u^n.
+  external_force(t, m.fext.data());
+  double* __restrict u = m.u.data();
+  double* __restrict v = m.v.data();
+  const double* __restrict fi = m.ku.data();
+  const double* __restrict fe = m.fext.data();
+  const double* __restrict im = m.inv_mass.data();
+  const std::uint8_t* __restrict mask = m.mask.data();
+  const std::int32_t* __restrict dn = m.dash_of_node.data();
+  const double h = dt;
+  double work = 0, absorbed = 0;
+#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const double fx = fi[2 * i] + fe[2 * i], fy = fi[2 * i + 1] + fe[2 * i + 1];
+    const double vx0 = v[2 * i], vy0 = v[2 * i + 1];
+    double vx, vy;
+    if (dn[i] < 0) {
+      vx = vx0 + h * fx * im[i];
+      vy = vy0 + h * fy * im[i];
+      if (mask[i] & 1) vx = 0;
+      if (mask[i] & 2) vy = 0;
+    } else {
+      const Impl::DashOp& o = m.dash_op[dn[i]];
+      vx = o.qxx * vx0 + o.qxy * vy0 + h * (o.pxx * fx + o.pxy * fy);
+      vy = o.qyx * vx0 + o.qyy * vy0 + h * (o.pyx * fx + o.pyy * fy);
+      const Solver::DashpotBlock& c = m.dash[dn[i]];
+      const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
+      absorbed += h * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
+    }
+    work += h * (fe[2 * i] * 0.5 * (vx0 + vx) + fe[2 * i + 1] * 0.5 * (vy0 + vy));
+    v[2 * i] = vx;
+    v[2 * i + 1] = vy;
+    u[2 * i] += h * vx;
+    u[2 * i + 1] += h * vy;
+  }
+  energy.external_work += work;
+  energy.absorbed += absorbed;
+  m.ku_valid = false;
+  t += dt;
+  ++steps;
+  // ku now holds -K u^n (u^n = the displacement before this step), used by update_energies().
+}
+
+void Solver::update_energies() {
+  Impl& m = *impl_;
+  const std::int64_t n = static_cast<std::int64_t>(m.x.size());
+  double kin = 0, el = 0;
+  // Elastic: 1/2 u^n K u^{n+1}; ku holds -K u^n from the last step (or -K u if never stepped).
+  if (steps == 0 && !m.ku_valid) {
+    internal_force(m.u.data(), m.ku.data());
+    m.ku_valid = true;
+  }
+#pragma omp parallel for schedule(static) reduction(+ : kin, el) num_threads(m.threads)
+  for (std::int64_t i = 0; i < n; ++i) {
+    kin += 0.5 * m.mass[i] * (m.v[2 * i] * m.v[2 * i] + m.v[2 * i + 1] * m.v[2 * i + 1]);
+    el -= 0.5 * (m.ku[2 * i] * m.u[2 * i] + m.ku[2 * i + 1] * m.u[2 * i + 1]);
+  }
+  energy.kinetic = kin;
+  energy.elastic = el;
+}
+
+std::vector<Sample> Solver::sample() const {
+  const Impl& m = *impl_;
+  std::vector<Sample> out(m.probes.size());
+  for (std::size_t p = 0; p < m.probes.size(); ++p) {
+    const auto& pr = m.probes[p];
+    double g[2][2] = {{0, 0}, {0, 0}}, vel[2] = {0, 0};
+    for (std::size_t k = 0; k < pr.dofs.size(); ++k) {
+      const int c = pr.comp[k];
+      const double uu = m.u[pr.dofs[k]];
+      g[c][0] += uu * pr.dx[k];
+      g[c][1] += uu * pr.dy[k];
+      vel[c] += m.v[pr.dofs[k]] * pr.N[k];
+    }
+    Sample s;
+    const double exx = g[0][0], eyy = g[1][1], gxy = g[0][1] + g[1][0];
+    const double tr = exx + eyy;
+    s.sxx = pr.lambda * tr + 2 * pr.mu * exx;
+    s.syy = pr.lambda * tr + 2 * pr.mu * eyy;
+    s.szz = pr.lambda * tr;
+    s.sxy = pr.mu * gxy;
+    s.j2 = j2_of(s.sxx, s.syy, s.szz, s.sxy);
+    s.vx = vel[0];
+    s.vy = vel[1];
+    s.div = tr;
+    s.curl = g[1][0] - g[0][1];
+    out[p] = s;
+  }
+  return out;
+}
+
+}  // namespace smpm::fem

@@ -1,0 +1,540 @@
+// FEM far-field setup with deal.II: mesh in, dofs numbered by node, lumped mass, stiffness in a
+// node-block CSR, LK dashpot blocks, traction load vectors, the element bound on the time step,
+// probes and DataOut snapshots. The time stepping itself is in fem_kernels.cpp (no deal.II).
+#include <deal.II/base/exceptions.h>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/dofs/dof_renumbering.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/fe/mapping_q.h>
+#include <deal.II/grid/grid_in.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/lac/vector.h>
+#include <deal.II/numerics/data_out.h>
+#include <deal.II/numerics/data_postprocessor.h>
+#include <mpi.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "fem_impl.hpp"
+
+namespace smpm::fem {
+
+using namespace dealii;
+
+struct Deal {
+  Triangulation<2> tria;
+  std::unique_ptr<FESystem<2>> fe;
+  DoFHandler<2> dofh;
+  MappingQ<2> mapping{1};
+  std::vector<XDMFEntry> xdmf;
+  Deal() : dofh(tria) {}
+};
+
+Solver::Impl::Impl() = default;
+Solver::Impl::~Impl() = default;
+
+namespace {
+
+std::string fmt(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// The useful part of a deal.II exception message.
+std::string deal_message(const std::exception& e) {
+  const std::string w = e.what();
+  const std::string key = "Additional information:";
+  const std::size_t p = w.find(key);
+  std::string s = p == std::string::npos ? w : w.substr(p + key.size());
+  std::string out;
+  bool space = false;
+  for (char c : s) {
+    if (std::isspace(static_cast<unsigned char>(c))) {
+      space = !out.empty();
+      continue;
+    }
+    if (space) out += ' ';
+    space = false;
+    out += c;
+  }
+  const std::size_t stack = out.find("Stacktrace:");
+  if (stack != std::string::npos) out = out.substr(0, stack);
+  while (!out.empty() && (out.back() == ' ' || out.back() == '-')) out.pop_back();
+  return out;
+}
+
+void ensure_mpi() {
+  int init = 0;
+  MPI_Initialized(&init);
+  if (init) return;
+  int fin = 0;
+  MPI_Finalized(&fin);
+  if (fin) return;
+  MPI_Init(nullptr, nullptr);
+  std::atexit([] {
+    int f = 0;
+    MPI_Finalized(&f);
+    if (!f) MPI_Finalize();
+  });
+}
+
+// Key of a cell's shape and material: cells with equal keys have equal element matrices.
+std::vector<long long> cell_key(const Triangulation<2>::active_cell_iterator& cell) {
+  const Point<2> v0 = cell->vertex(0);
+  const double d = cell->diameter();
+  int ex = 0;
+  const double mant = std::frexp(d, &ex);
+  std::vector<long long> k = {static_cast<long long>(cell->material_id()), ex,
+                              std::llround(mant * 1e10)};
+  for (unsigned v = 1; v < 4; ++v)
+    for (unsigned c = 0; c < 2; ++c) k.push_back(std::llround((cell->vertex(v)[c] - v0[c]) / d * 1e10));
+  return k;
+}
+
+class StressPostprocessor : public DataPostprocessor<2> {
+ public:
+  StressPostprocessor(const std::vector<Material>& mats, const std::map<int, int>& region)
+      : mats_(mats), region_(region) {}
+  void evaluate_vector_field(const DataPostprocessorInputs::Vector<2>& in,
+                             std::vector<Vector<double>>& out) const override {
+    const auto cell = in.template get_cell<2>();
+    const Material& m = mats_[region_.at(static_cast<int>(cell->material_id()))];
+    for (unsigned q = 0; q < in.solution_gradients.size(); ++q) {
+      const auto& g = in.solution_gradients[q];
+      const double exx = g[0][0], eyy = g[1][1], gxy = g[0][1] + g[1][0];
+      const double tr = exx + eyy;
+      out[q](0) = m.lambda * tr + 2 * m.mu * exx;
+      out[q](1) = m.lambda * tr + 2 * m.mu * eyy;
+      out[q](2) = m.lambda * tr;
+      out[q](3) = m.mu * gxy;
+    }
+  }
+  std::vector<std::string> get_names() const override { return {"sxx", "syy", "szz", "sxy"}; }
+  UpdateFlags get_needed_update_flags() const override { return update_gradients; }
+
+ private:
+  const std::vector<Material>& mats_;
+  const std::map<int, int>& region_;
+};
+
+}  // namespace
+
+Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
+  ensure_mpi();
+  Impl& m = *impl_;
+  m.spec = spec;
+  m.deal = std::make_unique<Deal>();
+  Deal& d = *m.deal;
+  const std::string& file = spec.mesh.file;
+  if (spec.degree != 1 && spec.degree != 2)
+    throw FemError("FEM: degree must be 1 or 2, got " + std::to_string(spec.degree));
+  m.degree = spec.degree;
+  m.threads = spec.threads > 0 ? spec.threads : omp_get_max_threads();
+  for (const auto& mat : spec.materials)
+    if (mat.model != Model::Elastic)
+      throw FemError("FEM: material \"" + mat.name +
+                     "\" is not elastic; the FEM far-field is linear elastic");
+
+  // --- mesh ---
+  try {
+    GridIn<2> gi;
+    gi.attach_triangulation(d.tria);
+    std::istringstream in(spec.mesh.msh);
+    gi.read_msh(in);
+  } catch (const std::exception& e) {
+    throw FemError(file + ": deal.II cannot use this mesh: " + deal_message(e));
+  }
+  m.n_cells = d.tria.n_active_cells();
+  for (const auto& cell : d.tria.active_cell_iterators()) {
+    const int id = static_cast<int>(cell->material_id());
+    if (!spec.region_material.count(id)) {
+      const PhysicalGroup* g = spec.mesh.surface(id);
+      throw FemError(file + ": physical surface " + std::to_string(id) +
+                     (g && !g->name.empty() ? " (\"" + g->name + "\")" : std::string()) +
+                     " has no material (add it to fem.regions)");
+    }
+  }
+  {
+    const auto& vs = d.tria.get_vertices();
+    m.box = {{1e300, 1e300, -1e300, -1e300}};
+    for (const auto& p : vs) {
+      m.box[0] = std::min(m.box[0], p[0]);
+      m.box[1] = std::min(m.box[1], p[1]);
+      m.box[2] = std::max(m.box[2], p[0]);
+      m.box[3] = std::max(m.box[3], p[1]);
+    }
+  }
+
+  // --- dofs: Cuthill-McKee, then interleaved by node (dof = 2 node + component) ---
+  d.fe = std::make_unique<FESystem<2>>(FE_Q<2>(m.degree), 2);
+  const FESystem<2>& fe = *d.fe;
+  d.dofh.distribute_dofs(fe);
+  DoFRenumbering::Cuthill_McKee(d.dofh);
+  const unsigned dpc = fe.n_dofs_per_cell();
+  const unsigned nbase = dpc / 2;
+  const std::size_t ndofs = d.dofh.n_dofs();
+  {
+    std::vector<types::global_dof_index> partner(ndofs, numbers::invalid_dof_index);
+    std::vector<types::global_dof_index> ld(dpc);
+    for (const auto& cell : d.dofh.active_cell_iterators()) {
+      cell->get_dof_indices(ld);
+      for (unsigned b = 0; b < nbase; ++b)
+        partner[ld[fe.component_to_system_index(0, b)]] = ld[fe.component_to_system_index(1, b)];
+    }
+    std::vector<types::global_dof_index> renum(ndofs);
+    types::global_dof_index k = 0;
+    for (std::size_t i = 0; i < ndofs; ++i)
+      if (partner[i] != numbers::invalid_dof_index) {
+        renum[i] = 2 * k;
+        renum[partner[i]] = 2 * k + 1;
+        ++k;
+      }
+    if (2 * k != ndofs) throw FemError(file + ": internal error numbering the nodes");
+    d.dofh.renumber_dofs(renum);
+  }
+  const std::size_t nn = ndofs / 2;
+  {
+    std::vector<Point<2>> pts(ndofs);
+    DoFTools::map_dofs_to_support_points(d.mapping, d.dofh, pts);
+    m.x.resize(nn);
+    m.y.resize(nn);
+    for (std::size_t i = 0; i < nn; ++i) {
+      m.x[i] = pts[2 * i][0];
+      m.y[i] = pts[2 * i][1];
+    }
+  }
+
+  // --- node-block sparsity ---
+  std::vector<types::global_dof_index> ld(dpc);
+  {
+    std::vector<std::vector<std::uint32_t>> adj(nn);
+    std::vector<std::uint32_t> cn(nbase);
+    for (const auto& cell : d.dofh.active_cell_iterators()) {
+      cell->get_dof_indices(ld);
+      for (unsigned b = 0; b < nbase; ++b)
+        cn[b] = static_cast<std::uint32_t>(ld[fe.component_to_system_index(0, b)] / 2);
+      for (unsigned a = 0; a < nbase; ++a)
+        for (unsigned b = 0; b < nbase; ++b) adj[cn[a]].push_back(cn[b]);
+    }
+    m.rowptr.assign(nn + 1, 0);
+    for (std::size_t i = 0; i < nn; ++i) {
+      auto& r = adj[i];
+      std::sort(r.begin(), r.end());
+      r.erase(std::unique(r.begin(), r.end()), r.end());
+      m.rowptr[i + 1] = m.rowptr[i] + r.size();
+    }
+    m.col.resize(m.rowptr[nn]);
+    for (std::size_t i = 0; i < nn; ++i) {
+      std::copy(adj[i].begin(), adj[i].end(), m.col.begin() + m.rowptr[i]);
+      std::vector<std::uint32_t>().swap(adj[i]);
+    }
+    m.val.assign(4 * m.col.size(), 0.0);
+  }
+
+  // --- stiffness, lumped mass, element bound on dt ---
+  m.mass.assign(nn, 0.0);
+  {
+    const QGauss<2> qk(m.degree + 1);
+    const QGaussLobatto<2> qm(m.degree + 1);
+    FEValues<2> fk(d.mapping, fe, qk, update_gradients | update_JxW_values);
+    FEValues<2> fm(d.mapping, fe, qm, update_values | update_JxW_values);
+    const FEValuesExtractors::Vector disp(0);
+    struct Elem {
+      std::vector<double> K, M;
+    };
+    std::map<std::vector<long long>, Elem> cache;
+    double lam_max = 0;
+    for (const auto& cell : d.dofh.active_cell_iterators()) {
+      const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
+      auto key = cell_key(cell);
+      auto it = cache.find(key);
+      if (it == cache.end()) {
+        Elem e;
+        e.K.assign(dpc * dpc, 0.0);
+        e.M.assign(dpc, 0.0);
+        fk.reinit(cell);
+        fm.reinit(cell);
+        for (unsigned q = 0; q < qk.size(); ++q)
+          for (unsigned i = 0; i < dpc; ++i) {
+            const auto ei = fk[disp].symmetric_gradient(i, q);
+            const double di = fk[disp].divergence(i, q);
+            for (unsigned j = 0; j < dpc; ++j)
+              e.K[i * dpc + j] += (mat.lambda * di * fk[disp].divergence(j, q) +
+                                   2 * mat.mu * (ei * fk[disp].symmetric_gradient(j, q))) *
+                                  fk.JxW(q);
+          }
+        for (unsigned q = 0; q < qm.size(); ++q)
+          for (unsigned i = 0; i < dpc; ++i) {
+            const double phi = fm.shape_value(i, q);
+            e.M[i] += mat.rho * phi * phi * fm.JxW(q);
+          }
+        for (unsigned i = 0; i < dpc; ++i)
+          if (!(e.M[i] > 0))
+            throw FemError(file + ": a cell has a non-positive lumped mass (degenerate or inverted element)");
+        std::vector<double> s(dpc * dpc);
+        for (unsigned i = 0; i < dpc; ++i)
+          for (unsigned j = 0; j < dpc; ++j) s[i * dpc + j] = e.K[i * dpc + j] / std::sqrt(e.M[i] * e.M[j]);
+        lam_max = std::max(lam_max, symmetric_max_eigenvalue(s, static_cast<int>(dpc)));
+        it = cache.emplace(std::move(key), std::move(e)).first;
+      }
+      const Elem& e = it->second;
+      cell->get_dof_indices(ld);
+      for (unsigned i = 0; i < dpc; ++i) {
+        const std::size_t ni = ld[i] / 2, ci = ld[i] % 2;
+        if (ci == 0) m.mass[ni] += e.M[i];
+        const std::uint32_t* b = m.col.data() + m.rowptr[ni];
+        const std::uint32_t* en = m.col.data() + m.rowptr[ni + 1];
+        for (unsigned j = 0; j < dpc; ++j) {
+          const std::uint32_t nj = static_cast<std::uint32_t>(ld[j] / 2);
+          const std::size_t cj = ld[j] % 2;
+          const std::size_t k = std::lower_bound(b, en, nj) - m.col.data();
+          m.val[4 * k + 2 * ci + cj] += e.K[i * dpc + j];
+        }
+      }
+    }
+    m.crit_dt = lam_max > 0 ? 2.0 / std::sqrt(lam_max) : 0.0;
+  }
+  m.inv_mass.resize(nn);
+  for (std::size_t i = 0; i < nn; ++i) m.inv_mass[i] = 1.0 / m.mass[i];
+
+  // --- boundary nodes per boundary id ---
+  std::set<int> present_ids;
+  {
+    const unsigned dpf = fe.n_dofs_per_face();
+    std::vector<types::global_dof_index> fd(dpf);
+    for (const auto& cell : d.dofh.active_cell_iterators())
+      for (const auto f : cell->face_indices())
+        if (cell->face(f)->at_boundary()) {
+          const int id = static_cast<int>(cell->face(f)->boundary_id());
+          present_ids.insert(id);
+          cell->face(f)->get_dof_indices(fd);
+          auto& v = m.curve_nodes[id];
+          for (auto g : fd)
+            if (g % 2 == 0) v.push_back(static_cast<std::uint32_t>(g / 2));
+        }
+    for (auto& [id, v] : m.curve_nodes) {
+      std::sort(v.begin(), v.end());
+      v.erase(std::unique(v.begin(), v.end()), v.end());
+    }
+  }
+  for (const auto& bc : spec.boundaries)
+    for (int c : bc.curves)
+      if (!present_ids.count(c)) {
+        const PhysicalGroup* g = spec.mesh.curve(c);
+        throw FemError(file + ": boundary \"" + bc.name + "\": physical curve " + std::to_string(c) +
+                       (g && !g->name.empty() ? " (\"" + g->name + "\")" : std::string()) +
+                       (g ? " is not on the outer boundary of the mesh" : " is not in the mesh"));
+      }
+
+  // --- constraints ---
+  m.mask.assign(nn, 0);
+  for (const auto& bc : spec.boundaries) {
+    if (bc.kind != Boundary::Kind::Fixed && bc.kind != Boundary::Kind::Roller) continue;
+    const std::uint8_t bit = bc.kind == Boundary::Kind::Fixed ? 3 : (bc.component == 0 ? 1 : 2);
+    for (auto n : boundary_nodes(bc.curves)) m.mask[n] |= bit;
+  }
+
+  // --- dashpots and tractions: face integrals ---
+  std::map<int, const Boundary*> dash_of_id;
+  for (const auto& bc : spec.boundaries)
+    if (bc.kind == Boundary::Kind::Dashpot)
+      for (int c : bc.curves) {
+        if (dash_of_id.count(c))
+          throw FemError("FEM: physical curve " + std::to_string(c) + " has two dashpot boundaries");
+        dash_of_id[c] = &bc;
+      }
+  {
+    const QGaussLobatto<1> ql(m.degree + 1);
+    const QGauss<1> qg(m.degree + 1);
+    FEFaceValues<2> fl(d.mapping, fe, ql, update_values | update_normal_vectors | update_JxW_values);
+    FEFaceValues<2> fg(d.mapping, fe, qg, update_values | update_normal_vectors | update_JxW_values);
+    std::map<std::uint32_t, std::array<double, 3>> cblocks;
+    std::vector<std::map<std::uint32_t, std::array<double, 2>>> loadf(spec.boundaries.size());
+    for (const auto& cell : d.dofh.active_cell_iterators()) {
+      const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
+      for (const auto f : cell->face_indices()) {
+        if (!cell->face(f)->at_boundary()) continue;
+        const int id = static_cast<int>(cell->face(f)->boundary_id());
+        auto dit = dash_of_id.find(id);
+        if (dit != dash_of_id.end()) {
+          const Boundary& bc = *dit->second;
+          fl.reinit(cell, f);
+          cell->get_dof_indices(ld);
+          for (unsigned q = 0; q < ql.size(); ++q) {
+            const Tensor<1, 2> n = fl.normal_vector(q);
+            const double l = fl.JxW(q);
+            const double ca = mat.rho * l * bc.a * mat.cd, cb = mat.rho * l * bc.b * mat.cs;
+            for (unsigned i = 0; i < dpc; ++i) {
+              if (fe.system_to_component_index(i).first != 0) continue;
+              if (std::fabs(fl.shape_value(i, q) - 1.0) > 1e-8) continue;
+              auto& c = cblocks[static_cast<std::uint32_t>(ld[i] / 2)];
+              c[0] += ca * n[0] * n[0] + cb * (1 - n[0] * n[0]);
+              c[1] += (ca - cb) * n[0] * n[1];
+              c[2] += ca * n[1] * n[1] + cb * (1 - n[1] * n[1]);
+            }
+          }
+        }
+        for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
+          const Boundary& bc = spec.boundaries[b];
+          if (bc.kind != Boundary::Kind::Traction) continue;
+          if (std::find(bc.curves.begin(), bc.curves.end(), id) == bc.curves.end()) continue;
+          fg.reinit(cell, f);
+          cell->get_dof_indices(ld);
+          for (unsigned q = 0; q < qg.size(); ++q) {
+            const Tensor<1, 2> n = fg.normal_vector(q);
+            const double tx = bc.normal * n[0] - bc.tangential * n[1] + bc.vx;
+            const double ty = bc.normal * n[1] + bc.tangential * n[0] + bc.vy;
+            for (unsigned i = 0; i < dpc; ++i) {
+              const unsigned c = fe.system_to_component_index(i).first;
+              const double phi = fg.shape_value(i, q);
+              if (phi == 0) continue;
+              loadf[b][static_cast<std::uint32_t>(ld[i] / 2)][c] += phi * (c == 0 ? tx : ty) * fg.JxW(q);
+            }
+          }
+        }
+      }
+    }
+    m.dash_of_node.assign(nn, -1);
+    for (const auto& [node, c] : cblocks) {
+      m.dash_of_node[node] = static_cast<std::int32_t>(m.dash.size());
+      m.dash.push_back({node, c[0], c[1], c[2]});
+    }
+    for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
+      if (spec.boundaries[b].kind != Boundary::Kind::Traction) continue;
+      Impl::Load l;
+      l.fn = spec.boundaries[b].fn;
+      for (const auto& [node, f] : loadf[b]) {
+        l.nodes.push_back(node);
+        l.f.push_back(f[0]);
+        l.f.push_back(f[1]);
+      }
+      m.loads.push_back(std::move(l));
+    }
+  }
+
+  m.u.assign(ndofs, 0.0);
+  m.v.assign(ndofs, 0.0);
+  m.ku.assign(ndofs, 0.0);
+  m.fext.assign(ndofs, 0.0);
+  m.ku_valid = true;  // u = 0
+}
+
+Solver::~Solver() = default;
+
+int Solver::add_probe(double x, double y) {
+  Impl& m = *impl_;
+  Deal& d = *m.deal;
+  const Point<2> p(x, y);
+  std::pair<DoFHandler<2>::active_cell_iterator, Point<2>> found;
+  try {
+    found = GridTools::find_active_cell_around_point(d.mapping, d.dofh, p);
+  } catch (...) {
+    return -1;
+  }
+  if (found.first == d.dofh.end()) return -1;
+  const Point<2> unit = GeometryInfo<2>::project_to_unit_cell(found.second);
+  const Quadrature<2> q(std::vector<Point<2>>{unit}, std::vector<double>{1.0});
+  FEValues<2> fv(d.mapping, *d.fe, q, update_values | update_gradients);
+  fv.reinit(found.first);
+  const unsigned dpc = d.fe->n_dofs_per_cell();
+  std::vector<types::global_dof_index> ld(dpc);
+  found.first->get_dof_indices(ld);
+  Impl::Probe pr;
+  pr.x = x;
+  pr.y = y;
+  for (unsigned i = 0; i < dpc; ++i) {
+    pr.dofs.push_back(static_cast<std::uint32_t>(ld[i]));
+    pr.comp.push_back(static_cast<std::uint8_t>(d.fe->system_to_component_index(i).first));
+    pr.N.push_back(fv.shape_value(i, 0));
+    const Tensor<1, 2> g = fv.shape_grad(i, 0);
+    pr.dx.push_back(g[0]);
+    pr.dy.push_back(g[1]);
+  }
+  const Material& mat =
+      m.spec.materials[m.spec.region_material.at(static_cast<int>(found.first->material_id()))];
+  pr.lambda = mat.lambda;
+  pr.mu = mat.mu;
+  pr.E = mat.E;
+  pr.nu = mat.nu;
+  m.probes.push_back(std::move(pr));
+  return static_cast<int>(m.probes.size()) - 1;
+}
+
+void Solver::write_snapshot(const std::string& dir, const std::string& base) {
+  Impl& m = *impl_;
+  Deal& d = *m.deal;
+  namespace fs = std::filesystem;
+  char num[16];
+  std::snprintf(num, sizeof num, "_%05d", m.snapshots);
+  const std::string h5 = base + num + ".h5";
+  Vector<double> uvec(m.u.begin(), m.u.end()), vvec(m.v.begin(), m.v.end());
+  Vector<float> mat(d.tria.n_active_cells());
+  for (const auto& cell : d.tria.active_cell_iterators())
+    mat[cell->active_cell_index()] = static_cast<float>(cell->material_id());
+  const std::vector<DataComponentInterpretation::DataComponentInterpretation> vec(
+      2, DataComponentInterpretation::component_is_part_of_vector);
+  StressPostprocessor post(m.spec.materials, m.spec.region_material);
+  DataOut<2> out;
+  out.attach_dof_handler(d.dofh);
+  out.add_data_vector(uvec, std::vector<std::string>(2, "displacement"),
+                      DataOut<2>::type_dof_data, vec);
+  out.add_data_vector(vvec, std::vector<std::string>(2, "velocity"), DataOut<2>::type_dof_data, vec);
+  out.add_data_vector(uvec, post);
+  out.add_data_vector(mat, "material", DataOut<2>::type_cell_data);
+  out.build_patches(d.mapping, m.degree);
+  DataOutBase::DataOutFilter filter(DataOutBase::DataOutFilterFlags(true, true));
+  out.write_filtered_data(filter);
+  try {
+    out.write_hdf5_parallel(filter, (fs::path(dir) / h5).string(), MPI_COMM_WORLD);
+    d.xdmf.push_back(out.create_xdmf_entry(filter, h5, t, MPI_COMM_WORLD));
+    out.write_xdmf_file(d.xdmf, (fs::path(dir) / (base + ".xdmf")).string(), MPI_COMM_WORLD);
+  } catch (const std::exception& e) {
+    throw FemError(dir + ": cannot write the FEM snapshot: " + deal_message(e));
+  }
+  ++m.snapshots;
+}
+
+std::vector<std::string> Solver::describe() const {
+  const Impl& m = *impl_;
+  std::vector<std::string> out;
+  out.push_back("FEM mesh " + m.spec.mesh.file + ": " + std::to_string(m.n_cells) + " quads, Q" +
+                std::to_string(m.degree) + ", " + std::to_string(nodes()) + " nodes, " +
+                std::to_string(dofs()) + " dofs, critical dt " + fmt(m.crit_dt) + " s");
+  for (const auto& [tag, mi] : m.spec.region_material) {
+    const PhysicalGroup* g = m.spec.mesh.surface(tag);
+    out.push_back("FEM region " + std::to_string(tag) + (g ? " \"" + g->name + "\"" : std::string()) +
+                  ": " + m.spec.materials[mi].name);
+  }
+  for (const auto& bc : m.spec.boundaries) {
+    std::string s = "FEM boundary \"" + bc.name + "\" on curves";
+    for (int c : bc.curves) s += " " + std::to_string(c);
+    const std::size_t n = boundary_nodes(bc.curves).size();
+    s += " (" + std::to_string(n) + " nodes): ";
+    switch (bc.kind) {
+      case Boundary::Kind::Dashpot: s += "LK dashpot a = " + fmt(bc.a) + ", b = " + fmt(bc.b); break;
+      case Boundary::Kind::Fixed: s += "fixed"; break;
+      case Boundary::Kind::Roller: s += std::string("roller, ") + (bc.component ? "y" : "x") + " held"; break;
+      case Boundary::Kind::Traction:
+        s += "traction normal " + fmt(bc.normal) + " Pa, tangential " + fmt(bc.tangential) +
+             " Pa, vector (" + fmt(bc.vx) + ", " + fmt(bc.vy) + ") Pa x " + bc.fn.describe();
+        break;
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace smpm::fem
