@@ -252,6 +252,9 @@ Geometry load_geometry(const std::string& file, double size) {
     return it->second;
   };
 
+  // Surfaces first, so an error names the body's surface before its curves.
+  std::stable_sort(groups.begin(), groups.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [dim, tag] : groups) {
     if (dim != 1 && dim != 2) continue;
     std::string name;

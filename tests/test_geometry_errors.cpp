@@ -1,0 +1,166 @@
+// Bad gmsh inputs: each gives one clear error naming the case file, the key, the geometry file
+// and the physical group, through load_case() and through the CLI (non-zero exit).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "silentmpm/case.hpp"
+#include "test_geometry_common.hpp"
+
+#ifndef SMPM_CLI
+#define SMPM_CLI ""
+#endif
+
+namespace {
+
+using namespace smpm::geotest;
+
+const char* kRect = R"(
+DefineConstant[ h = 0.001 ];
+Point(1) = {0, 0, 0, h}; Point(2) = {0.02, 0, 0, h};
+Point(3) = {0.02, 0.01, 0, h}; Point(4) = {0, 0.01, 0, h};
+Line(1) = {4, 1}; Line(2) = {2, 3}; Line(3) = {1, 2}; Line(4) = {3, 4};
+Curve Loop(1) = {3, 2, 4, 1}; Plane Surface(1) = {1};
+Physical Surface("plate", 1) = {1};
+Physical Curve("left", 11) = {1}; Physical Curve("right", 12) = {2};
+Physical Curve("bottom", 13) = {3}; Physical Curve("top", 14) = {4};
+)";
+
+// A second, separate square (surface 2) whose edge (curve 15) does not touch the plate.
+const char* kTwo = R"(
+DefineConstant[ h = 0.001 ];
+Point(1) = {0, 0, 0, h}; Point(2) = {0.02, 0, 0, h};
+Point(3) = {0.02, 0.01, 0, h}; Point(4) = {0, 0.01, 0, h};
+Line(1) = {4, 1}; Line(2) = {2, 3}; Line(3) = {1, 2}; Line(4) = {3, 4};
+Curve Loop(1) = {3, 2, 4, 1}; Plane Surface(1) = {1};
+Point(5) = {0, 0.012, 0, h}; Point(6) = {0.005, 0.012, 0, h};
+Point(7) = {0.005, 0.015, 0, h}; Point(8) = {0, 0.015, 0, h};
+Line(5) = {5, 6}; Line(6) = {6, 7}; Line(7) = {7, 8}; Line(8) = {8, 5};
+Curve Loop(2) = {5, 6, 7, 8}; Plane Surface(2) = {2};
+Physical Surface("plate", 1) = {1}; Physical Surface("lid", 2) = {2};
+Physical Curve("right", 12) = {2}; Physical Curve("lid_bottom", 15) = {5};
+)";
+
+std::string case_json(const std::string& geo_file, const std::string& body,
+                      const std::string& boundaries = "", const std::string& grid_size = "[0.03, 0.02]",
+                      const std::string& geometry_extra = "") {
+  return R"({
+  "grid": { "origin": [-0.004, -0.004], "size": )" + grid_size + R"(, "cell": 0.001 },
+  "time": { "end": 1e-6, "cfl": 0.3 },
+  "materials": { "w": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 } },
+  "geometry": { "file": ")" + geo_file + "\"" + geometry_extra + R"( },
+  "bodies": [ )" + body + R"( ],
+  "boundaries": [ )" + boundaries + R"( ]
+})";
+}
+
+const std::string kBody = R"({ "name": "plate", "material": "w", "surface": 1 })";
+
+struct Bad {
+  std::string name;
+  std::string geo_name, geo_text;  // written next to the case (empty name: none)
+  std::string json;
+  std::vector<std::string> expect;  // substrings of the message
+};
+
+std::vector<Bad> bad_cases() {
+  std::vector<Bad> v;
+  v.push_back({"missing_surface", "rect_a.geo", kRect,
+               case_json("rect_a.geo", R"({ "name": "plate", "material": "w", "surface": 7 })"),
+               {"bodies[0].surface", "rect_a.geo", "no physical surface 7", "1 \"plate\""}});
+  v.push_back({"missing_surface_name", "rect_b.geo", kRect,
+               case_json("rect_b.geo", R"({ "name": "plate", "material": "w", "surface": "steel" })"),
+               {"bodies[0].surface", "rect_b.geo", "no physical surface named \"steel\""}});
+  v.push_back({"missing_curve", "rect_c.geo", kRect,
+               case_json("rect_c.geo", kBody, R"({ "type": "silent", "body": "plate", "curve": 19 })"),
+               {"boundaries[0].curve", "rect_c.geo", "no physical curve 19", "11 \"left\""}});
+  v.push_back({"missing_file", "", "", case_json("nowhere.geo", kBody),
+               {"geometry.file", "nowhere.geo", "cannot open file"}});
+  v.push_back({"directory", "", "", case_json(".", kBody), {"geometry.file", "cannot open file"}});
+  v.push_back({"empty_geo", "empty.geo", "", case_json("empty.geo", kBody),
+               {"geometry.file", "empty.geo", "the file is empty"}});
+  v.push_back({"empty_msh", "empty.msh", "  \n", case_json("empty.msh", kBody),
+               {"geometry.file", "empty.msh", "the file is empty"}});
+  v.push_back({"syntax_error", "broken.geo", "Point(1) = {0, 0, 0\n", case_json("broken.geo", kBody),
+               {"geometry.file", "broken.geo", "gmsh could not read the geometry"}});
+  v.push_back({"no_groups", "nogroups.geo",
+               "Point(1) = {0,0,0,1e-3}; Point(2) = {1e-2,0,0,1e-3}; Line(1) = {1,2};\n",
+               case_json("nogroups.geo", kBody),
+               {"geometry.file", "nogroups.geo", "defines no physical surface or physical curve"}});
+  v.push_back({"second_order", "order2.geo", std::string(kRect) + "Mesh.ElementOrder = 2;\n",
+               case_json("order2.geo", kBody),
+               {"geometry.file", "order2.geo", "physical surface 1 \"plate\"", "second-order element"}});
+  v.push_back({"unsupported_type", "shape.stl", "solid x\nendsolid x\n", case_json("shape.stl", kBody),
+               {"geometry.file", "shape.stl", "unsupported file type \".stl\""}});
+  v.push_back({"outside_grid", "rect_d.geo", kRect,
+               case_json("rect_d.geo", kBody, "", "[0.02, 0.02]"),
+               {"bodies[0].surface", "rect_d.geo", "physical surface 1 \"plate\"", "partly outside the grid"}});
+  v.push_back({"no_particle", "rect_e.geo", kRect,
+               case_json("rect_e.geo", kBody,
+                         R"({ "type": "silent", "body": "plate", "curve": 12, "width": 1e-5 })"),
+               {"boundaries[0].curve", "rect_e.geo", "physical curve 12 \"right\"", "selects no particle"}});
+  v.push_back({"curve_off_body", "two.geo", kTwo,
+               case_json("two.geo", kBody,
+                         R"({ "type": "traction", "body": "plate", "curve": 15, "normal": 1 })"),
+               {"boundaries[0].curve", "two.geo", "physical curve 15 \"lid_bottom\"",
+                "is not on the boundary of physical surface 1 \"plate\""}});
+  v.push_back({"side_on_surface_body", "rect_f.geo", kRect,
+               case_json("rect_f.geo", kBody, R"({ "type": "silent", "body": "plate", "side": "right" })"),
+               {"boundaries[0].side", "comes from a gmsh surface"}});
+  v.push_back({"box_and_surface", "rect_g.geo", kRect,
+               case_json("rect_g.geo",
+                         R"({ "name": "plate", "material": "w", "surface": 1, "box": [0, 0, 0.01, 0.01] })"),
+               {"bodies[0].surface", "either box or surface"}});
+  v.push_back({"bad_size", "rect_h.geo", kRect, case_json("rect_h.geo", kBody, "", "[0.03, 0.02]", R"(, "size": -1)"),
+               {"geometry.size", "must be > 0"}});
+  // No geometry key at all.
+  v.push_back({"no_geometry", "", "", R"({
+  "grid": { "size": [0.03, 0.02], "cell": 0.001 }, "time": { "end": 1e-6, "cfl": 0.3 },
+  "materials": { "w": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 } },
+  "bodies": [ { "name": "plate", "material": "w", "surface": 1 } ] })",
+               {"bodies[0].surface", "needs the top-level key \"geometry\""}});
+  return v;
+}
+
+void PrintTo(const Bad& b, std::ostream* os) { *os << b.name; }
+
+fs::path write_bad(const Bad& b) {
+  if (!b.geo_name.empty()) write_file(b.geo_name, b.geo_text);
+  return write_file("bad_" + b.name + ".json", b.json);
+}
+
+class GeometryErrors : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(GeometryErrors, LibraryMessage) {
+  const Bad& b = GetParam();
+  const fs::path file = write_bad(b);
+  try {
+    smpm::load_case(file.string());
+    FAIL() << b.name << ": no error";
+  } catch (const smpm::CaseError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(file.string() + ": ", 0), 0u) << m;  // starts with the case file
+    for (const auto& s : b.expect) EXPECT_NE(m.find(s), std::string::npos) << "missing \"" << s << "\" in: " << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+  }
+}
+
+TEST_P(GeometryErrors, CliExitAndMessage) {
+  const std::string cli = SMPM_CLI;
+  if (cli.empty() || !fs::exists(cli)) GTEST_SKIP() << "CLI binary not built";
+  const Bad& b = GetParam();
+  const fs::path file = write_bad(b);
+  const fs::path err = scratch() / ("err_" + b.name + ".txt");
+  const std::string cmd = "\"" + cli + "\" check \"" + file.string() + "\" >/dev/null 2>\"" + err.string() + "\"";
+  const int status = std::system(cmd.c_str());
+  EXPECT_NE(status, 0) << b.name;
+  const std::string m = read_text(err);
+  for (const auto& s : b.expect) EXPECT_NE(m.find(s), std::string::npos) << "missing \"" << s << "\" in: " << m;
+}
+
+std::string bad_name(const ::testing::TestParamInfo<Bad>& info) { return info.param.name; }
+INSTANTIATE_TEST_SUITE_P(Bad, GeometryErrors, ::testing::ValuesIn(bad_cases()), bad_name);
+
+}  // namespace
