@@ -54,6 +54,24 @@ int main(int argc, char** argv) {
     if (*run && threads >= 0) overrides.push_back("scheme.threads=" + std::to_string(threads));
     if (*run && quiet) overrides.push_back("output.progress=false");
     smpm::Case c = smpm::load_case(case_path, overrides);
+    if (!c.solver && c.fem) {  // FEM-only case
+      const smpm::fem::Solver& f = *c.fem;
+      if (*check) {
+        std::printf("%s: ok\n", case_path.c_str());
+        std::printf("  FEM: %zu cells, Q%d, %zu dofs, dt %g s (CFL %.3f of the element bound), "
+                    "%ld steps, %zu probe(s)\n", f.cells(), f.degree(), f.dofs(), f.dt,
+                    f.dt / f.critical_dt(), static_cast<long>(std::ceil(c.t_end / f.dt - 1e-9)),
+                    c.probes.size());
+        for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
+        return 0;
+      }
+      const auto r = smpm::run_case(c, out_dir);
+      if (!quiet)
+        std::printf("%s: %ld steps, %zu dofs, %.2f s, %.3g dof-updates/s -> %s\n",
+                    case_path.c_str(), r.steps, r.dofs, r.wall_seconds, r.dof_updates_per_second,
+                    out_dir.c_str());
+      return 0;
+    }
     const smpm::Solver& s = *c.solver;
     if (*check) {
       std::printf("%s: ok\n", case_path.c_str());

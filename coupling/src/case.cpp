@@ -12,6 +12,7 @@
 //   * build         the sections in dependency order: grid, time, scheme, output, materials,
 //                   bodies, probes, seeding, boundaries, finalize, time step.
 #include "silentmpm/case.hpp"
+#include "case_fem.hpp"
 #include "silentmpm/geometry.hpp"
 
 #include <algorithm>
@@ -720,6 +721,8 @@ class Builder {
   Case build() {
     if (!doc_.is_object())
       ctx_.fail("", "a case file must be a JSON object {...}, got " + a_type(doc_));
+    // A case with an FEM region is built by case_fem.cpp.
+    if (doc_.contains("fem")) return detail::build_fem_case(ctx_.source, doc_);
     Obj top(ctx_, doc_, "");
     top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes", "geometry",
                "output", "contact"});
@@ -1102,16 +1105,22 @@ class Builder {
   // ---- gmsh geometry: the "geometry" key, bodies from physical surfaces, boundaries from
   // physical curves (the work is done in geometry.cpp / geometry_mpm.cpp).
   void parse_geometry(Obj o) {
-    o.allow({"file", "size"});
+    o.allow({"file", "size", "parameters"});
     std::string file = o.str("file");
     if (file.empty()) o.fail("file", "must not be empty");
     namespace fs = std::filesystem;
     if (fs::path(file).is_relative()) file = (fs::path(ctx_.source).parent_path() / file).string();
     const double size = o.num("size", 0.5 * grid_.h);
     o.gt("size", size, 0);
+    std::vector<std::pair<std::string, double>> params;
+    if (const ojson* p = o.find("parameters")) {
+      if (!p->is_object()) o.fail("parameters", "expected an object {name: number}, got " + a_type(*p));
+      for (const auto& item : p->items())
+        params.emplace_back(item.key(), as_number(ctx_, item.value(), o.at("parameters") + "." + item.key()));
+    }
     o.done();
     try {
-      geo_ = std::make_unique<Geometry>(load_geometry(file, size));
+      geo_ = std::make_unique<Geometry>(load_geometry(file, size, params));
     } catch (const GeometryError& e) {
       o.fail("file", e.what());
     }
@@ -1257,5 +1266,18 @@ Case build_case(const nlohmann::json& doc, const std::string& source) {
   const ojson ordered(doc);  // nlohmann::json keeps keys sorted; material groups follow that order
   return build_ordered(ctx, ordered);
 }
+
+// Shared with case_fem.cpp (the FEM sections use the same material and time-function keys).
+namespace detail {
+Material parse_material_at(const std::string& source, const std::string& name, const ojson& j) {
+  const Ctx ctx{source, {}};
+  return parse_material(ctx, name, j);
+}
+TimeFunction parse_time_function_at(const std::string& source, const ojson& j,
+                                    const std::string& path) {
+  const Ctx ctx{source, {}};
+  return parse_time_function(Obj(ctx, j, path));
+}
+}  // namespace detail
 
 }  // namespace smpm

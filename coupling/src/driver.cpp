@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "case_fem.hpp"
 #include "silentmpm/output.hpp"
 
 namespace smpm {
@@ -64,6 +65,7 @@ class Progress {
 
 RunResult run_case(Case& c, const std::string& out_dir) {
   namespace fs = std::filesystem;
+  if (!c.solver && c.fem) return detail::run_fem_case(c, out_dir);  // FEM-only case
   Solver& s = *c.solver;
   std::error_code ec;
   fs::create_directories(out_dir, ec);

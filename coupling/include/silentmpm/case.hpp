@@ -10,6 +10,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "silentmpm/fem.hpp"
 #include "silentmpm/solver.hpp"
 
 namespace smpm {
@@ -38,6 +39,9 @@ struct Case {
   std::vector<ProbeSpec> probes;
   OutputSpec output;
   std::unique_ptr<Solver> solver;  // seeded, boundary conditions added, finalize() called
+  // FEM region (a case with "fem"): mesh read, boundaries added, dt set; probes added in the
+  // order of `probes`. Null for an MPM-only case; solver is null for an FEM-only case.
+  std::unique_ptr<fem::Solver> fem;
   std::vector<std::string> notes;  // human-readable description of the loads (time functions...)
 };
 

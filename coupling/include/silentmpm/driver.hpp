@@ -11,6 +11,8 @@ struct RunResult {
   long steps = 0;
   double wall_seconds = 0;
   double particle_updates_per_second = 0;
+  std::size_t dofs = 0;                 // FEM region
+  double dof_updates_per_second = 0;    // FEM region
 };
 
 // Runs the case and writes DIR/history.csv, DIR/summary.json, DIR/particles.{h5,xdmf}.

@@ -1,0 +1,430 @@
+// Case files with an FEM region ("fem" at the top level): parsing, validation, and construction of
+// the fem::Solver. Keys are documented in docs/case-reference.md (section "fem"). Every problem
+// is a CaseError "<source>: <key path>: <what>", as for the MPM sections.
+//
+// Layout of an FEM-only case: title, time, scheme (threads only), materials, fem, probes, output.
+// A case with both MPM bodies and an FEM region (the coupled hybrid) is not supported yet.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <regex>
+#include <set>
+
+#include "case_fem.hpp"
+
+namespace smpm::detail {
+namespace {
+
+using ojson = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+
+std::string fmt(double v) {
+  char b[40];
+  for (int p = 1; p <= 12; ++p) {
+    std::snprintf(b, sizeof b, "%.*g", p, v);
+    if (std::strtod(b, nullptr) == v) return b;
+  }
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+std::string fmt_down(double v) {
+  if (!(v > 0) || !std::isfinite(v)) return fmt(v);
+  const double scale = std::pow(10.0, 5 - std::floor(std::log10(v)));
+  return fmt(std::floor(v * scale + 1e-9) / scale);
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
+  return s;
+}
+
+std::string a_type(const ojson& v) {
+  if (v.is_null()) return "null";
+  if (v.is_boolean()) return "a boolean";
+  if (v.is_number()) return "a number";
+  if (v.is_string()) return "a string";
+  if (v.is_array()) return "an array";
+  if (v.is_object()) return "an object";
+  return "an unsupported value";
+}
+
+// A small key walker (the FEM twin of case.cpp's): typed getters, unknown keys rejected.
+class Node {
+ public:
+  Node(const std::string& source, const ojson& j, std::string path)
+      : src_(source), j_(j), path_(std::move(path)) {
+    if (!j.is_object()) fail("", "expected an object, got " + a_type(j));
+  }
+  std::string at(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
+  [[noreturn]] void fail(const std::string& k, const std::string& what) const {
+    const std::string p = k.empty() ? path_ : at(k);
+    throw CaseError(src_ + ": " + (p.empty() ? "" : p + ": ") + what);
+  }
+  void allow(const std::vector<std::string>& keys, const std::string& where = "") const {
+    for (const auto& it : j_.items())
+      if (std::find(keys.begin(), keys.end(), it.key()) == keys.end())
+        fail(it.key(), "unknown key" + (where.empty() ? "" : " " + where) + "; allowed: " + join(keys));
+  }
+  bool has(const std::string& k) const { return j_.contains(k); }
+  const ojson* find(const std::string& k) const {
+    auto it = j_.find(k);
+    return it == j_.end() ? nullptr : &*it;
+  }
+  const ojson& need(const std::string& k) const {
+    const ojson* v = find(k);
+    if (!v) fail(k, "missing required key");
+    return *v;
+  }
+  double num(const std::string& k) const {
+    const ojson& v = need(k);
+    if (!v.is_number()) fail(k, "expected a number, got " + a_type(v));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(k, "expected a finite number");
+    return d;
+  }
+  double num(const std::string& k, double def) const { return has(k) ? num(k) : def; }
+  long integer(const std::string& k, long def) const {
+    if (!has(k)) return def;
+    const ojson& v = need(k);
+    if (v.is_number_integer()) return static_cast<long>(v.get<std::int64_t>());
+    if (v.is_number_float() && v.get<double>() == std::floor(v.get<double>()) &&
+        std::fabs(v.get<double>()) < 1e12)
+      return static_cast<long>(v.get<double>());
+    fail(k, "expected an integer, got " + (v.is_number() ? fmt(v.get<double>()) : a_type(v)));
+  }
+  std::string str(const std::string& k) const {
+    const ojson& v = need(k);
+    if (!v.is_string()) fail(k, "expected a string, got " + a_type(v));
+    return v.get<std::string>();
+  }
+  bool boolean(const std::string& k, bool def) const {
+    if (!has(k)) return def;
+    const ojson& v = need(k);
+    if (!v.is_boolean()) fail(k, "expected true or false, got " + a_type(v));
+    return v.get<bool>();
+  }
+  std::string choice(const std::string& k, const std::vector<std::string>& opts,
+                     const char* def = nullptr) const {
+    if (!has(k)) {
+      if (!def) fail(k, "missing required key (one of " + join(opts) + ")");
+      return def;
+    }
+    const std::string s = str(k);
+    if (std::find(opts.begin(), opts.end(), s) == opts.end())
+      fail(k, "must be one of " + join(opts) + ", got \"" + s + "\"");
+    return s;
+  }
+  std::vector<double> nums(const std::string& k, std::size_t n) const {
+    const ojson& v = need(k);
+    if (!v.is_array() || v.size() != n)
+      fail(k, "expected an array of " + std::to_string(n) + " numbers, got " + a_type(v));
+    std::vector<double> out;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!v[i].is_number()) fail(k, "expected an array of " + std::to_string(n) + " numbers");
+      out.push_back(v[i].get<double>());
+    }
+    return out;
+  }
+  void gt(const std::string& k, double v, double lo) const {
+    if (!(v > lo)) fail(k, "must be > " + fmt(lo) + ", got " + fmt(v));
+  }
+  void ge(const std::string& k, double v, double lo) const {
+    if (!(v >= lo)) fail(k, "must be >= " + fmt(lo) + ", got " + fmt(v));
+  }
+  void le(const std::string& k, double v, double hi) const {
+    if (!(v <= hi)) fail(k, "must be <= " + fmt(hi) + ", got " + fmt(v));
+  }
+  const std::string& source() const { return src_; }
+
+ private:
+  const std::string& src_;
+  const ojson& j_;
+  std::string path_;
+};
+
+std::string index_path(const std::string& p, std::size_t i) {
+  return p + "[" + std::to_string(i) + "]";
+}
+
+// Mesh paths are relative to the case file's folder (or the working directory when the case
+// does not come from a file).
+std::string resolve_path(const std::string& source, const std::string& file) {
+  const fs::path p(file);
+  if (p.is_absolute()) return file;
+  std::error_code ec;
+  const fs::path src(source);
+  if (fs::is_regular_file(src, ec)) return (src.parent_path() / p).lexically_normal().string();
+  return file;
+}
+
+std::vector<std::string> group_list(const std::vector<fem::PhysicalGroup>& gs) {
+  std::vector<std::string> v;
+  for (const auto& g : gs) v.push_back(std::to_string(g.tag) + (g.name.empty() ? "" : " \"" + g.name + "\""));
+  return v;
+}
+
+// A physical group given as a name or a tag (string or integer).
+int group_ref(const Node& o, const ojson& v, const std::string& path, const fem::Mesh& mesh,
+              bool surface) {
+  std::string key;
+  if (v.is_number_integer()) key = std::to_string(v.get<long>());
+  else if (v.is_string()) key = v.get<std::string>();
+  else throw CaseError(o.source() + ": " + path + ": expected a group name or tag, got " + a_type(v));
+  const int tag = surface ? mesh.surface_tag(key) : mesh.curve_tag(key);
+  if (tag < 0)
+    throw CaseError(o.source() + ": " + path + ": no physical " + (surface ? "surface" : "curve") +
+                    " \"" + key + "\" in " + mesh.file + "; it has: " +
+                    join(group_list(surface ? mesh.surfaces : mesh.curves)));
+  return tag;
+}
+
+}  // namespace
+
+Case build_fem_case(const std::string& source, const ojson& doc) {
+  Node top(source, doc, "");
+  if (top.has("bodies") || top.has("grid"))
+    top.fail("fem", "a case with both an MPM region (grid, bodies) and an FEM region is not "
+                    "supported yet (the coupled MPM-FEM hybrid); give either grid + bodies or fem");
+  top.allow({"title", "time", "scheme", "materials", "fem", "probes", "output"}, "in an FEM case");
+  for (const char* k : {"time", "materials", "fem"})
+    if (!top.has(k)) top.fail(k, "missing required key");
+
+  Case c;
+  c.source = source;
+  if (top.has("title")) c.title = top.str("title");
+
+  // time
+  Node t(source, top.need("time"), "time");
+  t.allow({"end", "dt", "cfl"});
+  c.t_end = t.num("end");
+  t.gt("end", c.t_end, 0);
+  if (t.has("dt") == t.has("cfl"))
+    t.fail("", t.has("dt") ? "give either dt or cfl, not both"
+                           : "missing dt or cfl (give exactly one: a time step in s, or a "
+                             "fraction of the stability limit)");
+  const bool use_cfl = t.has("cfl");
+  const double dt_or_cfl = use_cfl ? t.num("cfl") : t.num("dt");
+  if (use_cfl) {
+    t.gt("cfl", dt_or_cfl, 0);
+    t.le("cfl", dt_or_cfl, 1);
+  } else {
+    t.gt("dt", dt_or_cfl, 0);
+  }
+
+  // scheme: threads only
+  int threads = 0;
+  if (top.has("scheme")) {
+    Node s(source, top.need("scheme"), "scheme");
+    s.allow({"threads"}, "in an FEM case (update and flip are MPM settings)");
+    const long th = s.integer("threads", 0);
+    s.ge("threads", static_cast<double>(th), 0);
+    s.le("threads", static_cast<double>(th), 4096);
+    threads = static_cast<int>(th);
+  }
+
+  // output
+  if (top.has("output")) {
+    Node o(source, top.need("output"), "output");
+    o.allow({"history_every", "snapshots", "progress"});
+    c.output.history_every = o.integer("history_every", 1);
+    o.ge("history_every", static_cast<double>(c.output.history_every), 1);
+    const long snaps = o.integer("snapshots", 10);
+    o.ge("snapshots", static_cast<double>(snaps), 0);
+    o.le("snapshots", static_cast<double>(snaps), 100000);
+    c.output.snapshots = static_cast<int>(snaps);
+    c.output.progress = o.boolean("progress", true);
+  }
+
+  // materials
+  const ojson& mats = top.need("materials");
+  if (!mats.is_object()) top.fail("materials", "expected an object {name: {...}}, got " + a_type(mats));
+  if (mats.empty()) top.fail("materials", "must define at least one material");
+  std::vector<Material> materials;
+  std::vector<std::string> mat_names;
+  for (const auto& it : mats.items()) {
+    materials.push_back(parse_material_at(source, it.key(), it.value()));
+    mat_names.push_back(it.key());
+  }
+
+  // fem
+  Node f(source, top.need("fem"), "fem");
+  f.allow({"mesh", "size", "degree", "regions", "boundaries"});
+  fem::Spec spec;
+  spec.threads = threads;
+  const std::string mesh_file = resolve_path(source, f.str("mesh"));
+  double size = 0;
+  if (f.has("size")) {
+    size = f.num("size");
+    f.gt("size", size, 0);
+  }
+  const long degree = f.integer("degree", 1);
+  if (degree != 1 && degree != 2) f.fail("degree", "must be 1 or 2, got " + std::to_string(degree));
+  spec.degree = static_cast<int>(degree);
+  try {
+    spec.mesh = fem::load_mesh(mesh_file, size);
+  } catch (const fem::FemError& e) {
+    f.fail(f.has("size") && std::string(e.what()).find("size") != std::string::npos ? "size" : "mesh",
+           e.what());
+  }
+
+  // regions: physical surface (name or tag) -> material name; every surface needs one.
+  const ojson& regs = f.need("regions");
+  if (!regs.is_object() || regs.empty())
+    f.fail("regions", "expected an object {physical surface: material name, ...}, got " +
+                          (regs.is_object() ? std::string("an empty object") : a_type(regs)));
+  std::set<std::string> used_mats;
+  for (const auto& it : regs.items()) {
+    const std::string path = f.at("regions") + "." + it.key();
+    const int tag = group_ref(f, ojson(it.key()), path, spec.mesh, true);
+    if (spec.region_material.count(tag))
+      throw CaseError(source + ": " + path + ": physical surface " + std::to_string(tag) + " given twice");
+    if (!it.value().is_string())
+      throw CaseError(source + ": " + path + ": expected a material name, got " + a_type(it.value()));
+    const std::string mname = it.value().get<std::string>();
+    auto mi = std::find(mat_names.begin(), mat_names.end(), mname);
+    if (mi == mat_names.end())
+      throw CaseError(source + ": " + path + ": no material named \"" + mname + "\"; defined: " +
+                      join(mat_names));
+    const Material& m = materials[mi - mat_names.begin()];
+    if (m.model != Model::Elastic)
+      throw CaseError(source + ": " + path + ": material \"" + mname + "\" has model \"" +
+                      model_name(m.model) + "\"; the FEM far-field is linear elastic (use \"elastic\")");
+    spec.region_material[tag] = static_cast<int>(mi - mat_names.begin());
+  }
+  for (const auto& g : spec.mesh.surfaces)
+    if (!spec.region_material.count(g.tag))
+      f.fail("regions", "physical surface " + std::to_string(g.tag) +
+                            (g.name.empty() ? "" : " \"" + g.name + "\"") + " of " + mesh_file +
+                            " has no material");
+  spec.materials = materials;
+
+  // boundaries
+  if (const ojson* b = f.find("boundaries")) {
+    if (!b->is_array()) f.fail("boundaries", "expected an array, got " + a_type(*b));
+    for (std::size_t i = 0; i < b->size(); ++i) {
+      const std::string path = index_path(f.at("boundaries"), i);
+      Node o(source, (*b)[i], path);
+      const std::string type = o.choice("type", {"dashpot", "traction", "fixed", "roller"});
+      const std::string where = "for a " + type + " boundary";
+      if (type == "dashpot") o.allow({"type", "name", "curve", "a", "b"}, where);
+      if (type == "traction")
+        o.allow({"type", "name", "curve", "normal", "tangential", "vector", "time"}, where);
+      if (type == "fixed") o.allow({"type", "name", "curve"}, where);
+      if (type == "roller") o.allow({"type", "name", "curve", "component"}, where);
+      fem::Boundary bc;
+      bc.name = o.has("name") ? o.str("name") : type + std::to_string(i);
+      const ojson& cv = o.need("curve");
+      if (cv.is_array()) {
+        if (cv.empty()) o.fail("curve", "must name at least one physical curve");
+        for (std::size_t k = 0; k < cv.size(); ++k)
+          bc.curves.push_back(group_ref(o, cv[k], index_path(o.at("curve"), k), spec.mesh, false));
+      } else {
+        bc.curves.push_back(group_ref(o, cv, o.at("curve"), spec.mesh, false));
+      }
+      if (type == "dashpot") {
+        bc.kind = fem::Boundary::Kind::Dashpot;
+        bc.a = o.num("a", 1.0);
+        o.ge("a", bc.a, 0);
+        bc.b = o.num("b", 1.0);
+        o.ge("b", bc.b, 0);
+        for (const auto& other : spec.boundaries)
+          if (other.kind == fem::Boundary::Kind::Dashpot)
+            for (int cc : bc.curves)
+              if (std::count(other.curves.begin(), other.curves.end(), cc))
+                o.fail("curve", "physical curve " + std::to_string(cc) + " already has a dashpot (\"" +
+                                    other.name + "\")");
+      } else if (type == "traction") {
+        bc.kind = fem::Boundary::Kind::Traction;
+        const bool scalar = o.has("normal") || o.has("tangential");
+        if (scalar && o.has("vector")) o.fail("vector", "give either normal/tangential or vector, not both");
+        if (!scalar && !o.has("vector"))
+          o.fail("", "missing the traction: give normal and/or tangential, or vector");
+        if (scalar) {
+          bc.normal = o.num("normal", 0.0);
+          bc.tangential = o.num("tangential", 0.0);
+        } else {
+          const auto v = o.nums("vector", 2);
+          bc.vx = v[0];
+          bc.vy = v[1];
+        }
+        if (const ojson* tf = o.find("time")) bc.fn = parse_time_function_at(source, *tf, o.at("time"));
+      } else if (type == "fixed") {
+        bc.kind = fem::Boundary::Kind::Fixed;
+      } else {
+        bc.kind = fem::Boundary::Kind::Roller;
+        bc.component = o.choice("component", {"x", "y"}) == "x" ? 0 : 1;
+      }
+      spec.boundaries.push_back(std::move(bc));
+    }
+  }
+
+  try {
+    c.fem = std::make_unique<fem::Solver>(spec);
+  } catch (const fem::FemError& e) {
+    f.fail("", e.what());
+  }
+  fem::Solver& s = *c.fem;
+
+  // time step against the element bound
+  const double crit = s.critical_dt();
+  if (!(crit > 0) || !std::isfinite(crit))
+    t.fail("", "cannot compute the stability limit of the FEM mesh (critical dt = " + fmt(crit) + ")");
+  double dt = use_cfl ? dt_or_cfl * crit : dt_or_cfl;
+  if (!use_cfl && dt > crit * (1 + 1e-12))
+    t.fail("dt", fmt(dt) + " s is above the FEM stability limit " + fmt_down(crit) +
+                     " s (element bound, CFL " + fmt(dt / crit) + " > 1); use dt <= " +
+                     fmt_down(crit) + " or set time.cfl");
+  s.set_dt(std::min(dt, crit));
+  s.t = 0;
+
+  // probes
+  if (const ojson* p = top.find("probes")) {
+    if (!p->is_array()) top.fail("probes", "expected an array, got " + a_type(*p));
+    static const std::vector<std::string> all = {"sxx", "syy", "szz", "sxy", "J2",
+                                                 "vx",  "vy",  "div", "curl"};
+    for (std::size_t i = 0; i < p->size(); ++i) {
+      Node o(source, (*p)[i], index_path("probes", i));
+      o.allow({"name", "at", "fields"});
+      ProbeSpec pr;
+      pr.name = o.str("name");
+      static const std::regex ok("[A-Za-z0-9_]+");
+      if (!std::regex_match(pr.name, ok))
+        o.fail("name", "must be letters, digits and _ only, got \"" + pr.name + "\"");
+      for (const auto& q : c.probes)
+        if (q.name == pr.name) o.fail("name", "probe name \"" + pr.name + "\" is used twice");
+      const auto at = o.nums("at", 2);
+      pr.x = at[0];
+      pr.y = at[1];
+      if (s.add_probe(pr.x, pr.y) < 0) {
+        const auto bb = s.bounds();
+        o.fail("at", "outside the FEM mesh (bounding box [" + fmt(bb[0]) + ", " + fmt(bb[2]) +
+                         "] x [" + fmt(bb[1]) + ", " + fmt(bb[3]) + "]): (" + fmt(pr.x) + ", " +
+                         fmt(pr.y) + ")");
+      }
+      if (const ojson* fl = o.find("fields")) {
+        if (!fl->is_array() || fl->empty())
+          o.fail("fields", "expected a non-empty array of field names");
+        for (std::size_t k = 0; k < fl->size(); ++k) {
+          const std::string fp = index_path(o.at("fields"), k);
+          if (!(*fl)[k].is_string()) throw CaseError(source + ": " + fp + ": expected a string");
+          const std::string name = (*fl)[k].get<std::string>();
+          if (std::find(all.begin(), all.end(), name) == all.end())
+            throw CaseError(source + ": " + fp + ": must be one of " + join(all) + ", got \"" + name + "\"");
+          if (std::find(pr.fields.begin(), pr.fields.end(), name) != pr.fields.end())
+            throw CaseError(source + ": " + fp + ": field \"" + name + "\" listed twice");
+          pr.fields.push_back(name);
+        }
+      } else {
+        pr.fields = all;
+      }
+      c.probes.push_back(std::move(pr));
+    }
+  }
+  c.notes = s.describe();
+  return c;
+}
+
+}  // namespace smpm::detail

@@ -1,0 +1,24 @@
+#pragma once
+// Internal: the FEM side of case files (case_fem.cpp) and of the run driver (driver_fem.cpp),
+// and the section parsers case.cpp shares with them.
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "silentmpm/case.hpp"
+#include "silentmpm/driver.hpp"
+
+namespace smpm::detail {
+
+// Defined in case.cpp: the same parsers (and messages) the MPM sections use.
+Material parse_material_at(const std::string& source, const std::string& name,
+                           const nlohmann::ordered_json& j);
+TimeFunction parse_time_function_at(const std::string& source, const nlohmann::ordered_json& j,
+                                    const std::string& path);
+
+// Defined in case_fem.cpp: builds a case whose top level has "fem" (an FEM region).
+Case build_fem_case(const std::string& source, const nlohmann::ordered_json& doc);
+
+// Defined in driver_fem.cpp: runs a case that has an FEM region and no MPM bodies.
+RunResult run_fem_case(Case& c, const std::string& out_dir);
+
+}  // namespace smpm::detail
