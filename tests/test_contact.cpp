@@ -243,3 +243,84 @@ TEST(ContactImpact, SingleFieldSticks) {
               -sf / 1e6, -st / 1e6, o.sigma / 1e6, (tb - ta) * 1e6, o.tc * 1e6, tr.flyer_v,
               tr.gap.back() / c.h, tr.max_momentum_error);
 }
+
+namespace {
+
+// Coulomb friction: an aluminium block (L x H = 20 x 10 cells, body 1) on a steel base (40 x 10
+// cells, body 0, bottom fixed), pushed down by p0 and sideways by tau0 on its top, both ramped
+// up together (sin^2 over 20 us, quasi-static for the block: 6 shear transit times). While it
+// slides, the base holds it back with mu N = mu p0 L, so its momentum is
+//   P(T) = (tau0 - mu p0) L  integral_0^T f dt = (tau0 - mu p0) L (T - t_ramp / 2);
+// with tau0 < mu p0 it sticks.
+struct Sliding {
+  double P = 0, P_free = 0;       // block momentum at T, and tau0 L integral f (no friction)
+  double min_gap = 1e30;          // lowest block particle minus highest base particle
+  double dissipated = 0, external = 0, imbalance = 0;
+};
+
+Sliding slide(double mu, double tau0, double p0) {
+  const double h = 1e-3, L = 20 * h, H = 10 * h;
+  auto s = std::make_unique<Solver>();
+  s->materials.push_back(steel());
+  s->materials.push_back(aluminium());
+  s->grid.init(-5 * h, 0.0, h, 50, 25);
+  s->seed_rectangle(0, 0, 40 * h, H, 1, 0, 0, 0, 0);
+  s->seed_rectangle(10 * h, H, 10 * h + L, 2 * H, 1, 1, 1, 0, 0);
+  s->constraints.push_back({"bottom", s->nodes_in_box(-1, 0, 1, 0), 3});
+  TractionLoad tl;
+  tl.layer = s->select_layer("top", 1, 10 * h + L, 2 * H, 10 * h, 2 * H, 0, 1, h);
+  tl.vx = tau0;
+  tl.vy = -p0;
+  const double t_ramp = 20e-6, T = 40e-6;
+  tl.fn.kind = TimeFunction::Kind::Step;
+  tl.fn.ramp = t_ramp;
+  s->tractions.push_back(tl);
+  s->contact.type = ContactType::Multi;
+  s->contact.friction = mu;
+  s->opt.threads = 1;
+  s->dt = 0.3 * h / s->materials[1].cd;
+  s->finalize();
+  Sliding r;
+  while (s->t < T - 0.5 * s->dt) {
+    s->step();
+    double top_base = -1e30, low_block = 1e30;
+    for (std::size_t k = 0; k < s->p.size(); ++k) {
+      if (s->p.body[k] == 0) top_base = std::max(top_base, s->p.y[k]);
+      else low_block = std::min(low_block, s->p.y[k]);
+    }
+    r.min_gap = std::min(r.min_gap, low_block - top_base);
+  }
+  for (std::size_t k = 0; k < s->p.size(); ++k)
+    if (s->p.body[k] == 1) r.P += s->p.mass[k] * s->p.vx[k];
+  r.P_free = tau0 * L * (s->t - 0.5 * t_ramp);
+  s->update_energies();
+  r.dissipated = s->contact.dissipated;
+  r.external = s->energy.external_work;
+  r.imbalance = s->energy.imbalance();
+  return r;
+}
+
+}  // namespace
+
+TEST(ContactFriction, SlidingBlockCoulomb) {
+  const double tau0 = 30e6, p0 = 50e6, mu = 0.3;
+  const Sliding f = slide(mu, tau0, p0);
+  const double expect = (tau0 - mu * p0) / tau0 * f.P_free;
+  EXPECT_NEAR(f.P, expect, 0.05 * expect);
+  EXPECT_GT(f.min_gap, 0.0);
+  // Friction heat is counted: kinetic + elastic + friction = work of the top traction, 2 %.
+  EXPECT_GT(f.dissipated, 0.0);
+  EXPECT_LT(std::abs(f.imbalance), 0.02 * f.external);
+  // Frictionless: the block slides with the full tangential impulse; nothing is dissipated.
+  const Sliding g = slide(0.0, tau0, p0);
+  EXPECT_NEAR(g.P, g.P_free, 0.03 * g.P_free);
+  EXPECT_LT(std::abs(g.dissipated), 1e-9 * g.external);
+  // Below the friction limit it sticks.
+  const Sliding st = slide(mu, 10e6, p0);
+  EXPECT_LT(std::abs(st.P), 0.05 * st.P_free);
+  std::printf("friction: momentum %.4g (closed form %.4g), frictionless %.4g (%.4g), stick %.3g "
+              "(free sliding would give %.4g) N s/m; friction heat %.4g J/m of %.4g J/m work, "
+              "imbalance %.3g J/m; min gap %.3g mm\n",
+              f.P, expect, g.P, g.P_free, st.P, st.P_free, f.dissipated, f.external, f.imbalance,
+              f.min_gap * 1e3);
+}

@@ -21,6 +21,12 @@
 
 namespace smpm {
 
+namespace {
+// The heaviest body's gradient gives the normal unless it is shorter than this fraction of the
+// difference of the gradients.
+constexpr double kWeakGradient = 0.25;
+}  // namespace
+
 const char* contact_type_name(ContactType t) {
   return t == ContactType::Multi ? "multi" : "single";
 }
@@ -267,12 +273,20 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
       Gy += gy_[b][i];
     }
     cx /= M; cy /= M;
+    // One normal for the node: the outward normal of the heaviest body h (its mass gradient),
+    // unless that gradient is weak against the difference g_h - g_others (a node inside body h);
+    // the other bodies take the opposite direction.
+    int hb = -1;
+    for (int b = 0; b < nb_; ++b)
+      if (m_[b][i] > floor && (hb < 0 || m_[b][i] > m_[hb][i])) hb = b;
+    double Nx = gx_[hb][i], Ny = gy_[hb][i];
+    const double Dx = 2 * Nx - Gx, Dy = 2 * Ny - Gy;
+    if (std::hypot(Nx, Ny) < kWeakGradient * std::hypot(Dx, Dy)) Nx = Dx, Ny = Dy;
     bool any = false;
     for (int b = 0; b < nb_; ++b) {
       const double mb = m_[b][i];
       if (mb <= floor) continue;
-      // Outward normal of body b: its mass gradient minus the others' (= 2 g_b - G).
-      double nx = 2 * gx_[b][i] - Gx, ny = 2 * gy_[b][i] - Gy;
+      double nx = b == hb ? Nx : -Nx, ny = b == hb ? Ny : -Ny;
       if (g.fix[i] & 1) nx = 0;
       if (g.fix[i] & 2) ny = 0;
       const double nn = std::hypot(nx, ny);
