@@ -667,8 +667,8 @@ TimeFunction parse_time_function(Obj o) {
   return f;
 }
 
-ProbeSpec parse_probe(Obj o, const GridSpec& g) {
-  o.allow({"name", "at", "fields"});
+ProbeSpec parse_probe(Obj o, const GridSpec& g, const std::vector<std::string>& body_names) {
+  o.allow({"name", "at", "fields", "body"});
   ProbeSpec p;
   p.name = o.str("name");
   static const std::regex ok("[A-Za-z0-9_]+");
@@ -695,6 +695,14 @@ ProbeSpec parse_probe(Obj o, const GridSpec& g) {
     }
   } else {
     p.fields = all;
+  }
+  if (o.has("body")) {
+    const std::string b = o.str("body");
+    const auto it = std::find(body_names.begin(), body_names.end(), b);
+    if (it == body_names.end())
+      o.fail("body", "no body named \"" + b + "\"" + suggestion(b, body_names) +
+                         "; bodies: " + join(body_names));
+    p.body = static_cast<int>(it - body_names.begin());
   }
   o.done();
   return p;
@@ -912,7 +920,7 @@ class Builder {
     if (!arr.is_array()) ctx_.fail("probes", "expected an array, got " + a_type(arr));
     for (std::size_t i = 0; i < arr.size(); ++i) {
       Obj o(ctx_, arr[i], index_path("probes", i));
-      ProbeSpec p = parse_probe(o, grid_);
+      ProbeSpec p = parse_probe(o, grid_, body_names());
       for (const auto& q : c.probes)
         if (q.name == p.name) o.fail("name", "probe name \"" + p.name + "\" is used twice");
       c.probes.push_back(std::move(p));

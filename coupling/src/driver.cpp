@@ -75,9 +75,11 @@ RunResult run_case(Case& c, const std::string& out_dir) {
 
   // Probes and history columns.
   std::vector<std::array<double, 2>> pts;
+  std::vector<int> probe_bodies;
   std::vector<std::string> cols;
   for (const auto& pr : c.probes) {
     pts.push_back({pr.x, pr.y});
+    probe_bodies.push_back(pr.body);
     for (const auto& f : pr.fields) cols.push_back(pr.name + "." + f);
   }
   for (const char* e : {"kinetic", "elastic", "dissipated", "absorbed", "external_work", "imbalance"})
@@ -86,7 +88,7 @@ RunResult run_case(Case& c, const std::string& out_dir) {
   hist.open((dir / "history.csv").string(), cols);
   std::vector<double> row(cols.size());
   auto record = [&]() {
-    const auto samples = s.sample(pts);
+    const auto samples = s.sample(pts, probe_bodies);
     s.update_energies();
     std::size_t k = 0;
     for (std::size_t q = 0; q < c.probes.size(); ++q)

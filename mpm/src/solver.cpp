@@ -734,6 +734,11 @@ void Solver::update_energies() {
 }
 
 std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>& pts) const {
+  return sample(pts, std::vector<int>());
+}
+
+std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>& pts,
+                                        const std::vector<int>& bodies) const {
   const std::size_t np = pts.size();
   std::vector<ProbeSample> out(np);
   if (np == 0) return out;
@@ -751,6 +756,7 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
     for (std::size_t q = 0; q < np; ++q) {
       Acc& A = acc[q];
       if (std::abs(sf.ci - A.ci) > 1 || std::abs(sf.cj - A.cj) > 1) continue;
+      if (!bodies.empty() && bodies[q] >= 0 && p.body[k] != bodies[q]) continue;
       const double vals[6] = {p.sxx[k], p.syy[k], p.szz[k], p.sxy[k], p.vx[k], p.vy[k]};
       for (int a = 0; a < 4; ++a) {
         const int li = sf.ci + sf.di[a] - A.ci, lj = sf.cj + sf.dj[a] - A.cj;

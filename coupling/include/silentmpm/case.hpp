@@ -24,6 +24,7 @@ struct ProbeSpec {
   std::string name;
   double x = 0, y = 0;
   std::vector<std::string> fields;
+  int body = -1;  // sample only this body's particles (-1: all bodies)
 };
 
 struct OutputSpec {

@@ -93,6 +93,9 @@ class Solver {
   ProbeSample sample(double x, double y) const;
   // Several points in one pass over the particles.
   std::vector<ProbeSample> sample(const std::vector<std::array<double, 2>>& points) const;
+  // Same, each point sampling only the particles of body bodies[q] (-1: every body).
+  std::vector<ProbeSample> sample(const std::vector<std::array<double, 2>>& points,
+                                  const std::vector<int>& bodies) const;
   int thread_count() const { return nthreads_; }
   // Check every particle is inside the grid; returns the index of the first outside, or -1.
   long first_particle_outside() const;

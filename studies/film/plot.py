@@ -1,0 +1,205 @@
+#!/usr/bin/python3
+"""Figures 16-24 and metrics.json of the film study (studies/film/README.md).
+
+    /usr/bin/python3 studies/film/plot.py OUTDIR
+
+Reads OUTDIR/<run>/history.csv, summary.json and particles.h5 as written by studies/film/run.
+"""
+import json
+import os
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+T_FIG = 2.88e-9      # time of the deformed configurations (paper Figs. 16-18)
+T_CMP = 3.2e-9       # comparison window end (extended bottom reflection returns at 3.25 ns)
+MAGNIFY = 10.0
+STATE_NAMES = ["elastic", "plastic", "decohesion", "separated"]
+STATE_COLOURS = ["#c8c8c8", "#4a90d9", "#f28e2b", "#d62728"]
+
+
+def history(path):
+    with open(path) as f:
+        head = f.readline().strip().split(",")
+    a = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return {k: a[:, i] for i, k in enumerate(head)}
+
+
+def rel_l2(a, b, col, t1):
+    t = b["time"]
+    m = t <= t1 + 1e-15
+    x = np.interp(t[m], a["time"], a[col])
+    y = b[col][m]
+    return float(np.linalg.norm(x - y) / np.linalg.norm(y))
+
+
+def snapshot_at(h5path, t):
+    with h5py.File(h5path, "r") as f:
+        names = sorted(f.keys())
+        times = np.array([f[n].attrs["time"] for n in names])
+        k = int(np.argmin(np.abs(times - t)))
+        g0, g = f[names[0]], f[names[k]]
+        order0 = np.argsort(g0["id"][:])
+        order = np.argsort(g["id"][:])
+        d = {
+            "time": float(times[k]),
+            "x0": g0["xyz"][:][order0, :2],
+            "x": g["xyz"][:][order, :2],
+            "state": g["state"][:][order],
+            "eps_p": g["eps_p"][:][order],
+            "body": g["body"][:][order],
+            "nx": g["normal_x"][:][order],
+            "ny": g["normal_y"][:][order],
+        }
+    return d
+
+
+def counts(snap):
+    film = snap["body"] == 0
+    st = snap["state"][film]
+    return {name: int(np.sum(st == i)) for i, name in enumerate(STATE_NAMES)}
+
+
+def figure_deformed(snap, title, path, cell):
+    x0, x = snap["x0"], snap["x"]
+    xm = x0 + MAGNIFY * (x - x0)
+    state = snap["state"].copy()
+    # Non-film materials have no state machine: show their yielded points as plastic.
+    other = snap["body"] != 0
+    state[other & (snap["eps_p"] > 0)] = 1
+    keep = x0[:, 1] >= -1e-12  # the film and the upper 5 um of the substrate
+    fig, ax = plt.subplots(figsize=(7.5, 6.2))
+    size = 2.2 * (cell / 1e-7) ** 2 * (72.0 / fig.dpi)
+    for i, name in enumerate(STATE_NAMES):
+        m = keep & (state == i)
+        if np.any(m):
+            ax.scatter(xm[m, 0] * 1e6, xm[m, 1] * 1e6, s=size, c=STATE_COLOURS[i], marker="s",
+                       linewidths=0, label=f"{name} ({int(np.sum(m & (snap['body'] == 0)))} in film)")
+    # Critical-plane traces of the decohesion / separated particles.
+    m = keep & (snap["state"] >= 2)
+    if np.any(m):
+        tx, ty = -snap["ny"][m], snap["nx"][m]
+        h = 0.6 * cell * 1e6
+        X, Y = xm[m, 0] * 1e6, xm[m, 1] * 1e6
+        ax.plot(np.vstack([X - h * tx, X + h * tx]), np.vstack([Y - h * ty, Y + h * ty]),
+                color="k", lw=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (µm), displacement x10")
+    ax.set_ylabel("y (µm), displacement x10")
+    ax.set_title(f"{title}\nt = {snap['time'] * 1e9:.2f} ns, displacements magnified {MAGNIFY:.0f}x",
+                 fontsize=10)
+    ax.legend(loc="lower center", fontsize=8, markerscale=3, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def figure_lines(runs, col, ylabel, title, path, scale):
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    styles = ["-", "--", ":", "-."]
+    for (label, h), ls in zip(runs, styles):
+        m = h["time"] <= T_CMP + 1e-15
+        ax.plot(h["time"][m] * 1e9, h[col][m] * scale, ls, lw=1.3, label=label)
+    ax.axvline(1.08, color="0.7", lw=0.8)
+    ax.text(1.1, 0.02, "Si round trip 5 µm", transform=ax.get_xaxis_transform(), fontsize=7,
+            color="0.4")
+    ax.set_xlabel("time (ns)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "out")
+    H = {}
+    for name in ["fixed", "extended", "silent", "cell_0.05", "cell_0.167", "ppc_4", "ppc_9"]:
+        p = os.path.join(out, name, "history.csv")
+        if os.path.exists(p):
+            H[name] = history(p)
+    metrics = {"comparison_window_s": [0.0, T_CMP], "relative_l2_syy": {}, "particles": {}}
+    for P in ["E", "F"]:
+        col = f"{P}.syy"
+        metrics["relative_l2_syy"][P] = {
+            "silent_vs_extended": rel_l2(H["silent"], H["extended"], col, T_CMP),
+            "fixed_vs_extended": rel_l2(H["fixed"], H["extended"], col, T_CMP),
+        }
+    titles = {
+        "fixed": ("figure16.png", "Fixed bottom, substrate 5 µm"),
+        "extended": ("figure17.png", "Fixed bottom, substrate 15 µm (extended; upper 5 µm shown)"),
+        "silent": ("figure18.png", "Silent bottom, substrate 5 µm"),
+    }
+    for name, (fig, title) in titles.items():
+        snap = snapshot_at(os.path.join(out, name, "particles.h5"), T_FIG)
+        figure_deformed(snap, title, os.path.join(out, fig), 1e-7)
+        with h5py.File(os.path.join(out, name, "particles.h5"), "r") as f:
+            last = sorted(f.keys())[-1]
+        end = snapshot_at(os.path.join(out, name, "particles.h5"), 1.0)
+        metrics["particles"][name] = {"at_2.88ns": counts(snap), "at_3.2ns": counts(end)}
+    # sigma_yy at E and F for the three substrates.
+    three = [("fixed 5 µm", H["fixed"]), ("extended 15 µm", H["extended"]),
+             ("silent 5 µm", H["silent"])]
+    figure_lines(three, "E.syy", "σyy at E (GPa)", "σyy at E (4.95 µm, 0.05 µm below the interface)",
+                 os.path.join(out, "figure19.png"), 1e-9)
+    figure_lines(three, "F.syy", "σyy at F (GPa)", "σyy at F (0.95 µm, 0.05 µm below the interface)",
+                 os.path.join(out, "figure20.png"), 1e-9)
+    # J2 convergence: cell size and particles per cell (silent bottom).
+    cells = [(lab, H[k]) for lab, k in [("0.05 µm", "cell_0.05"), ("0.1 µm", "silent"),
+                                         ("0.167 µm", "cell_0.167")] if k in H]
+    ppcs = [(lab, H[k]) for lab, k in [("1 ppc", "silent"), ("4 ppc", "ppc_4"),
+                                        ("9 ppc", "ppc_9")] if k in H]
+    for fig, runs, P, what in [("figure21.png", cells, "E", "cell size"),
+                               ("figure22.png", cells, "F", "cell size"),
+                               ("figure23.png", ppcs, "E", "particles per cell"),
+                               ("figure24.png", ppcs, "F", "particles per cell")]:
+        figure_lines(runs, f"{P}.J2", f"J2 at {P} (GPa²)", f"J2 at {P}, silent bottom: {what}",
+                     os.path.join(out, fig), 1e-18)
+    # Convergence numbers: relative L2 of J2 against the finest / densest run.
+    conv = {}
+    for P in ["E", "F"]:
+        col = f"{P}.J2"
+        if "cell_0.05" in H:
+            conv[f"{P}.J2_cell_0.1_vs_0.05"] = rel_l2(H["silent"], H["cell_0.05"], col, T_CMP)
+            if "cell_0.167" in H:
+                conv[f"{P}.J2_cell_0.167_vs_0.05"] = rel_l2(H["cell_0.167"], H["cell_0.05"], col, T_CMP)
+        if "ppc_9" in H:
+            conv[f"{P}.J2_ppc_1_vs_9"] = rel_l2(H["silent"], H["ppc_9"], col, T_CMP)
+            if "ppc_4" in H:
+                conv[f"{P}.J2_ppc_4_vs_9"] = rel_l2(H["ppc_4"], H["ppc_9"], col, T_CMP)
+    metrics["convergence_relative_l2"] = conv
+    # Wall time: one thread, no snapshots, best of three.
+    wall = {}
+    for c in ["fixed", "silent"]:
+        ts = []
+        for k in (1, 2, 3):
+            p = os.path.join(out, f"time_{c}_{k}", "summary.json")
+            if os.path.exists(p):
+                s = json.load(open(p))
+                ts.append((s["wall_seconds"], s["step_seconds"], s["particles"], s["steps"]))
+        if ts:
+            best = min(ts)
+            wall[c] = {"wall_seconds": best[0], "step_seconds": best[1], "particles": best[2],
+                       "steps": best[3], "runs": len(ts)}
+    if "fixed" in wall and "silent" in wall:
+        wall["silent_over_fixed_step_time"] = wall["silent"]["step_seconds"] / wall["fixed"]["step_seconds"]
+    metrics["timing_one_thread"] = wall
+    energy = {}
+    for name in ["fixed", "extended", "silent"]:
+        s = json.load(open(os.path.join(out, name, "summary.json")))
+        energy[name] = s["energy"]
+    metrics["energy"] = energy
+    with open(os.path.join(out, "metrics.json"), "w") as f:
+        json.dump(metrics, f, indent=2)
+    print(json.dumps(metrics, indent=2))
+
+
+if __name__ == "__main__":
+    main()
