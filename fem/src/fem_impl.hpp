@@ -23,6 +23,7 @@ struct Solver::Impl {
   int degree = 1;
   int threads = 1;
   std::size_t n_cells = 0;
+  std::vector<std::uint32_t> cell_nodes;  // nodes of each cell, (degree+1)^2 per cell (coupling)
   std::array<double, 4> box{{0, 0, 0, 0}};
 
   // Per node.
@@ -63,13 +64,17 @@ struct Solver::Impl {
   double crit_dt = 0;
   bool ku_valid = false;  // ku holds K u for the current u
 
-  // Probes: shape values and gradients of the cell's dofs at the point.
-  struct Probe {
-    double x, y;
+  // Probes: shape values and gradients of the dofs of every cell containing the point (a point on
+  // a cell edge or node belongs to 2 or 4 cells; their stresses are averaged).
+  struct ProbePart {
     std::vector<std::uint32_t> dofs;
     std::vector<std::uint8_t> comp;
     std::vector<double> N, dx, dy;
-    double lambda, mu, E, nu;
+    double lambda, mu;
+  };
+  struct Probe {
+    double x, y;
+    std::vector<ProbePart> parts;
   };
   std::vector<Probe> probes;
 

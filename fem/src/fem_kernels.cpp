@@ -66,6 +66,7 @@ std::vector<double>& Solver::displacement() {
 std::vector<double>& Solver::velocity() { return impl_->v; }
 const std::vector<Solver::DashpotBlock>& Solver::dashpots() const { return impl_->dash; }
 const std::vector<std::uint8_t>& Solver::constraint_mask() const { return impl_->mask; }
+const std::vector<std::uint32_t>& Solver::cell_nodes() const { return impl_->cell_nodes; }
 
 std::vector<std::uint32_t> Solver::boundary_nodes(const std::vector<int>& curves) const {
   std::vector<std::uint32_t> out;
@@ -230,27 +231,29 @@ std::vector<Sample> Solver::sample() const {
   const Impl& m = *impl_;
   std::vector<Sample> out(m.probes.size());
   for (std::size_t p = 0; p < m.probes.size(); ++p) {
-    const auto& pr = m.probes[p];
-    double g[2][2] = {{0, 0}, {0, 0}}, vel[2] = {0, 0};
-    for (std::size_t k = 0; k < pr.dofs.size(); ++k) {
-      const int c = pr.comp[k];
-      const double uu = m.u[pr.dofs[k]];
-      g[c][0] += uu * pr.dx[k];
-      g[c][1] += uu * pr.dy[k];
-      vel[c] += m.v[pr.dofs[k]] * pr.N[k];
-    }
     Sample s;
-    const double exx = g[0][0], eyy = g[1][1], gxy = g[0][1] + g[1][0];
-    const double tr = exx + eyy;
-    s.sxx = pr.lambda * tr + 2 * pr.mu * exx;
-    s.syy = pr.lambda * tr + 2 * pr.mu * eyy;
-    s.szz = pr.lambda * tr;
-    s.sxy = pr.mu * gxy;
+    const double w = 1.0 / static_cast<double>(m.probes[p].parts.size());
+    for (const auto& pr : m.probes[p].parts) {
+      double g[2][2] = {{0, 0}, {0, 0}}, vel[2] = {0, 0};
+      for (std::size_t k = 0; k < pr.dofs.size(); ++k) {
+        const int c = pr.comp[k];
+        const double uu = m.u[pr.dofs[k]];
+        g[c][0] += uu * pr.dx[k];
+        g[c][1] += uu * pr.dy[k];
+        vel[c] += m.v[pr.dofs[k]] * pr.N[k];
+      }
+      const double exx = g[0][0], eyy = g[1][1], gxy = g[0][1] + g[1][0];
+      const double tr = exx + eyy;
+      s.sxx += w * (pr.lambda * tr + 2 * pr.mu * exx);
+      s.syy += w * (pr.lambda * tr + 2 * pr.mu * eyy);
+      s.szz += w * pr.lambda * tr;
+      s.sxy += w * pr.mu * gxy;
+      s.vx += w * vel[0];
+      s.vy += w * vel[1];
+      s.div += w * tr;
+      s.curl += w * (g[1][0] - g[0][1]);
+    }
     s.j2 = j2_of(s.sxx, s.syy, s.szz, s.sxy);
-    s.vx = vel[0];
-    s.vy = vel[1];
-    s.div = tr;
-    s.curl = g[1][0] - g[0][1];
     out[p] = s;
   }
   return out;

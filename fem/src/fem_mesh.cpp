@@ -28,11 +28,15 @@ std::string fmt(double v) {
 
 const char* kSizeParameter = "Parameters/h";
 
-// gmsh holds global state. Initialise it if needed (a second initialise is harmless), never
-// finalise it (another part of the program may be using it), and clear the model when done.
+// gmsh holds global state: options set by an earlier .geo (Mesh.ElementOrder...) persist, and
+// after a syntax error its parser no longer defines the DefineConstant parameters. So every load
+// starts from a fresh gmsh (initialise, finalise, initialise: gmsh 4.8 has no isInitialized) and
+// leaves it initialised, with the model cleared, for any other user in the program.
 class GmshSession {
  public:
   GmshSession() {
+    gmsh::initialize(0, nullptr, false);
+    gmsh::finalize();
     gmsh::initialize(0, nullptr, false);
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::logger::start();

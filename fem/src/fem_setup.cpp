@@ -226,6 +226,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
       cell->get_dof_indices(ld);
       for (unsigned b = 0; b < nbase; ++b)
         cn[b] = static_cast<std::uint32_t>(ld[fe.component_to_system_index(0, b)] / 2);
+      m.cell_nodes.insert(m.cell_nodes.end(), cn.begin(), cn.end());
       for (unsigned a = 0; a < nbase; ++a)
         for (unsigned b = 0; b < nbase; ++b) adj[cn[a]].push_back(cn[b]);
     }
@@ -438,37 +439,42 @@ int Solver::add_probe(double x, double y) {
   Impl& m = *impl_;
   Deal& d = *m.deal;
   const Point<2> p(x, y);
-  std::pair<DoFHandler<2>::active_cell_iterator, Point<2>> found;
+  using CellPoint = std::pair<DoFHandler<2>::active_cell_iterator, Point<2>>;
+  std::vector<CellPoint> found;
   try {
-    found = GridTools::find_active_cell_around_point(d.mapping, d.dofh, p);
+    // Tolerance in reference coordinates: a point on an edge or a node belongs to every cell
+    // that shares it.
+    found = GridTools::find_all_active_cells_around_point(d.mapping, d.dofh, p, 1e-9);
   } catch (...) {
     return -1;
   }
-  if (found.first == d.dofh.end()) return -1;
-  const Point<2> unit = GeometryInfo<2>::project_to_unit_cell(found.second);
-  const Quadrature<2> q(std::vector<Point<2>>{unit}, std::vector<double>{1.0});
-  FEValues<2> fv(d.mapping, *d.fe, q, update_values | update_gradients);
-  fv.reinit(found.first);
+  if (found.empty() || found.front().first == d.dofh.end()) return -1;
   const unsigned dpc = d.fe->n_dofs_per_cell();
   std::vector<types::global_dof_index> ld(dpc);
-  found.first->get_dof_indices(ld);
   Impl::Probe pr;
   pr.x = x;
   pr.y = y;
-  for (unsigned i = 0; i < dpc; ++i) {
-    pr.dofs.push_back(static_cast<std::uint32_t>(ld[i]));
-    pr.comp.push_back(static_cast<std::uint8_t>(d.fe->system_to_component_index(i).first));
-    pr.N.push_back(fv.shape_value(i, 0));
-    const Tensor<1, 2> g = fv.shape_grad(i, 0);
-    pr.dx.push_back(g[0]);
-    pr.dy.push_back(g[1]);
+  for (const auto& [cell, ref] : found) {
+    const Point<2> unit = GeometryInfo<2>::project_to_unit_cell(ref);
+    const Quadrature<2> q(std::vector<Point<2>>{unit}, std::vector<double>{1.0});
+    FEValues<2> fv(d.mapping, *d.fe, q, update_values | update_gradients);
+    fv.reinit(cell);
+    cell->get_dof_indices(ld);
+    Impl::ProbePart part;
+    for (unsigned i = 0; i < dpc; ++i) {
+      part.dofs.push_back(static_cast<std::uint32_t>(ld[i]));
+      part.comp.push_back(static_cast<std::uint8_t>(d.fe->system_to_component_index(i).first));
+      part.N.push_back(fv.shape_value(i, 0));
+      const Tensor<1, 2> g = fv.shape_grad(i, 0);
+      part.dx.push_back(g[0]);
+      part.dy.push_back(g[1]);
+    }
+    const Material& mat =
+        m.spec.materials[m.spec.region_material.at(static_cast<int>(cell->material_id()))];
+    part.lambda = mat.lambda;
+    part.mu = mat.mu;
+    pr.parts.push_back(std::move(part));
   }
-  const Material& mat =
-      m.spec.materials[m.spec.region_material.at(static_cast<int>(found.first->material_id()))];
-  pr.lambda = mat.lambda;
-  pr.mu = mat.mu;
-  pr.E = mat.E;
-  pr.nu = mat.nu;
   m.probes.push_back(std::move(pr));
   return static_cast<int>(m.probes.size()) - 1;
 }

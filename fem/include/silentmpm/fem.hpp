@@ -148,6 +148,9 @@ class Solver {
     double cxx, cxy, cyy;
   };
   const std::vector<DashpotBlock>& dashpots() const;
+  // Nodes of each cell, (degree + 1)^2 per cell in deal.II's FE_Q order (vertices first:
+  // (0,0), (1,0), (0,1), (1,1) in the cell's reference frame).
+  const std::vector<std::uint32_t>& cell_nodes() const;
   // Constraint mask per node: bit 0 = x held, bit 1 = y held.
   const std::vector<std::uint8_t>& constraint_mask() const;
   // External nodal force f_ext(t) (2 per node) into f (overwrites).
