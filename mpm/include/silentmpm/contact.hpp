@@ -81,6 +81,7 @@ class Contact {
   std::vector<int> body_of_group_;
   using Field = std::vector<std::vector<double>>;  // [body][node]
   Field m_, px_, py_, fx_, fy_, gx_, gy_, vx_, vy_, vnx_, vny_, qx_, qy_;
+  Field xm_, ym_, sm_;  // sum m_p N x_p, sum m_p N y_p, sum m_p N sqrt(V_p): nodal centroid, size
   std::vector<uint32_t> cnodes_;  // nodes with two or more bodies this step
   std::vector<std::vector<std::array<uint32_t, 2>>> ranges_;  // per body: solver ranges, others empty
 
