@@ -56,7 +56,7 @@ TEST(FilmStudy, SilentTracksExtendedBetterThanFixedAtE) {
 
 TEST(FilmStudy, EnergyBalanceWithPlasticAndDecohesionDissipation) {
   Case c = load_case(case_path("silent").string(),
-                     {"grid.cell=2.5e-7", "time.dt=4e-12", "scheme.threads=1"});
+                     {"grid.cell=2.5e-7", "time.dt=8e-12", "scheme.threads=1"});
   Solver& s = *c.solver;
   const long n = std::lround(c.t_end / s.dt);
   for (long i = 0; i < n; ++i) s.step();

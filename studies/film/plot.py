@@ -74,7 +74,8 @@ def figure_deformed(snap, title, path, cell):
     state[other & (snap["eps_p"] > 0)] = 1
     keep = x0[:, 1] >= -1e-12  # the film and the upper 5 um of the substrate
     fig, ax = plt.subplots(figsize=(7.5, 6.2))
-    size = 2.2 * (cell / 1e-7) ** 2 * (72.0 / fig.dpi)
+    # Marker side about one particle spacing: the axes span ~11 um over ~6.6 in (475 pt).
+    size = (0.85 * cell * 1e6 * 475.0 / 11.0) ** 2
     for i, name in enumerate(STATE_NAMES):
         m = keep & (state == i)
         if np.any(m):
@@ -84,10 +85,10 @@ def figure_deformed(snap, title, path, cell):
     m = keep & (snap["state"] >= 2)
     if np.any(m):
         tx, ty = -snap["ny"][m], snap["nx"][m]
-        h = 0.6 * cell * 1e6
+        h = 0.45 * cell * 1e6
         X, Y = xm[m, 0] * 1e6, xm[m, 1] * 1e6
         ax.plot(np.vstack([X - h * tx, X + h * tx]), np.vstack([Y - h * ty, Y + h * ty]),
-                color="k", lw=0.5)
+                color="k", lw=0.35, alpha=0.6)
     ax.set_aspect("equal")
     ax.set_xlabel("x (µm), displacement x10")
     ax.set_ylabel("y (µm), displacement x10")
@@ -140,8 +141,6 @@ def main():
     for name, (fig, title) in titles.items():
         snap = snapshot_at(os.path.join(out, name, "particles.h5"), T_FIG)
         figure_deformed(snap, title, os.path.join(out, fig), 1e-7)
-        with h5py.File(os.path.join(out, name, "particles.h5"), "r") as f:
-            last = sorted(f.keys())[-1]
         end = snapshot_at(os.path.join(out, name, "particles.h5"), 1.0)
         metrics["particles"][name] = {"at_2.88ns": counts(snap), "at_3.2ns": counts(end)}
     # sigma_yy at E and F for the three substrates.
