@@ -55,6 +55,7 @@ struct ProbeSample {
 
 class Solver {
   friend class Contact;  // the multi-field step runs the stages below per body
+  friend class Hybrid;   // the MPM-FEM coupled step (coupling/src/hybrid.cpp) runs them too
 
  public:
   Grid grid;

@@ -1,0 +1,99 @@
+#pragma once
+// MPM-FEM coupling through shared nodes (REFERENCE.md section 7).
+//
+// With bilinear grid shape functions MPM is a Q1 Galerkin method whose quadrature points are the
+// particles. A Q1 far-field whose interface nodes coincide with grid nodes forms one
+// discretisation with it: at a shared node the lumped masses, the momenta and the forces of both
+// regions add, and one explicit update serves both. Each coupled step (USL or MUSL):
+//
+//   MPM p2g + particle loads        masses, momenta, internal and boundary forces on the grid
+//   FE  f = -K u^n + f_ext(t^n)      on every FE node
+//   shared nodes                     grid m += m_FE, p += m_FE v_FE, f += f_FE
+//   grid update                      v+ = v + dt f / m (semi-implicit where a dashpot block sits,
+//                                    FE dashpot blocks included at shared nodes)
+//   FE nodes not shared              (m + dt/2 C) v+ = (m - dt/2 C) v + dt f, constraints
+//   FE nodes shared                  v_FE+ = grid v+
+//   u^{n+1} = u^n + dt v_FE+;  particles: g2p (MUSL re-maps the momentum, the FE momentum of a
+//   shared node included), stress update, positions
+//
+// The interface is found automatically: an FE node that lies within h 1e-6 of a grid node is
+// mapped to it; the shared nodes are those FE nodes at grid nodes that are a corner of a grid cell
+// not covered by the FE mesh (a cell particles may occupy). Guards (HybridError, at setup unless
+// said otherwise):
+//   * FE degree 1 only; FE cells touching the MPM region must be exactly one grid cell (same
+//     spacing h, nodes on grid nodes); an FE node on an occupied MPM cell must sit on a grid node;
+//   * a particle inside an FE cell (at setup and after every step);
+//   * an MPM cell touching the interface must be full (particle volume h^2 within 0.1 %);
+//   * no MPM traction on an interface node (setup) and no FE load on an interface node carrying
+//     MPM mass (checked every step: the FE load is evaluated there anyway).
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "silentmpm/fem.hpp"
+#include "silentmpm/solver.hpp"
+
+namespace smpm {
+
+struct HybridError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class Hybrid {
+ public:
+  // Both solvers fully built (mpm.finalize() called). Finds and checks the interface; throws
+  // HybridError with a complete message on any guard. dt must then be set with set_dt.
+  Hybrid(Solver& mpm, fem::Solver& fe);
+
+  // Sets the common time step on both regions (throws HybridError if it exceeds the FE element
+  // bound or the MPM limit h / c_d).
+  void set_dt(double dt);
+  double dt() const { return mpm_.dt; }
+  double time() const { return mpm_.t; }
+  long steps() const { return mpm_.steps; }
+  // Largest stable step of the coupled system: min of both regions' limits.
+  double critical_dt() const;
+
+  void step();
+
+  // Energies of both regions summed (kinetic, elastic; dissipated, absorbed and external work
+  // accumulate in step()); also refreshes mpm.energy and fe.energy.
+  void update_energies();
+  Energies energy;
+
+  // Interface: (FE node, grid node) pairs of the shared nodes, and how many of them carry MPM
+  // mass at setup (the interface proper).
+  const std::vector<std::array<std::uint32_t, 2>>& shared() const { return shared_; }
+  std::size_t interface_nodes() const { return interface_count_; }
+  // 1 for grid cells covered by the FE mesh.
+  const std::vector<std::uint8_t>& fe_cells() const { return fe_cell_; }
+
+  // Total momentum of both regions (particles + FE nodes not shared + FE mass at shared nodes
+  // with the shared velocity).
+  std::array<double, 2> momentum() const;
+
+  Solver& mpm() { return mpm_; }
+  fem::Solver& fe() { return fe_; }
+
+ private:
+  Solver& mpm_;
+  fem::Solver& fe_;
+  std::vector<std::array<std::uint32_t, 2>> shared_;
+  std::vector<std::int64_t> grid_of_fe_;   // shared grid node of each FE node, or -1
+  std::vector<std::int32_t> dash_of_fe_;   // index into fe.dashpots(), or -1
+  std::vector<std::uint8_t> fe_cell_;      // per grid cell
+  std::vector<std::uint8_t> has_mpm_mass_; // per shared pair: node had MPM mass at setup
+  std::size_t interface_count_ = 0;
+  std::vector<double> fint_, fext_, vold_; // FE per-dof work arrays
+  std::vector<double> mpm_v_, sum_v_;      // per shared node: p_MPM / m_MPM, (p_MPM + m_FE v_FE) / m
+  double fe_kinetic_ = 0, fe_elastic_ = 0;
+  double fe_absorbed_ = 0, fe_work_ = 0;
+  double fe_initial_ = 0;
+
+  void check_particles_in_fe_cells(bool at_setup) const;
+  void fe_energies(bool with_step_force);
+};
+
+}  // namespace smpm

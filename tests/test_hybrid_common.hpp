@@ -1,0 +1,164 @@
+#pragma once
+// Helpers for the MPM-FEM hybrid tests: a tungsten strip [0, L] x [0, H] whose part x < xi is
+// particles and x > xi finite elements (a gmsh rectangle with curves 11 left = interface,
+// 12 right, 13 bottom, 14 top), or all particles, or all finite elements.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "common.hpp"
+#include "silentmpm/fem.hpp"
+#include "silentmpm/hybrid.hpp"
+
+namespace smpm::hybrid_testing {
+
+namespace fs = std::filesystem;
+
+// .geo of [x0, x1] x [y0, y1], square transfinite quads of size h.
+inline std::string box_geo(const std::string& name, double x0, double y0, double x1, double y1,
+                           double h) {
+  const fs::path d = fs::temp_directory_path() / "smpm_hybrid_tests";
+  fs::create_directories(d);
+  const fs::path p = d / (name + ".geo");
+  std::ofstream f(p);
+  char buf[2048];
+  std::snprintf(buf, sizeof buf,
+                "DefineConstant[ h = {%.17g, Name \"Parameters/h\"} ];\n"
+                "Point(1) = {%.17g, %.17g, 0}; Point(2) = {%.17g, %.17g, 0};\n"
+                "Point(3) = {%.17g, %.17g, 0}; Point(4) = {%.17g, %.17g, 0};\n"
+                "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
+                "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
+                "Transfinite Curve{1, 3} = Round(%.17g / h) + 1;\n"
+                "Transfinite Curve{2, 4} = Round(%.17g / h) + 1;\n"
+                "Transfinite Surface{1}; Recombine Surface{1};\n"
+                "Physical Surface(\"body\", 1) = {1};\n"
+                "Physical Curve(\"left\", 11) = {4}; Physical Curve(\"right\", 12) = {2};\n"
+                "Physical Curve(\"bottom\", 13) = {1}; Physical Curve(\"top\", 14) = {3};\n",
+                h, x0, y0, x1, y0, x1, y1, x0, y1, x1 - x0, y1 - y0);
+  f << buf;
+  return p.string();
+}
+
+inline fem::Boundary fe_bc(fem::Boundary::Kind k, int curve, const std::string& name) {
+  fem::Boundary b;
+  b.kind = k;
+  b.curves = {curve};
+  b.name = name;
+  return b;
+}
+
+enum class Right { Free, Dashpot };
+
+struct Strip {
+  int cells = 200;        // total length in cells
+  int mpm_cells = 60;     // particles on [0, mpm_cells h] (cells = mpm_cells: all MPM; 0: all FE)
+  int height = 2;         // cells across
+  int ppc_side = 1;
+  double h = 1e-3;
+  double cfl = 0.3;
+  bool rollers = true;    // top and bottom hold v_y (a 1D column); false: free plate
+  Right right = Right::Free;
+  double amplitude = 100e6;  // compressive normal traction on the left end
+  TimeFunction fn;
+  Scheme scheme = Scheme::MUSL;
+  double v0 = 0;          // initial x velocity of the particles
+  bool load = true;       // the traction on the left end
+};
+
+struct HybRun {
+  std::unique_ptr<Solver> mpm;
+  std::unique_ptr<fem::Solver> fe;
+  std::unique_ptr<Hybrid> hyb;
+  double dt = 0;
+  void step() {
+    if (hyb) hyb->step();
+    else if (mpm) mpm->step();
+    else fe->step();
+  }
+  double time() const { return mpm ? mpm->t : fe->t; }
+};
+
+inline std::unique_ptr<fem::Solver> strip_fe(const Strip& c, double x0, bool loaded_left) {
+  fem::Spec s;
+  const double L = c.cells * c.h, H = c.height * c.h;
+  s.mesh = fem::load_mesh(box_geo("strip_" + std::to_string(c.cells) + "_" +
+                                      std::to_string(c.mpm_cells) + "_" +
+                                      std::to_string(c.height),
+                                  x0, 0, L, H, c.h),
+                          c.h);
+  s.degree = 1;
+  s.materials = {testing::tungsten()};
+  s.region_material = {{1, 0}};
+  s.threads = 1;
+  if (c.rollers) {
+    auto b13 = fe_bc(fem::Boundary::Kind::Roller, 13, "bottom");
+    auto b14 = fe_bc(fem::Boundary::Kind::Roller, 14, "top");
+    b13.component = b14.component = 1;
+    s.boundaries = {b13, b14};
+  }
+  if (loaded_left) {
+    auto load = fe_bc(fem::Boundary::Kind::Traction, 11, "load");
+    load.normal = -c.amplitude;
+    load.fn = c.fn;
+    s.boundaries.push_back(load);
+  }
+  if (c.right == Right::Dashpot) s.boundaries.push_back(fe_bc(fem::Boundary::Kind::Dashpot, 12, "right"));
+  return std::make_unique<fem::Solver>(s);
+}
+
+inline HybRun make_strip(const Strip& c) {
+  HybRun m;
+  const double h = c.h, L = c.cells * h, H = c.height * h, xi = c.mpm_cells * h;
+  const double dt = c.cfl * h / testing::tungsten().cd;
+  m.dt = dt;
+  if (c.mpm_cells > 0) {
+    auto s = std::make_unique<Solver>();
+    s->materials.push_back(testing::tungsten());
+    const int nx = (c.mpm_cells < c.cells ? c.mpm_cells : c.cells) + 4;
+    s->grid.init(-2 * h, 0.0, h, nx, c.height);
+    s->seed_rectangle(0, 0, xi, H, c.ppc_side, 0, 0, c.v0, 0);
+    if (c.rollers) {
+      s->constraints.push_back({"bottom", s->nodes_in_box(-1, 0, 1, 0), 2});
+      s->constraints.push_back({"top", s->nodes_in_box(-1, H, 1, H), 2});
+    }
+    if (c.load) {
+      TractionLoad tl;
+      tl.layer = s->select_layer("left", 0, 0, H, 0, 0, -1, 0, h);
+      tl.normal = -c.amplitude;
+      tl.fn = c.fn;
+      s->tractions.push_back(tl);
+    }
+    if (c.mpm_cells == c.cells && c.right == Right::Dashpot) {
+      SilentBoundary sb;
+      sb.layer = s->select_layer("right", 0, L, 0, L, H, 1, 0, h);
+      s->silents.push_back(sb);
+    }
+    s->opt.scheme = c.scheme;
+    s->opt.threads = 1;
+    s->dt = dt;
+    s->finalize();
+    m.mpm = std::move(s);
+  }
+  if (c.mpm_cells < c.cells) {
+    m.fe = strip_fe(c, xi, c.mpm_cells == 0 && c.load);
+    if (m.mpm) {
+      m.hyb = std::make_unique<Hybrid>(*m.mpm, *m.fe);
+      m.hyb->set_dt(dt);
+    } else {
+      m.fe->set_dt(dt);
+    }
+  }
+  return m;
+}
+
+inline TimeFunction bell(double duration) {
+  TimeFunction f;
+  f.kind = TimeFunction::Kind::Sin2Pulse;
+  f.duration = duration;
+  f.ramp = 0.5 * duration;
+  return f;
+}
+
+}  // namespace smpm::hybrid_testing
