@@ -16,6 +16,10 @@
 #include "silentmpm/solver.hpp"
 #include "test_geometry_common.hpp"
 
+#ifndef SMPM_SOURCE_DIR
+#define SMPM_SOURCE_DIR "."
+#endif
+
 namespace {
 
 using namespace smpm;
@@ -213,6 +217,12 @@ TEST(GeometryLayer, InclinedEdgeNormalsAndTractionSum) {
     BodyRegion region;
     region.surface = &g.surfaces[0];
     TractionLoad t;
+    // Length weights (1D Voronoi cells of the projections) also sum to the edge length.
+    const BoundaryLayer by_length =
+        select_curve_layer(*s, g, edge, region, 0, kH, "edge", LayerWeights::Length);
+    double lsum = 0;
+    for (double w : by_length.w) lsum += w;
+    EXPECT_NEAR(lsum, exact_length, 1e-12 * exact_length);
     t.layer = select_curve_layer(*s, g, edge, region, 0, kH, "edge");
     ASSERT_GT(t.layer.ids.size(), 10u);
     double worst = 0;
@@ -317,6 +327,66 @@ TEST(GeometryCase, BodiesAndBoundariesFromGmsh) {
     EXPECT_NEAR(s.tractions[0].layer.nx[q], -1.0, 1e-14);
   }
   EXPECT_NEAR(s.tractions[0].layer.length, 0.01, 1e-15);
+}
+
+// ---------------------------------------------------------------------------------------------
+// meshes/: every .geo loads, follows the group convention, and has the documented areas.
+
+TEST(GeometryMeshes, ConventionAndAreas) {
+  const fs::path dir = fs::path(SMPM_SOURCE_DIR) / "meshes";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir;
+  const std::map<std::string, std::vector<double>> areas = {
+      {"impact.geo", {0.02 * 0.03, 0.1 * 0.1}},
+      {"impact_extended.geo", {0.02 * 0.03, 0.3 * 0.1}},
+      {"convergence.geo", {0.01, 0.01}},
+      {"film_5um.geo", {10e-6 * 2.5e-6, 10e-6 * 5e-6}},
+      {"film_15um.geo", {10e-6 * 2.5e-6, 10e-6 * 15e-6}},
+      {"inclined_edge.geo", {0.16 * 0.16 - 0.5 * 0.16 * 0.16 * std::tan(M_PI / 6)}},
+      {"ring.geo", {M_PI * (0.05 * 0.05 - 0.01 * 0.01)}},
+  };
+  int checked = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() != ".geo") continue;
+    const std::string name = entry.path().filename().string();
+    const std::string text = read_text(entry.path());
+    EXPECT_EQ(text.find("\nPhysical Point"), std::string::npos) << name << ": no Physical Points";
+    EXPECT_NE(text.find("DefineConstant[ h ="), std::string::npos) << name << ": mesh size h";
+    EXPECT_EQ(text.rfind("//", 0), 0u) << name << ": a comment block at the top";
+    Geometry g;
+    // Meshed coarsely to keep the test fast (0: the file's own h).
+    const std::map<std::string, double> coarse = {
+        {"impact.geo", 0.005}, {"impact_extended.geo", 0.005}, {"convergence.geo", 0.01},
+        {"film_5um.geo", 5e-7}, {"film_15um.geo", 5e-7}, {"film.geo", 5e-7},
+        {"inclined_edge.geo", 0.01}, {"ring.geo", 0.002}, {"pulse_plate.geo", 0.005},
+        {"pulse_extended.geo", 0.005}};
+    const auto cs = coarse.find(name);
+    try {
+      g = load_geometry(entry.path().string(), cs == coarse.end() ? 0.0 : cs->second);
+    } catch (const GeometryError& e) {
+      ADD_FAILURE() << e.what();
+      continue;
+    }
+    for (std::size_t i = 0; i < g.surfaces.size(); ++i) {
+      EXPECT_EQ(g.surfaces[i].tag, static_cast<int>(i + 1)) << name << ": surfaces numbered 1, 2, ...";
+      EXPECT_FALSE(g.surfaces[i].name.empty()) << name;
+      EXPECT_EQ(g.surfaces[i].name.find(':'), std::string::npos) << name;
+    }
+    for (const auto& c : g.curves) {
+      EXPECT_GE(c.tag, 11) << name << ": curves numbered from 11";
+      EXPECT_FALSE(c.name.empty()) << name;
+      EXPECT_EQ(c.name.find(':'), std::string::npos) << name;
+    }
+    auto it = areas.find(name);
+    if (it == areas.end()) continue;
+    ASSERT_EQ(g.surfaces.size(), it->second.size()) << name;
+    for (std::size_t i = 0; i < g.surfaces.size(); ++i) {
+      const double a = g.area(g.surfaces[i]), want = it->second[i];
+      const double tol = name == "ring.geo" ? 2e-3 * want : 1e-9 * want;  // inscribed polygons
+      EXPECT_NEAR(a, want, tol) << name << ": surface " << g.surfaces[i].tag;
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(areas.size()));
 }
 
 }  // namespace

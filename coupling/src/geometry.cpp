@@ -186,7 +186,8 @@ int element_order(int type) {
 
 }  // namespace
 
-Geometry load_geometry(const std::string& file, double size) {
+Geometry load_geometry(const std::string& file, double size,
+                       const std::vector<std::pair<std::string, double>>& parameters) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(file, ec)) throw GeometryError(file + ": cannot open file (it does not exist)");
@@ -209,6 +210,12 @@ Geometry load_geometry(const std::string& file, double size) {
   std::lock_guard<std::mutex> lock(gmsh_mutex());
   std::vector<std::string> args = {"silentmpm"};
   if (geo && size > 0) args.insert(args.end(), {"-setnumber", "h", fmt17(size)});
+  for (const auto& [name, value] : parameters) {
+    if (!geo) throw GeometryError(file + ": parameters are only used by a .geo file");
+    if (name.empty() || name == "h" || name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos)
+      throw GeometryError(file + ": parameter name \"" + name + "\" must be letters, digits and _ (and not h: use size)");
+    args.insert(args.end(), {"-setnumber", name, fmt17(value)});
+  }
   GmshSession session(args);
 
   gmsh_call(file, geo ? "read the geometry" : "read the mesh", [&] { gmsh::open(file); });

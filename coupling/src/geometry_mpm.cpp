@@ -237,7 +237,7 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
 
 BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geometry::Curve& c,
                                  const BodyRegion& region, int body, double depth,
-                                 const std::string& name) {
+                                 const std::string& name, LayerWeights weights) {
   const std::string label = Geometry::label("physical curve", c.tag, c.name);
   const std::string body_label =
       region.surface ? Geometry::label("physical surface", region.surface->tag, region.surface->name)
@@ -306,6 +306,8 @@ BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geo
   const double tol = 1e-9 * sol.grid.h;
   const Particles& p = sol.p;
   double vsum = 0;
+  std::vector<int> seg_of;
+  std::vector<double> along_of;
   for (std::size_t k = 0; k < p.size(); ++k) {
     if (p.body[k] != body) continue;
     double dist, along;
@@ -324,11 +326,38 @@ BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geo
     L.ny.push_back(ny);
     L.d.push_back(dist);
     L.w.push_back(p.vol[k]);
+    seg_of.push_back(i);
+    along_of.push_back(std::clamp(along, 0.0, s.len));
     vsum += p.vol[k];
   }
   if (vsum > 0) {
     L.width = vsum / L.length;
     for (double& w : L.w) w /= L.width;
+  }
+  if (weights == LayerWeights::Length && !L.w.empty()) {
+    // Each particle carries the piece of its segment nearest to its projection (1D Voronoi cells
+    // along the segment); particles projecting to the same point share their cell.
+    std::vector<std::vector<std::size_t>> on(P.segs.size());
+    for (std::size_t q = 0; q < seg_of.size(); ++q) on[seg_of[q]].push_back(q);
+    double total = 0;
+    for (std::size_t si = 0; si < on.size(); ++si) {
+      auto& v = on[si];
+      if (v.empty()) continue;
+      std::sort(v.begin(), v.end(), [&](std::size_t a, std::size_t b) { return along_of[a] < along_of[b]; });
+      const double len = P.segs[si].len, eps = 1e-9 * len;
+      std::size_t g0 = 0;
+      while (g0 < v.size()) {  // a group of equal projections
+        std::size_t g1 = g0 + 1;
+        while (g1 < v.size() && along_of[v[g1]] - along_of[v[g0]] <= eps) ++g1;
+        const double lo = g0 == 0 ? 0.0 : 0.5 * (along_of[v[g0 - 1]] + along_of[v[g0]]);
+        const double hi = g1 == v.size() ? len : 0.5 * (along_of[v[g1 - 1]] + along_of[v[g1]]);
+        for (std::size_t q = g0; q < g1; ++q) L.w[v[q]] = (hi - lo) / (g1 - g0);
+        total += hi - lo;
+        g0 = g1;
+      }
+    }
+    // Segments without a particle: spread their length so that the weights still sum to L.
+    for (double& w : L.w) w *= L.length / total;
   }
   return L;
 }

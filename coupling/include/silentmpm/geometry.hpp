@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "silentmpm/boundary.hpp"
@@ -66,9 +67,12 @@ struct Geometry {
 };
 
 // Read a .geo (meshed with mesh size `size`; size <= 0 keeps the file's own `h`) or a .msh.
+// `parameters` set other numbers of a .geo before it is read (gmsh -setnumber; the .geo declares
+// them with DefineConstant so that the given value wins).
 // Throws GeometryError "<file>: ..." for an unreadable, empty or unparsable file, a file without
 // physical surfaces, second-order or unsupported elements, or a geometry outside the z = 0 plane.
-Geometry load_geometry(const std::string& file, double size);
+Geometry load_geometry(const std::string& file, double size,
+                       const std::vector<std::pair<std::string, double>>& parameters = {});
 
 // Lattice seeding of surface `s` into solver `sol` (grid already initialised, materials set):
 // points grid.x0 + (i + 1/2) h / n, grid.y0 + (j + 1/2) h / n inside an element, volume
@@ -90,9 +94,14 @@ struct BodyRegion {
 // where the curve turns by less than 30 degrees (exactly radial on a discretised circle);
 // corners keep the normal of each side. Weights w = V_p L / sum V_p with L the curve length.
 // Throws GeometryError if the curve does not bound the body (body on neither or both sides).
+enum class LayerWeights {
+  Volume,  // w = V_p L / sum V_p (as Solver::select_layer)
+  Length   // w = the length of curve nearest to the particle's projection (1D Voronoi cells)
+};
 BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geometry::Curve& c,
                                  const BodyRegion& region, int body, double depth,
-                                 const std::string& name);
+                                 const std::string& name,
+                                 LayerWeights weights = LayerWeights::Volume);
 
 // Grid nodes within `tol` of curve `c` (closest point not beyond an open end, to 1e-6 h).
 std::vector<uint32_t> nodes_near_curve(const Solver& sol, const Geometry& g,

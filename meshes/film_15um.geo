@@ -1,0 +1,11 @@
+// Tungsten film on a 15 um silicon substrate (the "extended" reference, fixed bottom):
+// film.geo with hs = 15 um.
+//
+// Physical groups: as film.geo
+//   surfaces  1 "tungsten", 2 "silicon"
+//   curves   11 "left", 12 "right", 13 "bottom" (y = -10 um), 14 "top", 15 "si_left",
+//            16 "si_right", 17 "interface"
+// Parameters: h mesh size (m).
+DefineConstant[ h = 1e-7 ];
+hs = 15e-6;
+Include "film.geo";
