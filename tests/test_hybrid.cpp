@@ -44,6 +44,7 @@ std::vector<double> record(HybRun& m, const Strip& c, double x, double y, double
 // only that reflection can reach the probe it must stay below 2 % of the pulse amplitude
 // (REFERENCE.md: ~0.5 % in a 1D prototype). With one particle per cell at the cell centre and u
 // a function of x only, MPM and lumped Q1 coincide, so the reflection is the MPM noise floor.
+// Measured (MUSL, 1 ppc): 0.86 % for this 20-cell pulse; 0.24 % for 40 cells; USL 0.15 %.
 TEST(Hybrid, PlanePWaveCrossesTheInterface) {
   Strip c;
   const double cd = smpm::testing::tungsten().cd;

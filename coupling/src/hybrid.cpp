@@ -171,6 +171,12 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
     mpm_.grid.fix[n] |= mask[e];  // FE essential conditions hold on the shared node
   }
 
+  if (interface_count_ == 0)
+    throw HybridError("hybrid: the FEM mesh does not touch the particles: no FE node coincides (within "
+                      "h 1e-6) with a grid node of an MPM cell holding particles; the interface nodes "
+                      "must be grid nodes (grid origin + integer multiples of h = " +
+                      std::to_string(h) + " m)");
+
   // MPM cells touching the interface must be full.
   for (int j = 0; j < g.ny; ++j)
     for (int i = 0; i < g.nx; ++i) {
