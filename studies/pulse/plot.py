@@ -17,7 +17,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 STYLE = {"free": ("tab:red", "--", "free boundary"),
          "silent": ("tab:blue", "-", "silent boundary"),
-         "extended": ("black", ":", "extended region")}
+         "extended": ("black", ":", "extended region"),
+         "fem_dashpot": ("tab:green", "-.", "FEM, LK dashpots"),
+         "fem_extended": ("tab:purple", (0, (1, 1)), "FEM, extended region")}
 FIGURES = [("figure5.png", "compressive", "sxx", r"$\sigma_{xx}$ at A (MPa)",
             "Longitudinal stress at A, compressive pulse (paper Fig. 5)"),
            ("figure6.png", "compressive", "syy", r"$\sigma_{yy}$ at A (MPa)",
@@ -52,9 +54,12 @@ def main():
     study = json.load(open(args.study))
     probe = study["probe"]
     hist = {}
+    fem = study.get("fem_treatments", [])
     for load in study["loads"]:
-        for bc in study["treatments"]:
+        for bc in study["treatments"] + fem:
             hist[(load, bc)] = os.path.join(args.out, f"{load}_{bc}", "history.csv")
+    # FEM curves are drawn and compared when their runs exist (studies/pulse/run makes them).
+    fem = [bc for bc in fem if all(os.path.exists(hist[(load, bc)]) for load in study["loads"])]
 
     metrics = {"probe": probe, "pulse": "sin^2-ramped, 200 MPa, 20 us, 2 us ramps",
                "metric": "relative L2 ||s - s_ext|| / ||s_ext|| of the component at A over the window"}
@@ -67,21 +72,32 @@ def main():
             entry = {bc: compare(args.bin, hist[(load, bc)], ext, col, t0, t1)
                      for bc in ("silent", "free")}
             vals = {"silent_vs_extended": entry["silent"], "free_vs_extended": entry["free"]}
+            if len(fem) == 2:
+                # FEM with dashpots against the FEM extended plate, and MPM against FEM
+                # (||mpm - fem|| / ||fem||): extended vs extended, silent layer vs dashpots.
+                vals["fem_dashpot_vs_fem_extended"] = compare(
+                    args.bin, hist[(load, "fem_dashpot")], hist[(load, "fem_extended")], col, t0, t1)
+                vals["mpm_vs_fem"] = {
+                    "extended": compare(args.bin, ext, hist[(load, "fem_extended")], col, t0, t1),
+                    "silent_vs_dashpot": compare(args.bin, hist[(load, "silent")],
+                                                 hist[(load, "fem_dashpot")], col, t0, t1)}
             if k == 0:
                 m["component"] = comp
                 m.update(vals)
             else:
                 m[comp] = vals
         summaries = {bc: json.load(open(os.path.join(args.out, f"{load}_{bc}", "summary.json")))
-                     for bc in study["treatments"]}
+                     for bc in study["treatments"] + fem}
         m["wall_seconds"] = {bc: s["wall_seconds"] for bc, s in summaries.items()}
         m["particle_updates_per_second"] = {bc: s["particle_updates_per_second"]
-                                            for bc, s in summaries.items()}
+                                            for bc, s in summaries.items() if bc not in fem}
+        if fem:
+            m["fem_dof_updates_per_second"] = {bc: summaries[bc]["dof_updates_per_second"] for bc in fem}
         metrics[load] = m
 
     for fname, load, comp, ylabel, title in FIGURES:
         fig, ax = plt.subplots(figsize=(6.4, 4.2))
-        for bc in study["treatments"]:
+        for bc in study["treatments"] + fem:
             h = read(hist[(load, bc)])
             color, ls, label = STYLE[bc]
             ax.plot([t * 1e6 for t in h["time"]], [v / 1e6 for v in h[f"{probe}.{comp}"]],
@@ -113,6 +129,12 @@ def main():
         for comp in spec["components"][1:]:
             print(f"{'':<12} {comp:<10} {w:<14} {m[comp]['silent_vs_extended']:>14.4f} "
                   f"{m[comp]['free_vs_extended']:>12.4f}")
+        if fem:
+            for comp in spec["components"]:
+                v = m if comp == m["component"] else m[comp]
+                print(f"{'':<12} {comp:<10} FEM dashpot vs FEM extended {v['fem_dashpot_vs_fem_extended']:.4f}; "
+                      f"MPM vs FEM: extended {v['mpm_vs_fem']['extended']:.4f}, "
+                      f"silent vs dashpot {v['mpm_vs_fem']['silent_vs_dashpot']:.4f}")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,212 @@
+#pragma once
+// Reflection of plane P and SV pulses at an LK dashpot boundary, measured in the FEM far-field by
+// extended-domain differencing (REFERENCE.md §4.1), against the closed form (lk_reflection).
+// Used by studies/oblique (all angles) and tests/test_fem_oblique.cpp (15 and 30 degrees).
+//
+// Geometry, in cells of size h (the boundary under test is the right side x = Lx, outward normal
+// +x; angles are measured from that normal):
+//   * run A: [0, 160] x [0, Ly] with LK dashpots (a = b = 1) on the right side, other sides free;
+//   * run B: [0, 260] x [0, Ly], all sides free: the same mesh over A, so A - B at a receiver is
+//     the field reflected by A's right side, until B's own right end answers (after the window);
+//   * the incident wave is an initial condition: a plane pulse travelling along n = (cos t, sin t)
+//     with displacement d G(n.(x - x0) - c t) E(t.(x - x0)), d = n (P) or t = (-sin, cos) (SV),
+//     G a Gaussian whose full width at half maximum is `fwhm` cells, E a flat-topped beam
+//     envelope (flat over 2 x 200 cells, 60-cell cos^2 tapers; Ly = 2 (flat + taper + 20) + 60), so the rays that reach the receiver after
+//     reflection are in the flat part;
+//   * receiver R: 20.5 cells inside the boundary, at y = flat + taper + 20.5 cells, on the beam's centre line;
+//     the pulse starts 4 sigma + 8 cells before R.
+// Measured: incident max|div B| (P) or max|curl B| (SV) at R; reflected max|div(A - B)| and
+// max|curl(A - B)|. |R_PP| = div ratio, |R_PS| = (c_s/c_d) curl ratio; |R_SS| = curl ratio,
+// |R_SP| = (c_d/c_s) div ratio (beyond the SV critical angle the reflected P is evanescent and
+// R_SP is not a travelling-wave amplitude: reported, not compared).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "silentmpm/fem.hpp"
+#include "silentmpm/lk_reflection.hpp"
+
+namespace smpm::oblique {
+
+struct Setup {
+  bool sv = false;        // incident SV (else P)
+  double angle_deg = 15;  // incidence angle from the boundary normal
+  double h = 1e-3;
+  int fwhm = 24;          // pulse width (cells, full width at half maximum of the displacement)
+  int degree = 1;
+  double nu = 0.25;
+  int threads = 0;
+  int flat = 200;          // half width of the beam's flat top (cells)
+  int taper = 60;          // cos^2 taper beyond it (cells)
+};
+
+struct Result {
+  double incident = 0;          // max |div B| (P) or max |curl B| (SV) at R
+  double refl_div = 0, refl_curl = 0;
+  double r_same = 0, r_conv = 0;  // measured |R_PP|, |R_PS| (P) or |R_SS|, |R_SP| (SV)
+  double exact_same = 0, exact_conv = 0;
+  bool evanescent = false;      // SV beyond the critical angle: the reflected P does not travel
+  double t_end = 0, dt = 0, seconds = 0;
+  std::size_t dofs_a = 0, dofs_b = 0;
+  std::vector<double> t, inc, ddiv, dcurl;  // receiver traces (incident, reflected div / curl)
+  double window_incident = 0, window_p = 0, window_s = 0, window_half = 0;  // window centres, half width
+};
+
+inline std::string rectangle_geo(const std::string& name, double lx, double ly, double h) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "smpm_oblique";
+  fs::create_directories(dir);
+  const fs::path p = dir / (name + ".geo");
+  std::ofstream f(p);
+  char buf[2048];
+  std::snprintf(buf, sizeof buf,
+                "DefineConstant[ h = {%.17g, Name \"Parameters/h\"} ];\n"
+                "Point(1) = {0, 0, 0}; Point(2) = {%.17g, 0, 0};\n"
+                "Point(3) = {%.17g, %.17g, 0}; Point(4) = {0, %.17g, 0};\n"
+                "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
+                "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
+                "Transfinite Curve{1, 3} = Round(%.17g / h) + 1;\n"
+                "Transfinite Curve{2, 4} = Round(%.17g / h) + 1;\n"
+                "Transfinite Surface{1}; Recombine Surface{1};\n"
+                "Physical Surface(\"body\", 1) = {1};\n"
+                "Physical Curve(\"left\", 11) = {4}; Physical Curve(\"right\", 12) = {2};\n"
+                "Physical Curve(\"bottom\", 13) = {1}; Physical Curve(\"top\", 14) = {3};\n",
+                h, lx, lx, ly, ly, lx, ly);
+  f << buf;
+  return p.string();
+}
+
+inline Result measure(const Setup& su) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const double h = su.h;
+  // Room for the beam: R sits (flat + taper + 20) cells above the bottom, the mesh is twice that
+  // plus 60 cells tall.
+  const int lx = 160, lext = 100;
+  const int yr = su.flat + su.taper + 20, ly = 2 * yr + 60;
+  Material mat;
+  mat.name = "solid";
+  mat.E = 200e9;
+  mat.nu = su.nu;
+  mat.rho = 8000;
+  mat.derive();
+  const double th = su.angle_deg * M_PI / 180;
+  const double c = su.sv ? mat.cs : mat.cd;
+  const double nx = std::cos(th), ny = std::sin(th), tx = -ny, ty = nx;
+  const double dx = su.sv ? tx : nx, dy = su.sv ? ty : ny;
+  const double W = su.fwhm * h, F = su.flat * h, T = su.taper * h;
+  const double sig = W / 2.3548;  // Gaussian sigma of the pulse
+  const double rx = (lx - 20.5) * h, ry = (yr + 0.5) * h;
+  const double D = 4 * sig + 8 * h;
+  const double x0 = rx - D * nx, y0 = ry - D * ny;
+  // Gaussian displacement profile (smooth, so no grid-scale content that the coarse-mesh
+  // dispersion would smear over the reflected window), cut at 4 sigma.
+  auto G = [&](double s) { return std::abs(s) < 4 * sig ? std::exp(-0.5 * s * s / (sig * sig)) : 0.0; };
+  auto dG = [&](double s) { return -s / (sig * sig) * G(s); };
+  auto E = [&](double r) {
+    const double a = std::abs(r);
+    if (a <= F) return 1.0;
+    if (a >= F + T) return 0.0;
+    return std::pow(std::cos(M_PI * (a - F) / (2 * T)), 2);
+  };
+
+  auto build = [&](int cells_x, bool dashpot) {
+    fem::Spec s;
+    s.mesh = fem::load_mesh(
+        rectangle_geo("oblique_" + std::to_string(cells_x) + "x" + std::to_string(ly) + "_h" +
+                          std::to_string(std::lround(h * 1e9)),
+                      cells_x * h, ly * h, h),
+        h);
+    s.degree = su.degree;
+    s.materials = {mat};
+    s.region_material = {{1, 0}};
+    s.threads = su.threads;
+    if (dashpot) {
+      fem::Boundary b;
+      b.kind = fem::Boundary::Kind::Dashpot;
+      b.curves = {12};
+      b.name = "right";
+      s.boundaries.push_back(b);
+    }
+    return std::make_unique<fem::Solver>(s);
+  };
+  auto A = build(lx, true);
+  auto B = build(lx + lext, false);
+  const double dt = 0.5 * std::min(A->critical_dt(), B->critical_dt());
+  for (fem::Solver* s : {A.get(), B.get()}) {
+    s->set_dt(dt);
+    auto& u = s->displacement();
+    auto& v = s->velocity();
+    for (std::size_t i = 0; i < s->nodes(); ++i) {
+      const double px = s->node_x()[i] - x0, py = s->node_y()[i] - y0;
+      const double sn = nx * px + ny * py, r = tx * px + ty * py;
+      const double e = E(r);
+      const double g = G(sn) * e;
+      // v at t = -dt/2: -c d G'(s + c dt / 2) E
+      const double gv = -c * dG(sn + 0.5 * c * dt) * e;
+      u[2 * i] = dx * g;
+      u[2 * i + 1] = dy * g;
+      v[2 * i] = dx * gv;
+      v[2 * i + 1] = dy * gv;
+    }
+    if (s->add_probe(rx, ry) != 0) throw std::runtime_error("oblique: receiver outside the mesh");
+  }
+  // Windows at R: the incident pulse, and each reflected pulse around its plane-wave arrival
+  // (the reflected P returns after 2 d cos(theta_P) / c_d more, the reflected S after
+  // d (cos(theta_in) / c_in + cos(theta_S) / c_s)), each as long as the pulse plus 4 cells of
+  // travel on either side. Outside them R sees the waves the beam's tapered edges radiate.
+  const double k = mat.cs / mat.cd;
+  const double dr = lx * h - rx;  // distance from R to the boundary
+  const double sin_p = su.sv ? std::sin(th) / k : std::sin(th);  // reflected P angle
+  const double sin_s = su.sv ? std::sin(th) : k * std::sin(th);  // reflected S angle
+  const bool evanescent = sin_p > 1;
+  const double cos_p = evanescent ? 0.0 : std::sqrt(1 - sin_p * sin_p);
+  const double cos_s = std::sqrt(1 - sin_s * sin_s);
+  const double t_inc = D / c;
+  const double t_p = t_inc + dr * (std::cos(th) / c + cos_p / mat.cd);
+  const double t_s = t_inc + dr * (std::cos(th) / c + cos_s / mat.cs);
+  const double half = 3 * sig / c + 4 * h / mat.cs;
+  const double t_end = std::max(t_p, t_s) + half;
+  Result res;
+  while (A->t < t_end) {
+    A->step();
+    B->step();
+    const fem::Sample a = A->sample()[0], b = B->sample()[0];
+    const double tt = A->t;
+    if (std::abs(tt - t_inc) <= half) res.incident = std::max(res.incident, std::abs(su.sv ? b.curl : b.div));
+    if (std::abs(tt - t_p) <= half) res.refl_div = std::max(res.refl_div, std::abs(a.div - b.div));
+    if (std::abs(tt - t_s) <= half) res.refl_curl = std::max(res.refl_curl, std::abs(a.curl - b.curl));
+    res.t.push_back(tt);
+    res.inc.push_back(su.sv ? b.curl : b.div);
+    res.ddiv.push_back(a.div - b.div);
+    res.dcurl.push_back(a.curl - b.curl);
+  }
+  res.window_incident = t_inc;
+  res.window_p = t_p;
+  res.window_s = t_s;
+  res.window_half = half;
+  const LKReflection ex = lk_reflection(su.nu, 1, 1, th);
+  if (su.sv) {
+    res.r_same = res.refl_curl / res.incident;
+    res.r_conv = res.refl_div / res.incident / k;
+    res.exact_same = std::abs(ex.rss);
+    res.exact_conv = std::abs(ex.rsp);
+    res.evanescent = evanescent;
+  } else {
+    res.r_same = res.refl_div / res.incident;
+    res.r_conv = k * res.refl_curl / res.incident;
+    res.exact_same = std::abs(ex.rpp);
+    res.exact_conv = std::abs(ex.rps);
+  }
+  res.t_end = t_end;
+  res.dt = dt;
+  res.dofs_a = A->dofs();
+  res.dofs_b = B->dofs();
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return res;
+}
+
+}  // namespace smpm::oblique
