@@ -30,6 +30,24 @@ constexpr double kGapTolerance = 0.01;
 
 }  // namespace
 
+namespace {
+using Box = std::array<int, 4>;  // node range i0..i1, j0..j1 (inclusive)
+
+bool empty(const Box& b) { return b[0] > b[1] || b[2] > b[3]; }
+bool inside(const Box& b, int i, int j) { return i >= b[0] && i <= b[1] && j >= b[2] && j <= b[3]; }
+
+// fn(node index) over the nodes of a box, rows in parallel.
+template <class Fn>
+void for_box(const Box& bx, int nnx, int nt, Fn&& fn) {
+  if (empty(bx)) return;
+#pragma omp parallel for schedule(static) num_threads(nt)
+  for (int j = bx[2]; j <= bx[3]; ++j) {
+    const long r = static_cast<long>(j) * nnx;
+    for (int i = bx[0]; i <= bx[1]; ++i) fn(r + i);
+  }
+}
+}  // namespace
+
 const char* contact_type_name(ContactType t) {
   return t == ContactType::Multi ? "multi" : "single";
 }
@@ -62,6 +80,7 @@ void Contact::setup(Solver& s) {
                    &xm_, &ym_, &sm_})
     f->assign(nb_, std::vector<double>(n, 0.0));
   force.assign(nb_, {0.0, 0.0});
+  box_.assign(nb_, {0, -1, 0, -1});
   ranges_.assign(nb_, {});
   dissipated = 0;
 }
@@ -115,19 +134,20 @@ void Contact::per_body_moving(Solver& s, Fn&& fn) {
 // (centre of mass) fields. Same strip colouring as the solver's scatters: no two threads write
 // one node.
 void Contact::p2g(Solver& s, bool momentum, bool with_force) {
-  const long n = static_cast<long>(s.grid.nodes());
   const int nt = s.nthreads_;
-  for (int b = 0; b < nb_; ++b) {
-    double* a[8] = {m_[b].data(), px_[b].data(), py_[b].data(), gx_[b].data(), gy_[b].data(),
-                    xm_[b].data(), ym_[b].data(), sm_[b].data()};
-    double* f[2] = {fx_[b].data(), fy_[b].data()};
-#pragma omp parallel for schedule(static) num_threads(nt)
-    for (long i = 0; i < n; ++i) {
-      if (momentum)
+  const int nnx0 = s.grid.nnx;
+  // The momentum pass clears what the last step wrote (every field, forces included) and finds
+  // the new boxes; a force-only pass (USF) accumulates into the same step's boxes.
+  if (momentum)
+    for (int b = 0; b < nb_; ++b) {
+      double* a[10] = {m_[b].data(), px_[b].data(), py_[b].data(), gx_[b].data(),
+                       gy_[b].data(), xm_[b].data(), ym_[b].data(), sm_[b].data(),
+                       fx_[b].data(), fy_[b].data()};
+      for_box(box_[b], nnx0, nt, [&](long i) {
         for (double* v : a) v[i] = 0;
-      if (with_force) f[0][i] = f[1][i] = 0;
+      });
     }
-  }
+  std::vector<Box> sbox(static_cast<std::size_t>(s.nstrips_) * nb_, Box{1 << 30, -1, 1 << 30, -1});
   const Grid& grid = s.grid;
   const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h;
   const int nnx = grid.nnx;
@@ -143,11 +163,16 @@ void Contact::p2g(Solver& s, bool momentum, bool with_force) {
       double* ggx = gx_[b].data(); double* ggy = gy_[b].data();
       double* gxm = xm_[b].data(); double* gym = ym_[b].data(); double* gsm = sm_[b].data();
       double* gfx = fx_[b].data(); double* gfy = fy_[b].data();
+      Box& bx = sbox[static_cast<std::size_t>(st) * nb_ + b];
       for (uint32_t k = kb; k < ke; ++k) {
         sf.eval(p.x[k], p.y[k], x0, y0, ih);
         const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
         const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
         if (momentum) {
+          bx[0] = std::min(bx[0], sf.ci);
+          bx[1] = std::max(bx[1], sf.ci + 1);
+          bx[2] = std::min(bx[2], sf.cj);
+          bx[3] = std::max(bx[3], sf.cj + 1);
           const double mk = p.mass[k], mvx = mk * p.vx[k], mvy = mk * p.vy[k];
           for (int c = 0; c < 4; ++c) {
             gm[nodes[c]] += mk * sf.N[c];
@@ -178,72 +203,90 @@ void Contact::p2g(Solver& s, bool momentum, bool with_force) {
       for (int st = colour; st < s.nstrips_; st += 2) strip(st);
     }
   }
-  // Centre-of-mass fields.
+  if (momentum)
+    for (int b = 0; b < nb_; ++b) {
+      Box u{1 << 30, -1, 1 << 30, -1};
+      for (int st = 0; st < s.nstrips_; ++st) {
+        const Box& q = sbox[static_cast<std::size_t>(st) * nb_ + b];
+        u = {std::min(u[0], q[0]), std::max(u[1], q[1]), std::min(u[2], q[2]), std::max(u[3], q[3])};
+      }
+      box_[b] = u;
+    }
+  // Centre-of-mass fields: the solver's arrays were cleared by reset_grid; add each body's box.
   Grid& gw = s.grid;
-  const int B = nb_;
-#pragma omp parallel for schedule(static) num_threads(nt)
-  for (long i = 0; i < n; ++i) {
-    if (momentum) {
-      double m = 0, qx = 0, qy = 0;
-      for (int b = 0; b < B; ++b) { m += m_[b][i]; qx += px_[b][i]; qy += py_[b][i]; }
-      gw.m[i] = m; gw.px[i] = qx; gw.py[i] = qy;
-    }
-    if (with_force) {
-      double fx = 0, fy = 0;
-      for (int b = 0; b < B; ++b) { fx += fx_[b][i]; fy += fy_[b][i]; }
-      gw.fx[i] = fx; gw.fy[i] = fy;
-    }
+  for (int b = 0; b < nb_; ++b) {
+    const double* m = m_[b].data(); const double* qx = px_[b].data(); const double* qy = py_[b].data();
+    const double* fx = fx_[b].data(); const double* fy = fy_[b].data();
+    for_box(box_[b], nnx0, nt, [&](long i) {
+      if (momentum) { gw.m[i] += m[i]; gw.px[i] += qx[i]; gw.py[i] += qy[i]; }
+      if (with_force) { gw.fx[i] += fx[i]; gw.fy[i] += fy[i]; }
+    });
   }
 }
 
+// Nodes where two or more bodies have mass: for each body b, the part of its box that overlaps
+// a later body's box; a node is listed by the first body that has mass there.
 void Contact::find_contact_nodes(Solver& s) {
   cnodes_.clear();
-  const long n = static_cast<long>(s.grid.nodes());
   const double floor = s.mass_floor_;
-  for (long i = 0; i < n; ++i) {
-    int c = 0;
-    for (int b = 0; b < nb_ && c < 2; ++b) c += m_[b][i] > floor;
-    if (c >= 2) cnodes_.push_back(static_cast<uint32_t>(i));
+  const int nnx = s.grid.nnx;
+  for (int b = 0; b < nb_; ++b) {
+    if (empty(box_[b])) continue;
+    Box u{1 << 30, -1, 1 << 30, -1};
+    for (int c = b + 1; c < nb_; ++c)
+      if (!empty(box_[c]))
+        u = {std::min(u[0], box_[c][0]), std::max(u[1], box_[c][1]), std::min(u[2], box_[c][2]),
+             std::max(u[3], box_[c][3])};
+    const Box r{std::max(box_[b][0], u[0]), std::min(box_[b][1], u[1]),
+                std::max(box_[b][2], u[2]), std::min(box_[b][3], u[3])};
+    if (empty(r)) continue;
+    for (int j = r[2]; j <= r[3]; ++j)
+      for (int i = r[0]; i <= r[1]; ++i) {
+        const long n = static_cast<long>(j) * nnx + i;
+        if (m_[b][n] <= floor) continue;
+        bool earlier = false;
+        for (int c = 0; c < b && !earlier; ++c) earlier = inside(box_[c], i, j) && m_[c][n] > floor;
+        if (earlier) continue;
+        bool other = false;
+        for (int c = b + 1; c < nb_ && !other; ++c) other = inside(box_[c], i, j) && m_[c][n] > floor;
+        if (other) cnodes_.push_back(static_cast<uint32_t>(n));
+      }
   }
   contact_nodes = static_cast<long>(cnodes_.size());
 }
 
 // v_b = p_b / m_b with the constraints (on a node with one body this is the centre-of-mass value).
 void Contact::split_start(Solver& s, Field& vx, Field& vy, const Field& px, const Field& py) {
-  const long n = static_cast<long>(s.grid.nodes());
   const double floor = s.mass_floor_;
   const uint8_t* fix = s.grid.fix.data();
   for (int b = 0; b < nb_; ++b) {
     const double* m = m_[b].data();
     const double* qx = px[b].data(); const double* qy = py[b].data();
     double* ux = vx[b].data(); double* uy = vy[b].data();
-#pragma omp parallel for schedule(static) num_threads(s.nthreads_)
-    for (long i = 0; i < n; ++i) {
+    for_box(box_[b], s.grid.nnx, s.nthreads_, [&](long i) {
       if (m[i] > floor) {
         ux[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
         uy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
       } else {
         ux[i] = 0; uy[i] = 0;
       }
-    }
+    });
   }
 }
 
 // Updated per-body velocities: the centre-of-mass value where one body is present; at contact
 // nodes the centre-of-mass value plus the body's own deviation, then the contact correction.
 void Contact::split_updated(Solver& s) {
-  const long n = static_cast<long>(s.grid.nodes());
   const double floor = s.mass_floor_, dt = s.dt;
   const Grid& g = s.grid;
   for (int b = 0; b < nb_; ++b) {
     const double* m = m_[b].data();
     double* ux = vnx_[b].data(); double* uy = vny_[b].data();
-#pragma omp parallel for schedule(static) num_threads(s.nthreads_)
-    for (long i = 0; i < n; ++i) {
+    for_box(box_[b], g.nnx, s.nthreads_, [&](long i) {
       const bool has = m[i] > floor;
       ux[i] = has ? g.vnx[i] : 0.0;
       uy[i] = has ? g.vny[i] : 0.0;
-    }
+    });
   }
   for (uint32_t i : cnodes_) {
     double fx = 0, fy = 0;
@@ -396,10 +439,9 @@ void Contact::step(Solver& s) {
       per_body_moving(s, [&] { s.update_stress_and_position(s.grid.vnx, s.grid.vny, true); });
       break;
     case Scheme::MUSL: {
-      const long n = static_cast<long>(s.grid.nodes());
       for (int b = 0; b < nb_; ++b) {
-        std::fill(qx_[b].begin(), qx_[b].begin() + n, 0.0);
-        std::fill(qy_[b].begin(), qy_[b].begin() + n, 0.0);
+        double* qx = qx_[b].data(); double* qy = qy_[b].data();
+        for_box(box_[b], s.grid.nnx, s.nthreads_, [&](long i) { qx[i] = 0; qy[i] = 0; });
         swap_in(s, b);
         s.g2p_velocity(true, false);
         swap_in(s, b);
