@@ -730,7 +730,10 @@ class Builder {
     if (!doc_.is_object())
       ctx_.fail("", "a case file must be a JSON object {...}, got " + a_type(doc_));
     // A case with an FEM region is built by case_fem.cpp.
-    if (doc_.contains("fem")) return detail::build_fem_case(ctx_.source, doc_);
+    if (doc_.contains("fem"))
+      return doc_.contains("bodies") || doc_.contains("grid")
+                 ? detail::build_hybrid_case(ctx_.source, doc_)  // case_hybrid.cpp
+                 : detail::build_fem_case(ctx_.source, doc_);
     Obj top(ctx_, doc_, "");
     top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes", "geometry",
                "output", "contact"});
@@ -1277,6 +1280,10 @@ Case build_case(const nlohmann::json& doc, const std::string& source) {
 
 // Shared with case_fem.cpp (the FEM sections use the same material and time-function keys).
 namespace detail {
+Case build_mpm_case(const std::string& source, const ojson& doc) {
+  Ctx ctx{source, {}};
+  return build_ordered(ctx, doc);
+}
 Material parse_material_at(const std::string& source, const std::string& name, const ojson& j) {
   const Ctx ctx{source, {}};
   return parse_material(ctx, name, j);

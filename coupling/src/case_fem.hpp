@@ -21,4 +21,9 @@ Case build_fem_case(const std::string& source, const nlohmann::ordered_json& doc
 // Defined in driver_fem.cpp: runs a case that has an FEM region and no MPM bodies.
 RunResult run_fem_case(Case& c, const std::string& out_dir);
 
+// Hybrid cases (both "bodies" and "fem"): case_hybrid.cpp and driver_hybrid.cpp.
+Case build_mpm_case(const std::string& source, const nlohmann::ordered_json& doc);  // case.cpp
+Case build_hybrid_case(const std::string& source, const nlohmann::ordered_json& doc);
+RunResult run_hybrid_case(Case& c, const std::string& out_dir);
+
 }  // namespace smpm::detail

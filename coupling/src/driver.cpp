@@ -66,6 +66,7 @@ class Progress {
 RunResult run_case(Case& c, const std::string& out_dir) {
   namespace fs = std::filesystem;
   if (!c.solver && c.fem) return detail::run_fem_case(c, out_dir);  // FEM-only case
+  if (c.hybrid) return detail::run_hybrid_case(c, out_dir);         // driver_hybrid.cpp
   Solver& s = *c.solver;
   std::error_code ec;
   fs::create_directories(out_dir, ec);

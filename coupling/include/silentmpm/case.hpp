@@ -11,6 +11,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "silentmpm/fem.hpp"
+#include "silentmpm/hybrid.hpp"
 #include "silentmpm/solver.hpp"
 
 namespace smpm {
@@ -25,6 +26,7 @@ struct ProbeSpec {
   double x = 0, y = 0;
   std::vector<std::string> fields;
   int body = -1;  // sample only this body's particles (-1: all bodies)
+  int fem_index = -1;  // hybrid case: index of the FEM probe (the point is in the FEM region), -1: particles
 };
 
 struct OutputSpec {
@@ -43,6 +45,8 @@ struct Case {
   // FEM region (a case with "fem"): mesh read, boundaries added, dt set; probes added in the
   // order of `probes`. Null for an MPM-only case; solver is null for an FEM-only case.
   std::unique_ptr<fem::Solver> fem;
+  // Both an MPM and an FEM region (case_hybrid.cpp): the coupled step over solver and fem.
+  std::unique_ptr<Hybrid> hybrid;
   std::vector<std::string> notes;  // human-readable description of the loads (time functions...)
 };
 

@@ -1,0 +1,200 @@
+// Hybrid case files: both an MPM region ("grid", "bodies", ...) and an FEM region ("fem"), coupled
+// through shared nodes (silentmpm/hybrid.hpp). The two regions are built by the MPM and the FEM
+// parsers from the same document (so every key keeps its messages), then coupled; probes are
+// read from whichever region holds their point. Keys: docs/case-reference.md, "Hybrid cases".
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <regex>
+
+#include "case_fem.hpp"
+
+namespace smpm::detail {
+namespace {
+
+using ojson = nlohmann::ordered_json;
+
+std::string fmt(double v) {
+  char b[40];
+  for (int p = 1; p <= 12; ++p) {
+    std::snprintf(b, sizeof b, "%.*g", p, v);
+    if (std::strtod(b, nullptr) == v) return b;
+  }
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// Rounds down to 6 significant digits (a dt that is safe to paste back).
+std::string fmt_down(double v) {
+  if (!(v > 0) || !std::isfinite(v)) return fmt(v);
+  const double scale = std::pow(10.0, 5 - std::floor(std::log10(v)));
+  return fmt(std::floor(v * scale + 1e-9) / scale);
+}
+
+[[noreturn]] void fail(const std::string& source, const std::string& path, const std::string& what) {
+  throw CaseError(source + ": " + (path.empty() ? "" : path + ": ") + what);
+}
+
+std::string probe_path(std::size_t i) { return "probes[" + std::to_string(i) + "]"; }
+
+}  // namespace
+
+Case build_hybrid_case(const std::string& source, const ojson& doc) {
+  static const std::vector<std::string> allowed = {"title",  "grid",       "time",   "scheme",
+                                                   "materials", "bodies",  "boundaries", "probes",
+                                                   "geometry", "output",   "contact", "fem"};
+  for (const auto& it : doc.items())
+    if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
+      std::string list;
+      for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
+      fail(source, it.key(), "unknown key in a hybrid (MPM + FEM) case; allowed: " + list);
+    }
+  for (const char* k : {"grid", "bodies", "time", "materials", "fem"})
+    if (!doc.contains(k))
+      fail(source, k, "missing required key (a case with both \"bodies\" and \"fem\" is an MPM-FEM "
+                      "hybrid and needs grid, bodies, time, materials and fem)");
+
+  // FEM region: the FEM parser on the FEM keys (no probes yet).
+  ojson dfe = ojson::object();
+  for (const char* k : {"title", "time", "materials", "fem", "output"})
+    if (doc.contains(k)) dfe[k] = doc[k];
+  if (doc.contains("scheme") && doc["scheme"].is_object() && doc["scheme"].contains("threads"))
+    dfe["scheme"] = ojson{{"threads", doc["scheme"]["threads"]}};
+  Case cf = build_fem_case(source, dfe);
+  fem::Solver& fe = *cf.fem;
+
+  // Probes: a point inside the FEM mesh is an FEM probe, any other one is read from particles.
+  std::vector<int> fem_probe;  // per probe in the document: FEM probe index or -1
+  const ojson* probes = doc.contains("probes") ? &doc["probes"] : nullptr;
+  if (probes && !probes->is_array()) fail(source, "probes", "expected an array");
+  ojson mpm_probes = ojson::array();
+  std::vector<std::size_t> mpm_origin;  // document index of each MPM probe
+  if (probes)
+    for (std::size_t i = 0; i < probes->size(); ++i) {
+      const ojson& p = (*probes)[i];
+      if (!p.is_object()) fail(source, probe_path(i), "expected an object");
+      const ojson* at = p.contains("at") ? &p["at"] : nullptr;
+      int idx = -1;
+      if (at && at->is_array() && at->size() == 2 && (*at)[0].is_number() && (*at)[1].is_number())
+        idx = fe.add_probe((*at)[0].get<double>(), (*at)[1].get<double>());
+      fem_probe.push_back(idx);
+      if (idx < 0) {
+        mpm_probes.push_back(p);
+        mpm_origin.push_back(i);
+      }
+    }
+
+  // MPM region: the MPM parser on everything but "fem", with the probes that lie outside the mesh.
+  ojson dm = doc;
+  dm.erase("fem");
+  dm.erase("probes");
+  if (!mpm_probes.empty()) dm["probes"] = mpm_probes;
+  Case c;
+  try {
+    c = build_mpm_case(source, dm);
+  } catch (const CaseError& e) {
+    // Report MPM probe errors at their index in the document.
+    std::string msg = e.what();
+    for (std::size_t k = mpm_origin.size(); k-- > 0;) {
+      const std::string from = source + ": " + probe_path(k);
+      if (msg.rfind(from, 0) == 0) {
+        msg = source + ": " + probe_path(mpm_origin[k]) + msg.substr(from.size());
+        break;
+      }
+    }
+    throw CaseError(msg);
+  }
+
+  // FEM probes: the same checks as the FEM parser's.
+  static const std::vector<std::string> fem_fields = {"sxx", "syy", "szz", "sxy", "J2",
+                                                      "vx",  "vy",  "div", "curl"};
+  std::vector<ProbeSpec> all;
+  std::size_t next_mpm = 0;
+  if (probes)
+    for (std::size_t i = 0; i < probes->size(); ++i) {
+      if (fem_probe[i] < 0) {
+        all.push_back(c.probes.at(next_mpm++));
+        continue;
+      }
+      const ojson& p = (*probes)[i];
+      const std::string path = probe_path(i);
+      for (const auto& it : p.items())
+        if (it.key() != "name" && it.key() != "at" && it.key() != "fields")
+          fail(source, path + "." + it.key(),
+               it.key() == "body" ? "the point lies in the FEM region, which has no bodies"
+                                  : "unknown key; allowed: name, at, fields");
+      ProbeSpec pr;
+      if (!p.contains("name") || !p["name"].is_string())
+        fail(source, path + ".name", "missing required key (a string)");
+      pr.name = p["name"].get<std::string>();
+      static const std::regex ok("[A-Za-z0-9_]+");
+      if (!std::regex_match(pr.name, ok))
+        fail(source, path + ".name", "must be letters, digits and _ only, got \"" + pr.name + "\"");
+      pr.x = p["at"][0].get<double>();
+      pr.y = p["at"][1].get<double>();
+      pr.fem_index = fem_probe[i];
+      if (p.contains("fields")) {
+        const ojson& fl = p["fields"];
+        if (!fl.is_array() || fl.empty())
+          fail(source, path + ".fields", "expected a non-empty array of field names");
+        for (std::size_t k = 0; k < fl.size(); ++k) {
+          const std::string fp = path + ".fields[" + std::to_string(k) + "]";
+          if (!fl[k].is_string()) fail(source, fp, "expected a string");
+          const std::string f = fl[k].get<std::string>();
+          if (std::find(fem_fields.begin(), fem_fields.end(), f) == fem_fields.end()) {
+            std::string list;
+            for (const auto& x : fem_fields) list += (list.empty() ? "" : ", ") + x;
+            fail(source, fp, "must be one of " + list + ", got \"" + f + "\"");
+          }
+          if (std::find(pr.fields.begin(), pr.fields.end(), f) != pr.fields.end())
+            fail(source, fp, "field \"" + f + "\" listed twice");
+          pr.fields.push_back(f);
+        }
+      } else {
+        pr.fields = {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"};
+      }
+      all.push_back(std::move(pr));
+    }
+  for (std::size_t i = 0; i < all.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (all[i].name == all[j].name)
+        fail(source, probe_path(i) + ".name", "probe name \"" + all[i].name + "\" is used twice");
+  c.probes = std::move(all);
+
+  // Couple.
+  c.fem = std::move(cf.fem);
+  try {
+    c.hybrid = std::make_unique<Hybrid>(*c.solver, *c.fem);
+  } catch (const HybridError& e) {
+    fail(source, "fem", e.what());
+  }
+  // Time step: time.dt, or time.cfl times the smaller of both regions' limits.
+  const ojson& t = doc["time"];
+  const double crit = c.hybrid->critical_dt();
+  double dt = 0;
+  if (t.contains("cfl")) {
+    dt = t["cfl"].get<double>() * crit;
+  } else {
+    dt = t["dt"].get<double>();
+    if (dt > crit * (1 + 1e-12))
+      fail(source, "time.dt",
+           fmt(dt) + " s is above the stability limit of the hybrid, " + fmt_down(crit) +
+               " s (the smaller of the MPM limit h / c_d = " + fmt_down(c.solver->critical_dt()) +
+               " s and the FEM element bound " + fmt_down(c.fem->critical_dt()) + " s)");
+  }
+  try {
+    c.hybrid->set_dt(dt);
+  } catch (const HybridError& e) {
+    fail(source, "time", e.what());
+  }
+  for (const auto& n : cf.notes) c.notes.push_back("FEM: " + n);
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "hybrid: %zu nodes shared with the FEM mesh, %zu of them on the interface with the "
+                "particles; dt %g s (%.3f of the hybrid limit)",
+                c.hybrid->shared().size(), c.hybrid->interface_nodes(), dt, dt / crit);
+  c.notes.push_back(line);
+  return c;
+}
+
+}  // namespace smpm::detail
