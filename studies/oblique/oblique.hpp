@@ -11,10 +11,10 @@
 //   * the incident wave is an initial condition: a plane pulse travelling along n = (cos t, sin t)
 //     with displacement d G(n.(x - x0) - c t) E(t.(x - x0)), d = n (P) or t = (-sin, cos) (SV),
 //     G a Gaussian whose full width at half maximum is `fwhm` cells, E a flat-topped beam
-//     envelope (flat over 2 x 200 cells, 60-cell cos^2 tapers; Ly = 2 (flat + taper + 20) + 60), so the rays that reach the receiver after
-//     reflection are in the flat part;
-//   * receiver R: 20.5 cells inside the boundary, at y = flat + taper + 20.5 cells, on the beam's centre line;
-//     the pulse starts 4 sigma + 8 cells before R.
+//     envelope (flat over 2 x 200 cells, 60-cell cos^2 tapers; Ly = 2 (flat + taper + 20) + 60),
+//     so the rays that reach the receiver after reflection are in the flat part;
+//   * receiver R: 20.5 cells inside the boundary, at y = flat + taper + 20.5 cells, on the beam's
+//     centre line; the pulse starts 4 sigma + 8 cells before R.
 // Measured: incident max|div B| (P) or max|curl B| (SV) at R; reflected max|div(A - B)| and
 // max|curl(A - B)|. |R_PP| = div ratio, |R_PS| = (c_s/c_d) curl ratio; |R_SS| = curl ratio,
 // |R_SP| = (c_d/c_s) div ratio (beyond the SV critical angle the reflected P is evanescent and
