@@ -1,0 +1,77 @@
+// The silent layer on an inclined gmsh edge (studies/geometry/inclined.hpp has the method): a
+// plane P pulse meets the right edge of meshes/inclined_edge.geo at 30 degrees from its normal;
+// the reflected field is measured by extended-domain differencing and split into P and SV by
+// div and curl (REFERENCE.md §4.1), then compared with the closed form smpm::lk_reflection.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "../studies/geometry/inclined.hpp"
+
+#ifndef SMPM_SOURCE_DIR
+#define SMPM_SOURCE_DIR "."
+#endif
+
+namespace {
+
+using smpm::inclined::InclinedResult;
+using smpm::inclined::InclinedSpec;
+
+InclinedResult run(InclinedSpec s) {
+  if (const char* e = std::getenv("SMPM_INCLINED_FWHM")) s.fwhm = std::atof(e);
+  if (const char* e = std::getenv("SMPM_INCLINED_PPC")) s.ppc = std::atoi(e);
+  if (const char* e = std::getenv("SMPM_INCLINED_HF")) s.height_factor = std::atof(e);
+  if (const char* e = std::getenv("SMPM_INCLINED_D0")) s.depth0 = std::atof(e);
+  if (const char* e = std::getenv("SMPM_INCLINED_D1")) s.depth1 = std::atof(e);
+  const InclinedResult r = smpm::inclined::measure_inclined(SMPM_SOURCE_DIR, s);
+  std::printf("[ inclined ] theta %.0f deg, a = b = %g, %d ppc, FWHM %.0f cells: |R_PP| %.4f "
+              "(closed form %.4f), |R_PS| %.4f (closed form %.4f); %ld + %ld particles, %ld steps, "
+              "%d receivers, %.1f s\n",
+              s.theta_deg, s.a, s.ppc, s.fwhm, r.rpp, r.rpp_exact, r.rps, r.rps_exact,
+              r.particles_a, r.particles_b, r.steps, r.receivers, r.wall_seconds);
+  return r;
+}
+
+InclinedSpec ci_spec() {
+  InclinedSpec s;
+  s.theta_deg = 30;
+  s.ppc = 4;       // 1 ppc carries the odd-even (hourglass) mode of one-point quadrature
+  s.fwhm = 8;
+  s.depth0 = 6;    // receivers 6-10 cells inside the edge
+  s.depth1 = 10;
+  s.half_span = 6;
+  return s;
+}
+
+// The measurement on a free edge (a = b = 0) against the closed form (|R_PP| = 0.754,
+// |R_PS| = 0.876 for nu = 0.33 at 30 degrees), then the silent edge at the same size.
+//
+// The silent edge does NOT reach the closed form (|R_PP| = 0.012, |R_PS| = 0.028) at this size:
+// the particle lattice makes the inclined edge a staircase, and the measured reflection is
+// dominated by the staircase's scattering, which decays with the distance from the edge and
+// with the pulse width (studies/geometry/README.md: |R_PP| 0.22 / 0.14 / 0.093 / 0.056 for
+// FWHM 8 / 12 / 16 / 24 cells, receivers 10-16 cells deep). What this test holds at CI size: the
+// measurement is right (free edge), the silent layer removes most of the free edge's reflection
+// on the inclined edge, and a grid-aligned silent edge reflects far less.
+TEST(GeometrySilent, Inclined30FreeAndSilentEdges) {
+  InclinedSpec free_spec = ci_spec();
+  free_spec.a = free_spec.b = 0;
+  const InclinedResult f = run(free_spec);
+  EXPECT_NEAR(f.rpp, f.rpp_exact, 0.05 * f.rpp_exact);
+  EXPECT_NEAR(f.rps, f.rps_exact, 0.15 * f.rps_exact);
+
+  const InclinedResult r = run(ci_spec());
+  EXPECT_LT(r.rpp, 0.5 * f.rpp);   // measured 0.31 vs 0.74
+  EXPECT_LT(r.rps, 0.25 * f.rps);  // measured 0.16 vs 0.83
+  EXPECT_GT(r.rpp, r.rpp_exact);   // the staircase adds to the closed form's reflection
+
+  InclinedSpec s0 = ci_spec();
+  s0.theta_deg = 0;
+  const InclinedResult r0 = run(s0);
+  EXPECT_LT(r0.rpp, 0.15);         // measured 0.10 (div-based, receivers 6-10 cells deep)
+  EXPECT_LT(r0.rpp, 0.5 * r.rpp);
+  EXPECT_NEAR(r0.rps, 0.0, 1e-6);  // normal incidence: no SV at all
+}
+
+}  // namespace
