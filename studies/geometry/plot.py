@@ -1,0 +1,152 @@
+"""Figures and metrics.json of the geometry study (called by studies/geometry/run).
+
+  inclined_reflection.png  |R_PP| and |R_PS| of the 30-degree silent edge against the pulse width,
+                           with the closed form (REFERENCE.md §4.1) and the free-edge check
+  ring_history.png         radial stress at P (30 mm from the centre of the ring) for the free,
+                           silent and extended outer circle
+  ring_energy.png          energy left in the ring / absorbed by the silent ring over time
+  metrics.json             every number of the README
+"""
+import argparse
+import csv
+import json
+import os
+import subprocess
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_csv(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return rows
+
+
+def columns(path):
+    with open(path) as f:
+        r = csv.reader(f)
+        head = next(r)
+        cols = {h: [] for h in head}
+        for row in r:
+            for h, v in zip(head, row):
+                cols[h].append(float(v))
+    return cols
+
+
+def compare(binary, a, b, col, t0, t1):
+    res = subprocess.run([binary, "compare", a, b, "--column", col, "--from", str(t0), "--to", str(t1)],
+                         capture_output=True, text=True, check=True)
+    return float(res.stdout.strip())
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("out")
+    ap.add_argument("--bin", required=True)
+    args = ap.parse_args()
+    out = args.out
+    metrics = {}
+
+    # ---- inclined edge ----
+    rows = read_csv(os.path.join(out, "inclined.csv"))
+    var_path = os.path.join(out, "inclined_variants.csv")
+    variants = read_csv(var_path) if os.path.exists(var_path) else []
+    f = lambda r, k: float(r[k])  # noqa: E731
+    free = [r for r in rows if f(r, "a") == 0]
+    normal = [r for r in rows if f(r, "theta_deg") == 0]
+    silent = [r for r in rows if f(r, "a") == 1 and f(r, "theta_deg") == 30]
+    silent.sort(key=lambda r: f(r, "fwhm_cells"))
+    inc = {"method": "extended-domain differencing, div/curl of the particle-velocity difference on "
+                     "the particle lattice, receivers 10-16 cells inside the edge, 4 ppc, aluminium "
+                     "(nu = 0.33), sin^2 pulse",
+           "closed_form_30deg": {"rpp": f(silent[0], "rpp_exact"), "rps": f(silent[0], "rps_exact")},
+           "free_edge_30deg": [{"fwhm_cells": f(r, "fwhm_cells"), "rpp": f(r, "rpp"), "rpp_exact": f(r, "rpp_exact"),
+                                "rps": f(r, "rps"), "rps_exact": f(r, "rps_exact")} for r in free],
+           "silent_edge_0deg": [{"fwhm_cells": f(r, "fwhm_cells"), "rpp": f(r, "rpp")} for r in normal],
+           "silent_edge_30deg": [{"fwhm_cells": f(r, "fwhm_cells"), "rpp": f(r, "rpp"), "rps": f(r, "rps"),
+                                  "particles": int(f(r, "particles_a")) + int(f(r, "particles_b")),
+                                  "wall_seconds": f(r, "wall_seconds")} for r in silent],
+           "silent_edge_30deg_variants": [{"form": r["form"], "anchor": r["anchor"], "fwhm_cells": f(r, "fwhm_cells"),
+                                           "rpp": f(r, "rpp"), "rps": f(r, "rps")} for r in variants]}
+    metrics["inclined_30deg"] = inc
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    w = [f(r, "fwhm_cells") for r in silent]
+    ax.loglog(w, [f(r, "rpp") for r in silent], "o-", color="tab:blue", label=r"$|R_{PP}|$ measured")
+    ax.loglog(w, [f(r, "rps") for r in silent], "s-", color="tab:red", label=r"$|R_{PS}|$ measured")
+    ax.axhline(f(silent[0], "rpp_exact"), color="tab:blue", ls=":", label=r"$|R_{PP}|$ closed form")
+    ax.axhline(f(silent[0], "rps_exact"), color="tab:red", ls=":", label=r"$|R_{PS}|$ closed form")
+    for r in variants:
+        ax.plot([f(r, "fwhm_cells")], [f(r, "rpp")], "x", color="tab:blue", ms=8)
+        ax.plot([f(r, "fwhm_cells")], [f(r, "rps")], "+", color="tab:red", ms=9)
+    ax.set_xlabel("pulse width (FWHM, cells)")
+    ax.set_ylabel("reflected amplitude / incident")
+    ax.set_title("Silent edge at 30° (aluminium, 4 ppc)\n"
+                 "x, +: anchor at the particle (nodal and paper forms)", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "inclined_reflection.png"), dpi=130)
+    plt.close(fig)
+
+    # ---- ring ----
+    ring = {}
+    hist = {k: os.path.join(out, f"ring_{k}", "history.csv") for k in ("free", "silent", "extended")}
+    t_end = 3e-5
+    for k in ("free", "silent", "extended"):
+        s = json.load(open(os.path.join(out, f"ring_{k}", "summary.json")))
+        e = s["energy"]
+        ring[k] = {"external_work_J": e["external_work"], "kinetic_J": e["kinetic"], "elastic_J": e["elastic"],
+                   "absorbed_J": e["absorbed"],
+                   "left_in_body_fraction": (e["kinetic"] + e["elastic"]) / e["external_work"],
+                   "absorbed_fraction": e["absorbed"] / e["external_work"],
+                   "energy_imbalance_fraction": e["imbalance"] / e["external_work"],
+                   "particles": s["particles"], "wall_seconds": s["wall_seconds"]}
+    for k in ("free", "silent"):
+        ring[k]["P_srr_L2_vs_extended"] = compare(args.bin, hist[k], hist["extended"], "P.sxx", 0, t_end)
+        ring[k]["Q_syy_L2_vs_extended"] = compare(args.bin, hist[k], hist["extended"], "Q.syy", 0, t_end)
+    metrics["ring"] = ring
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    style = {"free": ("tab:red", "--", "free outer circle"), "silent": ("tab:blue", "-", "silent outer circle"),
+             "extended": ("black", ":", "extended ring (R = 150 mm)")}
+    for k in ("free", "silent", "extended"):
+        c = columns(hist[k])
+        ax.plot([t * 1e6 for t in c["time"]], [v / 1e6 for v in c["P.sxx"]], color=style[k][0], ls=style[k][1],
+                label=style[k][2])
+    ax.set_xlabel("time (µs)")
+    ax.set_ylabel(r"$\sigma_{rr}$ at P (MPa)")
+    ax.set_title("Ring a = 10 mm, R = 50 mm, 100 MPa pressure pulse in the hole", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "ring_history.png"), dpi=130)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    for k in ("free", "silent"):
+        c = columns(hist[k])
+        t = [x * 1e6 for x in c["time"]]
+        W = ring[k]["external_work_J"]
+        left = [(a + b) / W for a, b in zip(c["energy.kinetic"], c["energy.elastic"])]
+        ax.plot(t, left, color=style[k][0], ls=style[k][1], label=f"{k}: energy in the ring")
+        if k == "silent":
+            ax.plot(t, [a / W for a in c["energy.absorbed"]], color="tab:green", label="silent: absorbed")
+    ax.set_xlabel("time (µs)")
+    ax.set_ylabel("fraction of the work of the pressure")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "ring_energy.png"), dpi=130)
+    plt.close(fig)
+
+    with open(os.path.join(out, "metrics.json"), "w") as fo:
+        json.dump(metrics, fo, indent=2)
+    print(json.dumps(metrics, indent=2))
+
+
+if __name__ == "__main__":
+    main()
