@@ -58,6 +58,15 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
   ojson dfe = ojson::object();
   for (const char* k : {"title", "time", "materials", "fem", "output"})
     if (doc.contains(k)) dfe[k] = doc[k];
+  // The FEM region gets the materials its regions name (the particles' may be plastic).
+  if (doc["fem"].is_object() && doc["fem"].contains("regions") && doc["fem"]["regions"].is_object() &&
+      doc["materials"].is_object()) {
+    ojson used = ojson::object();
+    for (const auto& it : doc["fem"]["regions"].items())
+      if (it.value().is_string() && doc["materials"].contains(it.value().get<std::string>()))
+        used[it.value().get<std::string>()] = doc["materials"][it.value().get<std::string>()];
+    if (!used.empty()) dfe["materials"] = used;
+  }
   if (doc.contains("scheme") && doc["scheme"].is_object() && doc["scheme"].contains("threads"))
     dfe["scheme"] = ojson{{"threads", doc["scheme"]["threads"]}};
   Case cf = build_fem_case(source, dfe);
