@@ -10,6 +10,10 @@
 namespace smpm::fem {
 
 namespace {
+// Loops over fewer items than this run on one thread: below it the fork/join of a parallel region
+// costs more than it saves (and far more on an oversubscribed machine).
+constexpr std::int64_t kParallelMinimum = 40000;
+
 std::string fmt(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.6g", v);
@@ -85,7 +89,7 @@ void Solver::internal_force(const double* __restrict u, double* __restrict f) co
   const std::uint64_t* __restrict rp = m.rowptr.data();
   const std::uint32_t* __restrict cl = m.col.data();
   const double* __restrict kv = m.val.data();
-#pragma omp parallel for schedule(static) num_threads(m.threads)
+#pragma omp parallel for schedule(static) num_threads(m.threads) if (n >= kParallelMinimum)
   for (std::int64_t i = 0; i < n; ++i) {
     double fx = 0, fy = 0;
     for (std::uint64_t k = rp[i]; k < rp[i + 1]; ++k) {
@@ -114,7 +118,7 @@ void Solver::external_force(double time, double* f) const {
 void Solver::advance_displacement(const double* v, double h) {
   Impl& m = *impl_;
   const std::int64_t n = static_cast<std::int64_t>(m.u.size());
-#pragma omp parallel for schedule(static) num_threads(m.threads)
+#pragma omp parallel for schedule(static) num_threads(m.threads) if (n >= kParallelMinimum)
   for (std::int64_t i = 0; i < n; ++i) m.u[i] += h * v[i];
   m.ku_valid = false;
 }
@@ -177,7 +181,8 @@ void Solver::step() {
   const std::int32_t* __restrict dn = m.dash_of_node.data();
   const double h = dt;
   double work = 0, absorbed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads)
+#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
+    if (n >= kParallelMinimum)
   for (std::int64_t i = 0; i < n; ++i) {
     const double fx = fi[2 * i] + fe[2 * i], fy = fi[2 * i + 1] + fe[2 * i + 1];
     const double vx0 = v[2 * i], vy0 = v[2 * i + 1];
@@ -218,7 +223,7 @@ void Solver::update_energies() {
     internal_force(m.u.data(), m.ku.data());
     m.ku_valid = true;
   }
-#pragma omp parallel for schedule(static) reduction(+ : kin, el) num_threads(m.threads)
+#pragma omp parallel for schedule(static) reduction(+ : kin, el) num_threads(m.threads) if (n >= kParallelMinimum)
   for (std::int64_t i = 0; i < n; ++i) {
     kin += 0.5 * m.mass[i] * (m.v[2 * i] * m.v[2 * i] + m.v[2 * i + 1] * m.v[2 * i + 1]);
     el -= 0.5 * (m.ku[2 * i] * m.u[2 * i] + m.ku[2 * i + 1] * m.u[2 * i + 1]);
