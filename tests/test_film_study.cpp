@@ -14,6 +14,9 @@
 #include "silentmpm/decohesion.hpp"
 #include "silentmpm/driver.hpp"
 #include "silentmpm/history.hpp"
+#include "silentmpm/output.hpp"
+
+#include <hdf5.h>
 
 using namespace smpm;
 namespace fs = std::filesystem;
@@ -186,4 +189,62 @@ TEST(FilmProbe, BodyRestrictedSamplingAtAnInterface) {
   ASSERT_TRUE(r[0].valid && r[1].valid);
   EXPECT_NEAR(r[0].sxx, 0.2e9, 1e-6);
   EXPECT_LT(r[1].sxx, 0.0);  // the denser top body dominates the shared interface nodes
+}
+
+// The snapshot carries the film state machine: state, plane normal, jump and ubar read back from
+// the HDF5 file equal the solver's arrays, and exactly the decohesion/separated particles have a
+// unit normal.
+TEST(FilmStudy, SnapshotCarriesStateNormalAndJump) {
+  Case c = load_case(case_path("silent").string(),
+                     {"grid.cell=2.5e-7", "time.dt=8e-12", "scheme.threads=1", "time.end=2.4e-9"});
+  Solver& s = *c.solver;
+  const long n = std::lround(c.t_end / s.dt);
+  for (long i = 0; i < n; ++i) s.step();
+  const fs::path dir = fs::temp_directory_path() / "smpm_film_snapshot_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    SnapshotWriter w;
+    w.open(dir.string(), "film");
+    w.write(s.p, s.steps, s.t);
+    w.close();
+  }
+  const hid_t f = H5Fopen((dir / "film.h5").string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  char gname[64];
+  std::snprintf(gname, sizeof gname, "step_%09ld", s.steps);
+  const std::size_t np = s.p.size();
+  auto read = [&](const char* name, hid_t type, void* out) {
+    const std::string path = std::string("/") + gname + "/" + name;
+    const hid_t ds = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+    ASSERT_GE(ds, 0) << path;
+    EXPECT_GE(H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out), 0) << path;
+    H5Dclose(ds);
+  };
+  std::vector<int32_t> state(np);
+  std::vector<double> nx(np), ny(np), jn(np), ub(np);
+  read("state", H5T_NATIVE_INT32, state.data());
+  read("normal_x", H5T_NATIVE_DOUBLE, nx.data());
+  read("normal_y", H5T_NATIVE_DOUBLE, ny.data());
+  read("jump_n", H5T_NATIVE_DOUBLE, jn.data());
+  read("ubar", H5T_NATIVE_DOUBLE, ub.data());
+  H5Fclose(f);
+  std::size_t coh = 0;
+  for (std::size_t k = 0; k < np; ++k) {
+    ASSERT_EQ(state[k], s.p.state[k]) << k;
+    EXPECT_EQ(nx[k], s.p.dnx[k]);
+    EXPECT_EQ(ny[k], s.p.dny[k]);
+    EXPECT_EQ(jn[k], s.p.jump_n[k]);
+    EXPECT_EQ(ub[k], s.p.ubar[k]);
+    const double len = std::hypot(nx[k], ny[k]);
+    if (state[k] >= kDecohesion) {
+      ++coh;
+      EXPECT_NEAR(len, 1.0, 1e-12);
+      EXPECT_GE(jn[k], 0.0);  // no interpenetration
+    } else {
+      EXPECT_EQ(len, 0.0);
+    }
+  }
+  EXPECT_GT(coh, 10u);
+  fs::remove_all(dir);
 }
