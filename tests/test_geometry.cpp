@@ -281,6 +281,17 @@ TEST(GeometryLayer, CornerKeepsSideNormals) {
   EXPECT_NEAR(wsum, 2 * kC, 1e-12 * kC);
 }
 
+// Numbers given to one load (size, parameters) must not leak into the next one in the process.
+TEST(GeometryLoad, NoStateLeaksBetweenLoads) {
+  const std::string l = write_file("leak_l.geo", l_geo()).string();
+  const Geometry first = load_geometry(l, 0);  // the file's own h = 1 mm
+  load_geometry(write_file("leak_disk.geo", disk_geo()).string(), 0.004);
+  const Geometry again = load_geometry(l, 0);
+  EXPECT_EQ(first.x.size(), again.x.size());
+  const Geometry coarse = load_geometry(l, 0.004);
+  EXPECT_LT(coarse.x.size(), first.x.size() / 4);
+}
+
 TEST(GeometryNodes, CurveOnGridLineAndInclined) {
   auto s = make_solver();
   const Geometry g = load_geometry(write_file("rect_n.geo", kRectangle).string(), kH);
@@ -358,7 +369,9 @@ TEST(GeometryMeshes, ConventionAndAreas) {
         {"impact.geo", 0.005}, {"impact_extended.geo", 0.005}, {"convergence.geo", 0.01},
         {"film_5um.geo", 5e-7}, {"film_15um.geo", 5e-7}, {"film.geo", 5e-7},
         {"inclined_edge.geo", 0.01}, {"ring.geo", 0.002}, {"pulse_plate.geo", 0.005},
-        {"pulse_extended.geo", 0.005}};
+        {"pulse_extended.geo", 0.005}, {"hybrid_film_substrate.geo", 5e-7},
+        {"hybrid_film_substrate_graded.geo", 5e-7}, {"hybrid_pulse_50.geo", 0.005},
+        {"hybrid_pulse_150.geo", 0.005}};
     const auto cs = coarse.find(name);
     try {
       g = load_geometry(entry.path().string(), cs == coarse.end() ? 0.0 : cs->second);

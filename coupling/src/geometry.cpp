@@ -15,6 +15,8 @@
 #include <sstream>
 #include <unordered_map>
 
+#include <unistd.h>
+
 namespace smpm {
 
 // ---------------------------------------------------------------------------------------------
@@ -117,12 +119,23 @@ struct GmshSession {
     std::vector<char*> argv;
     for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
+    // ONELAB parameters (DefineConstant[ h = {..., Name "Parameters/h"} ]) and options outlive
+    // gmsh::finalize() in one process: clear them so that a value of an earlier load (ours or
+    // fem/'s) is never picked up by this one.
+    gmsh::initialize(1, argv.data(), /*readConfigFiles=*/false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::clear();  // also the parser's variables (h of the last .geo)
+    gmsh::onelab::clear();
+    gmsh::finalize();
     gmsh::initialize(static_cast<int>(args.size()), argv.data(), /*readConfigFiles=*/false);
     gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);  // gmsh's default
+    gmsh::option::setNumber("Mesh.MeshSizeMin", 0);
     gmsh::logger::start();
   }
   ~GmshSession() {
     try {
+      gmsh::onelab::clear();
       gmsh::logger::stop();
       gmsh::finalize();
     } catch (...) {
@@ -208,17 +221,41 @@ Geometry load_geometry(const std::string& file, double size,
                         "\" (give a gmsh .geo or .msh file)");
 
   std::lock_guard<std::mutex> lock(gmsh_mutex());
-  std::vector<std::string> args = {"silentmpm"};
-  if (geo && size > 0) args.insert(args.end(), {"-setnumber", "h", fmt17(size)});
+  // The numbers (h and the parameters) go in through a small wrapper .geo that assigns them and
+  // then includes the file; the file's DefineConstant keeps an already defined value. (gmsh's
+  // -setnumber is kept by gmsh across sessions of one process, so it would leak into later
+  // loads, fem/'s included.)
+  std::string preamble;
+  if (geo && size > 0) preamble += "h = " + fmt17(size) + ";\n";
   for (const auto& [name, value] : parameters) {
     if (!geo) throw GeometryError(file + ": parameters are only used by a .geo file");
     if (name.empty() || name == "h" || name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos)
       throw GeometryError(file + ": parameter name \"" + name + "\" must be letters, digits and _ (and not h: use size)");
-    args.insert(args.end(), {"-setnumber", name, fmt17(value)});
+    preamble += name + " = " + fmt17(value) + ";\n";
   }
-  GmshSession session(args);
+  std::string opened = file;
+  struct TempFile {
+    std::string path;
+    ~TempFile() {
+      std::error_code ec;
+      if (!path.empty()) fs::remove(path, ec);
+    }
+  } wrapper;
+  if (!preamble.empty()) {
+    static int counter = 0;
+    const fs::path abs = fs::absolute(file, ec);
+    wrapper.path = (fs::temp_directory_path(ec) /
+                    ("silentmpm_" + std::to_string(static_cast<long>(::getpid())) + "_" +
+                     std::to_string(++counter) + "_" + abs.filename().string()))
+                       .string();
+    std::ofstream w(wrapper.path);
+    w << preamble << "Include \"" << abs.string() << "\";\n";
+    if (!w) throw GeometryError(file + ": cannot write a temporary file " + wrapper.path);
+    opened = wrapper.path;
+  }
+  GmshSession session({"silentmpm"});
 
-  gmsh_call(file, geo ? "read the geometry" : "read the mesh", [&] { gmsh::open(file); });
+  gmsh_call(file, geo ? "read the geometry" : "read the mesh", [&] { gmsh::open(opened); });
   if (geo) {
     if (size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", size);
     gmsh_call(file, "mesh the geometry", [&] { gmsh::model::mesh::generate(2); });
