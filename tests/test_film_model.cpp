@@ -280,6 +280,40 @@ TEST(FilmDecohesion, ModeIStrainAtZeroStressAndEnergy) {
   EXPECT_REL(sxx, -m.M * 1e-3, 0.01);
 }
 
+// Mode II on a plane of normal x under simple shear: tau_t decays linearly to zero when the
+// shear strain counted from the unstressed state reaches u_tf / L (g = u_tf / L - tau_f / mu
+// past bifurcation), dissipating 1/2 tau_tf u_tf per area, and the
+// normal jump stays zero (no dilatancy: the plane carries no normal traction).
+TEST(FilmDecohesion, ModeIIShearSofteningAndEnergy) {
+  const Material m = film_tungsten();
+  DecohesionParams P = m.coh;
+  P.u_tf = 20e-9;
+  const double L = 0.1e-6, tf = 0.9e9;
+  P.smear_length = L;
+  double sxx = 0, syy = 0, szz = 0, sxy = tf;
+  Discontinuity d;
+  d.nx = 1; d.ny = 0;
+  ASSERT_FALSE(decohesion_start(P, m.M, m.mu, sxx, syy, sxy, 1.0, d));
+  EXPECT_DOUBLE_EQ(d.ttf, tf);
+  EXPECT_DOUBLE_EQ(d.tnf, tf);  // compressed/zero normal traction: the shear strength
+  uint8_t state = kDecohesion;
+  const double dg = 2e-6;
+  double g = 0, diss = 0, g_zero = -1;
+  for (int i = 0; i < 200000 && g < 0.4; ++i) {
+    elastic_increment(m, 0, 0, dg, sxx, syy, szz, sxy);
+    g += dg;
+    diss += decohesion_update(P, m.lambda, m.mu, d, state, sxx, syy, szz, sxy);
+    if (g_zero < 0 && sxy <= 1e-9 * tf) g_zero = g;
+  }
+  std::printf("mode II: zero shear at %.6g (closed form %.6g); dissipation %.6g J/m^2 "
+              "(closed form %.6g)\n", g_zero, P.u_tf / L - tf / m.mu, diss * L, 0.5 * tf * P.u_tf);
+  EXPECT_REL(g_zero, P.u_tf / L - tf / m.mu, 0.01);
+  EXPECT_REL(diss * L, 0.5 * tf * P.u_tf, 0.01);
+  EXPECT_EQ(state, kSeparated);
+  EXPECT_EQ(d.un, 0.0);
+  EXPECT_NEAR(sxy, 0.0, 1e-6 * tf);
+}
+
 TEST(FilmDecohesion, SnapBackGuardClampsTheSmearLength) {
   const Material m = film_tungsten();
   DecohesionParams P = m.coh;
