@@ -10,7 +10,8 @@
 //   curve  12  right   x = 10 um
 //   curve  13  bottom  y = -10 um
 //   curve  14  top     y = 3 um    (the interface with the particles)
-DefineConstant[ h = {1e-7, Name "Parameters/h"} ];
+// Default h is coarse (a quick look / the mesh test); the study cases set fem.size = 1e-7.
+DefineConstant[ h = {5e-7, Name "Parameters/h"} ];
 L = 10e-6;
 y0 = -10e-6;
 yb = 2e-6;

@@ -8,7 +8,8 @@
 //   curve  12  right   x = 150 mm
 //   curve  13  bottom  y = 0
 //   curve  14  top     y = 200 mm
-DefineConstant[ h = {0.001, Name "Parameters/h"} ];
+// Default h is coarse (a quick look / the mesh test); the study cases set fem.size = 0.001.
+DefineConstant[ h = {0.005, Name "Parameters/h"} ];
 x0 = 0.01;
 x1 = 0.150;
 Ly = 0.2;
