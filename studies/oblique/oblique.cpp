@@ -2,7 +2,7 @@
 // extended-domain differencing (see oblique.hpp), written as OUT/metrics.json and the receiver
 // traces OUT/trace_<P|SV>_<angle>.csv.
 //
-//   oblique OUTDIR [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N]
+//   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N]
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "oblique.hpp"
+#include "oblique_mpm.hpp"
 
 using namespace smpm;
 
@@ -22,12 +23,19 @@ int main(int argc, char** argv) {
   const std::string out = argv[1];
   std::vector<double> angles = {0, 15, 30, 45, 60};
   oblique::Setup base;
+  std::string method = "fem";
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--angles") {
       angles.clear();
       std::istringstream in(argv[i + 1]);
       for (double x; in >> x;) angles.push_back(x);
+    } else if (a == "--method") {
+      method = argv[i + 1];
+      if (method != "fem" && method != "mpm") {
+        std::fprintf(stderr, "oblique: --method must be fem or mpm\n");
+        return 1;
+      }
     } else if (a == "--fwhm") {
       base.fwhm = std::atoi(argv[i + 1]);
     } else if (a == "--degree") {
@@ -46,8 +54,12 @@ int main(int argc, char** argv) {
   try {
     std::filesystem::create_directories(out);
     nlohmann::ordered_json j;
-    j["method"] = "FEM (deal.II) Q" + std::to_string(base.degree) +
-                  ", lumped mass, semi-implicit LK dashpots a = b = 1; extended-domain differencing";
+    j["method"] = method == "fem"
+                      ? "FEM (deal.II) Q" + std::to_string(base.degree) +
+                            ", lumped mass, semi-implicit LK dashpots a = b = 1; extended-domain "
+                            "differencing"
+                      : std::string("MPM, 1 particle per cell, MUSL, nodal semi-implicit silent layer "
+                                    "a = b = 1, CFL 0.3; extended-domain differencing (div v, curl v)");
     j["nu"] = base.nu;
     j["pulse_fwhm_cells"] = base.fwhm;
     j["results"] = nlohmann::ordered_json::array();
@@ -56,7 +68,7 @@ int main(int argc, char** argv) {
         oblique::Setup s = base;
         s.sv = sv;
         s.angle_deg = ang;
-        const oblique::Result r = oblique::measure(s);
+        const oblique::Result r = method == "fem" ? oblique::measure(s) : oblique::measure_mpm(s);
         const char* w = sv ? "SV" : "P";
         std::printf("%-2s %4.0f deg: %s %.5f (exact %.5f)  %s %.5f (exact %.5f)%s  [%.1f s]\n", w, ang,
                     sv ? "|R_SS|" : "|R_PP|", r.r_same, r.exact_same, sv ? "|R_SP|" : "|R_PS|",
@@ -73,12 +85,13 @@ int main(int argc, char** argv) {
                                 {"t_end", r.t_end},
                                 {"dofs", {r.dofs_a, r.dofs_b}},
                                 {"seconds", r.seconds}});
-        std::ofstream tr(out + "/trace_" + w + "_" + std::to_string(static_cast<int>(ang)) + ".csv");
+        std::ofstream tr(out + "/trace_" + (method == "fem" ? "" : "mpm_") + w + "_" +
+                         std::to_string(static_cast<int>(ang)) + ".csv");
         tr << "time,incident,reflected_div,reflected_curl\n" << std::setprecision(9);
         for (std::size_t k = 0; k < r.t.size(); ++k)
           tr << r.t[k] << "," << r.inc[k] << "," << r.ddiv[k] << "," << r.dcurl[k] << "\n";
       }
-    std::ofstream(out + "/metrics.json") << std::setw(2) << j << "\n";
+    std::ofstream(out + "/metrics" + (method == "fem" ? "" : "_mpm") + ".json") << std::setw(2) << j << "\n";
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oblique: error: %s\n", e.what());
     return 1;
