@@ -2,7 +2,8 @@
 
     /usr/bin/python3 studies/oblique/plot.py OUTDIR
 
-Reads OUTDIR/metrics.json (written by the `oblique` program), adds the closed-form curves
+Reads OUTDIR/metrics.json (written by the `oblique` program) and, when present,
+OUTDIR/metrics_mpm.json (`oblique --method mpm`), adds the closed-form curves
 (REFERENCE.md §4.1, a = b = 1) and writes OUTDIR/reflection_vs_angle.png.
 """
 import cmath
@@ -48,6 +49,12 @@ def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "studies/oblique/out"
     with open(f"{out}/metrics.json") as f:
         m = json.load(f)
+    mpm = None
+    try:
+        with open(f"{out}/metrics_mpm.json") as f:
+            mpm = json.load(f)
+    except FileNotFoundError:
+        pass
     nu = m["nu"]
     ang = np.linspace(0, 80, 161)
     ex = np.array([lk(nu, math.radians(a)) for a in ang])
@@ -70,6 +77,18 @@ def main():
     if ev:
         ax.plot([r["angle_deg"] for r in ev], [r["R_SP"] for r in ev], "C3x",
                 label="|R_SP| FEM (evanescent P: not an amplitude)")
+    if mpm:
+        pm = [r for r in mpm["results"] if r["wave"] == "P"]
+        sm = [r for r in mpm["results"] if r["wave"] == "SV" and not r["reflected_p_evanescent"]]
+        sm_all = [r for r in mpm["results"] if r["wave"] == "SV"]
+        axs[0].plot([r["angle_deg"] for r in pm], [r["R_PP"] for r in pm], "C0^", mfc="none",
+                    label="|R_PP| MPM")
+        axs[0].plot([r["angle_deg"] for r in pm], [r["R_PS"] for r in pm], "C1v", mfc="none",
+                    label="|R_PS| MPM")
+        axs[1].plot([r["angle_deg"] for r in sm_all], [r["R_SS"] for r in sm_all], "C2^",
+                    mfc="none", label="|R_SS| MPM")
+        axs[1].plot([r["angle_deg"] for r in sm], [r["R_SP"] for r in sm], "C3v", mfc="none",
+                    label="|R_SP| MPM")
     kappa = math.sqrt((1 - 2 * nu) / (2 * (1 - nu)))
     ax.axvline(math.degrees(math.asin(kappa)), color="0.6", ls=":", lw=1)
     ax.set_title("incident SV (dotted: critical angle)")
@@ -80,8 +99,9 @@ def main():
         ax.set_ylim(0, 0.8)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle(f"LK dashpots (a = b = 1) on the FEM far-field, nu = {nu}, Q1, Gaussian pulse "
-                 f"{m['pulse_fwhm_cells']} cells FWHM; extended-domain differencing", fontsize=10)
+    fig.suptitle(f"LK dashpots (a = b = 1): FEM far-field (Q1){' and MPM silent layer (1 ppc)' if mpm else ''}, "
+                 f"nu = {nu}, Gaussian pulse {m['pulse_fwhm_cells']} cells FWHM; extended-domain differencing",
+                 fontsize=10)
     fig.tight_layout()
     fig.savefig(f"{out}/reflection_vs_angle.png", dpi=130)
     print(f"oblique: wrote {out}/reflection_vs_angle.png")
