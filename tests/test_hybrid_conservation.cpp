@@ -182,3 +182,67 @@ TEST(HybridConservation, UniformStrainPatch) {
   EXPECT_LT(df / std::abs(sxx), 1e-9);
   EXPECT_LT(vmax, 1e-9 * std::abs(sxx) / (mat.rho * mat.cd));
 }
+
+// General uniform strain (exx, eyy, gxy all non-zero) across the interface: particles carry
+// sigma = C eps, FE nodes u = eps x, and every node on the outer boundary of the strip (particles'
+// and elements') is fixed. Every free node, the interface nodes included, is then in equilibrium
+// (the forces of both regions cancel there), so after 200 steps nothing moved and the stress is
+// uniform to round-off in both regions.
+TEST(HybridConservation, GeneralUniformStrainPatch) {
+  const Material mat = smpm::testing::tungsten();
+  const double exx = -1e-4, eyy = 0.5e-4, gxy = 0.8e-4;
+  const double sxx = mat.lambda * (exx + eyy) + 2 * mat.mu * exx;
+  const double syy = mat.lambda * (exx + eyy) + 2 * mat.mu * eyy;
+  const double szz = mat.lambda * (exx + eyy), sxy = mat.mu * gxy;
+  const double h = 1e-3;
+  const int cells = 30, mpm_cells = 12, height = 6;
+  const double L = cells * h, H = height * h, xi = mpm_cells * h;
+  Solver s;
+  s.materials.push_back(mat);
+  s.grid.init(-2 * h, -2 * h, h, mpm_cells + 4, height + 4);
+  s.seed_rectangle(0, 0, xi, H, 2, 0, 0, 0, 0);
+  for (std::size_t k = 0; k < s.p.size(); ++k) {
+    s.p.sxx[k] = sxx; s.p.syy[k] = syy; s.p.szz[k] = szz; s.p.sxy[k] = sxy;
+  }
+  s.constraints.push_back({"left", s.nodes_in_box(0, 0, 0, H), 3});
+  s.constraints.push_back({"bottom", s.nodes_in_box(0, 0, xi, 0), 3});
+  s.constraints.push_back({"top", s.nodes_in_box(0, H, xi, H), 3});
+  s.opt.threads = 1;
+  s.finalize();
+  fem::Spec spec;
+  spec.mesh = fem::load_mesh(box_geo("patch_general", xi, 0, L, H, h), h);
+  spec.materials = {mat};
+  spec.region_material = {{1, 0}};
+  spec.threads = 1;
+  spec.boundaries = {fe_bc(fem::Boundary::Kind::Fixed, 12, "right"),
+                     fe_bc(fem::Boundary::Kind::Fixed, 13, "bottom"),
+                     fe_bc(fem::Boundary::Kind::Fixed, 14, "top")};
+  fem::Solver fe(spec);
+  for (std::size_t i = 0; i < fe.nodes(); ++i) {
+    const double x = fe.node_x()[i], y = fe.node_y()[i];
+    fe.displacement()[2 * i] = exx * x + 0.5 * gxy * y;
+    fe.displacement()[2 * i + 1] = 0.5 * gxy * x + eyy * y;
+  }
+  Hybrid hy(s, fe);
+  EXPECT_EQ(hy.interface_nodes(), static_cast<std::size_t>(height + 1));
+  hy.set_dt(0.3 * h / mat.cd);
+  std::vector<int> probes;
+  for (double x : {12.5, 13.3, 20.7, 29.5})
+    for (double y : {0.5, 3.0, 5.6}) probes.push_back(fe.add_probe(x * h, y * h));
+  for (int k = 0; k < 200; ++k) hy.step();
+  double dm = 0, df = 0, vmax = 0;
+  for (std::size_t k = 0; k < s.p.size(); ++k) {
+    dm = std::max({dm, std::abs(s.p.sxx[k] - sxx), std::abs(s.p.syy[k] - syy),
+                   std::abs(s.p.szz[k] - szz), std::abs(s.p.sxy[k] - sxy)});
+    vmax = std::max(vmax, std::hypot(s.p.vx[k], s.p.vy[k]));
+  }
+  for (const auto& q : fe.sample())
+    df = std::max({df, std::abs(q.sxx - sxx), std::abs(q.syy - syy), std::abs(q.szz - szz),
+                   std::abs(q.sxy - sxy)});
+  const double ref = std::abs(sxx);
+  std::printf("general patch: MPM stress error %.3e, FE %.3e (of %.3e), max particle speed %.3e\n",
+              dm / ref, df / ref, ref, vmax);
+  EXPECT_LT(dm / ref, 1e-9);
+  EXPECT_LT(df / ref, 1e-9);
+  EXPECT_LT(vmax, 1e-9 * ref / (mat.rho * mat.cd));
+}
