@@ -13,8 +13,15 @@
 //                                    FE dashpot blocks included at shared nodes)
 //   FE nodes not shared              (m + dt/2 C) v+ = (m - dt/2 C) v + dt f, constraints
 //   FE nodes shared                  v_FE+ = grid v+
-//   u^{n+1} = u^n + dt v_FE+;  particles: g2p (MUSL re-maps the momentum, the FE momentum of a
-//   shared node included), stress update, positions
+//   particles                        g2p: the FLIP increment at a shared node is v+ - p_MPM/m_MPM
+//                                    (the particles' own old velocity there), so that
+//                                    Sum_p m_p dv_p + m_FE dv_FE = dt f: momentum is exact;
+//                                    stress update and positions (USL: with v+; MUSL: with the
+//                                    re-mapped q / m, the FE momentum of a shared node in q)
+//   u^{n+1} = u^n + dt v             FE displacements; at a shared node v = v+ (USL) or the same
+//                                    re-mapped q / m that strains the particles (MUSL), so both
+//                                    sides see one displacement increment (halves the interface
+//                                    reflection of MUSL: 0.86 % instead of 1.5 % for 20 cells)
 //
 // The interface is found automatically: an FE node that lies within h 1e-6 of a grid node is
 // mapped to it; the shared nodes are those FE nodes at grid nodes that are a corner of a grid cell
