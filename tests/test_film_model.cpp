@@ -211,7 +211,9 @@ TEST(FilmBifurcation, SweepMatchesBruteForceMinimum) {
     EXPECT_EQ(r.bifurcated, dmin <= 0) << trial;
     // Refined near zero: to 1e-5 mu M. Far from zero the coarse sample stands, above the true
     // minimum by far less than the refinement threshold 40 step^2 mu M = 0.012 mu M.
-    if (dmin <= 0.01 * m.mu * m.M) EXPECT_NEAR(r.det_min, dmin, 1e-5 * m.mu * m.M) << trial;
+    if (dmin <= 0.01 * m.mu * m.M) {
+      EXPECT_NEAR(r.det_min, dmin, 1e-5 * m.mu * m.M) << trial;
+    }
     EXPECT_GE(r.det_min, dmin - 1e-6 * m.mu * m.M) << trial;
     EXPECT_LE(r.det_min - dmin, 1e-3 * m.mu * m.M) << trial;
     bif += r.bifurcated;
