@@ -103,9 +103,10 @@ void Solver::internal_force(const double* __restrict u, double* __restrict f) co
   }
 }
 
-void Solver::external_force(double time, double* f) const {
-  std::fill(f, f + dofs(), 0.0);
-  for (const auto& l : impl_->loads) {
+namespace {
+// f += f_ext(time) over the loaded nodes only.
+void add_loads(const Solver::Impl& m, double time, double* f) {
+  for (const auto& l : m.loads) {
     const double s = l.fn(time);
     if (s == 0) continue;
     for (std::size_t k = 0; k < l.nodes.size(); ++k) {
@@ -113,6 +114,12 @@ void Solver::external_force(double time, double* f) const {
       f[2 * l.nodes[k] + 1] += s * l.f[2 * k + 1];
     }
   }
+}
+}  // namespace
+
+void Solver::external_force(double time, double* f) const {
+  std::fill(f, f + dofs(), 0.0);
+  add_loads(*impl_, time, f);
 }
 
 void Solver::advance_displacement(const double* v, double h) {
@@ -171,7 +178,12 @@ void Solver::step() {
   // Internal force at u^n (reused from update_energies when still valid).
   if (!m.ku_valid) internal_force(m.u.data(), m.ku.data());
   // m.ku holds -K u^n.
-  external_force(t, m.fext.data());
+  // f_ext is zero away from the loaded nodes (fext is zero-initialised and only these entries
+  // are ever written): refresh just those, not the whole vector (a serial pass over every dof
+  // would cap the two-thread speed-up).
+  for (const auto& l : m.loads)
+    for (const auto nd : l.nodes) m.fext[2 * nd] = m.fext[2 * nd + 1] = 0.0;
+  add_loads(m, t, m.fext.data());
   double* __restrict u = m.u.data();
   double* __restrict v = m.v.data();
   const double* __restrict fi = m.ku.data();
