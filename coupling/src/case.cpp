@@ -13,6 +13,7 @@
 //                   bodies, probes, seeding, boundaries, finalize, time step.
 #include "silentmpm/case.hpp"
 #include "case_fem.hpp"
+#include "case_util.hpp"
 #include "silentmpm/geometry.hpp"
 
 #include <algorithm>
@@ -41,23 +42,11 @@ using ojson = nlohmann::ordered_json;
 constexpr double kMaxCells = 2e8;
 constexpr double kMaxParticles = 2e8;
 
-// Shortest form that reads back as v (so a value the user typed prints as typed), else 6 digits.
-std::string fmt(double v) {
-  char b[40];
-  for (int p = 1; p <= 12; ++p) {
-    std::snprintf(b, sizeof b, "%.*g", p, v);
-    if (std::strtod(b, nullptr) == v) return b;
-  }
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
-// 6 significant digits, rounded towards zero (a limit the user can copy without exceeding it).
-std::string fmt_down(double v) {
-  if (!(v > 0) || !std::isfinite(v)) return fmt(v);
-  const double scale = std::pow(10.0, 5 - std::floor(std::log10(v)));
-  return fmt(std::floor(v * scale + 1e-9) / scale);
-}
+using detail::a_type;
+using detail::fmt;
+using detail::fmt_down;
+using detail::index_path;
+using detail::join;
 
 std::string fmt_list(const std::vector<double>& v) {
   std::string s = "[";
@@ -65,31 +54,10 @@ std::string fmt_list(const std::vector<double>& v) {
   return s + "]";
 }
 
-std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
-  std::string s;
-  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
-  return s;
-}
-
 std::string quoted_list(const std::vector<std::string>& v) {
   std::vector<std::string> q;
   for (const auto& s : v) q.push_back("\"" + s + "\"");
   return join(q);
-}
-
-// "a string", "an array", ... for messages like "expected a number, got a string".
-std::string a_type(const ojson& v) {
-  switch (v.type()) {
-    case ojson::value_t::null: return "null";
-    case ojson::value_t::boolean: return "a boolean";
-    case ojson::value_t::number_integer:
-    case ojson::value_t::number_unsigned:
-    case ojson::value_t::number_float: return "a number";
-    case ojson::value_t::string: return "a string";
-    case ojson::value_t::array: return "an array";
-    case ojson::value_t::object: return "an object";
-    default: return "an unsupported value";
-  }
 }
 
 std::size_t edit_distance(const std::string& a, const std::string& b) {
@@ -141,10 +109,6 @@ struct Ctx {
     throw CaseError(m);
   }
 };
-
-std::string index_path(const std::string& path, std::size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
 
 // Typed reading of one value at a known path.
 double as_number(const Ctx& ctx, const ojson& v, const std::string& path) {

@@ -12,44 +12,13 @@
 #include <set>
 
 #include "case_fem.hpp"
+#include "case_util.hpp"
 
 namespace smpm::detail {
 namespace {
 
 using ojson = nlohmann::ordered_json;
 namespace fs = std::filesystem;
-
-std::string fmt(double v) {
-  char b[40];
-  for (int p = 1; p <= 12; ++p) {
-    std::snprintf(b, sizeof b, "%.*g", p, v);
-    if (std::strtod(b, nullptr) == v) return b;
-  }
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
-std::string fmt_down(double v) {
-  if (!(v > 0) || !std::isfinite(v)) return fmt(v);
-  const double scale = std::pow(10.0, 5 - std::floor(std::log10(v)));
-  return fmt(std::floor(v * scale + 1e-9) / scale);
-}
-
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + v[i];
-  return s;
-}
-
-std::string a_type(const ojson& v) {
-  if (v.is_null()) return "null";
-  if (v.is_boolean()) return "a boolean";
-  if (v.is_number()) return "a number";
-  if (v.is_string()) return "a string";
-  if (v.is_array()) return "an array";
-  if (v.is_object()) return "an object";
-  return "an unsupported value";
-}
 
 // A small key walker (the FEM twin of case.cpp's): typed getters, unknown keys rejected.
 class Node {
@@ -144,10 +113,6 @@ class Node {
   const ojson& j_;
   std::string path_;
 };
-
-std::string index_path(const std::string& p, std::size_t i) {
-  return p + "[" + std::to_string(i) + "]";
-}
 
 // Mesh paths are relative to the case file's folder (or the working directory when the case
 // does not come from a file).

@@ -8,28 +8,12 @@
 #include <regex>
 
 #include "case_fem.hpp"
+#include "case_util.hpp"
 
 namespace smpm::detail {
 namespace {
 
 using ojson = nlohmann::ordered_json;
-
-std::string fmt(double v) {
-  char b[40];
-  for (int p = 1; p <= 12; ++p) {
-    std::snprintf(b, sizeof b, "%.*g", p, v);
-    if (std::strtod(b, nullptr) == v) return b;
-  }
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
-// Rounds down to 6 significant digits (a dt that is safe to paste back).
-std::string fmt_down(double v) {
-  if (!(v > 0) || !std::isfinite(v)) return fmt(v);
-  const double scale = std::pow(10.0, 5 - std::floor(std::log10(v)));
-  return fmt(std::floor(v * scale + 1e-9) / scale);
-}
 
 [[noreturn]] void fail(const std::string& source, const std::string& path, const std::string& what) {
   throw CaseError(source + ": " + (path.empty() ? "" : path + ": ") + what);

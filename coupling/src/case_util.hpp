@@ -1,0 +1,54 @@
+#pragma once
+// Internal: small formatting helpers shared by the case parsers (case.cpp, case_fem.cpp,
+// case_hybrid.cpp), so that every section prints numbers, lists and types the same way.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace smpm::detail {
+
+// Shortest form that reads back as v (so a value the user typed prints as typed), else 6 digits.
+inline std::string fmt(double v) {
+  char b[40];
+  for (int p = 1; p <= 12; ++p) {
+    std::snprintf(b, sizeof b, "%.*g", p, v);
+    if (std::strtod(b, nullptr) == v) return b;
+  }
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// 6 significant digits, rounded towards zero (a limit the user can copy without exceeding it,
+// e.g. a dt that is safe to paste back).
+inline std::string fmt_down(double v) {
+  if (!(v > 0) || !std::isfinite(v)) return fmt(v);
+  const double scale = std::pow(10.0, 5 - std::floor(std::log10(v)));
+  return fmt(std::floor(v * scale + 1e-9) / scale);
+}
+
+inline std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+// "a string", "an array", ... for messages like "expected a number, got a string".
+inline std::string a_type(const nlohmann::ordered_json& v) {
+  if (v.is_null()) return "null";
+  if (v.is_boolean()) return "a boolean";
+  if (v.is_number()) return "a number";
+  if (v.is_string()) return "a string";
+  if (v.is_array()) return "an array";
+  if (v.is_object()) return "an object";
+  return "an unsupported value";
+}
+
+// "path[i]"
+inline std::string index_path(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+}  // namespace smpm::detail

@@ -1,0 +1,152 @@
+#include "driver_common.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <stdexcept>
+
+namespace smpm::detail {
+
+namespace fs = std::filesystem;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+fs::path prepare_output_dir(const std::string& out_dir) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) throw std::runtime_error(out_dir + ": cannot create output directory: " + ec.message());
+  const fs::path dir(out_dir);
+  fs::remove(dir / "summary.json", ec);  // its presence marks a complete run
+  return dir;
+}
+
+std::vector<std::string> history_columns(const std::vector<ProbeSpec>& probes) {
+  std::vector<std::string> cols;
+  for (const auto& pr : probes)
+    for (const auto& f : pr.fields) cols.push_back(pr.name + "." + f);
+  for (const char* e : {"kinetic", "elastic", "dissipated", "absorbed", "external_work", "imbalance"})
+    cols.push_back(std::string("energy.") + e);
+  return cols;
+}
+
+void put_energies(const Energies& e, std::vector<double>& row, std::size_t& k) {
+  for (double v : {e.kinetic, e.elastic, e.dissipated, e.absorbed, e.external_work, e.imbalance()})
+    row[k++] = v;
+}
+
+double probe_field(const ProbeSample& s, const std::string& f) {
+  if (f == "sxx") return s.sxx;
+  if (f == "syy") return s.syy;
+  if (f == "szz") return s.szz;
+  if (f == "sxy") return s.sxy;
+  if (f == "J2") return s.j2;
+  if (f == "vx") return s.vx;
+  if (f == "vy") return s.vy;
+  throw std::runtime_error("unknown probe field " + f);
+}
+
+double probe_field(const fem::Sample& s, const std::string& f) {
+  if (f == "div") return s.div;
+  if (f == "curl") return s.curl;
+  ProbeSample p;
+  p.sxx = s.sxx; p.syy = s.syy; p.szz = s.szz; p.sxy = s.sxy; p.j2 = s.j2; p.vx = s.vx; p.vy = s.vy;
+  return probe_field(p, f);
+}
+
+Progress::Progress(bool on, long total, bool eta, Clock::time_point t0)
+    : on_(on), total_(total), eta_(eta), tty_(isatty(2)), t0_(t0) {}
+
+void Progress::update(long step) {
+  if (!on_) return;
+  const double el = seconds_since(t0_);
+  const bool last = step >= total_;
+  const double every = tty_ ? 0.5 : 5.0;
+  if (eta_) {
+    if (el - last_ < every && !last) return;
+    if (el < 2.0 && !last) return;  // short runs stay quiet
+  } else if (!(el > 2.0 && (el - last_ >= every || last))) {
+    return;
+  }
+  last_ = el;
+  const double rate = step / std::max(el, 1e-9);
+  if (eta_) {
+    const double left = (total_ - step) / std::max(rate, 1e-9);
+    std::fprintf(stderr, "%s  %5.1f%%  step %ld/%ld  %.0f steps/s  %.1f s left%s",
+                 tty_ ? "\r" : "", 100.0 * step / total_, step, total_, rate, left,
+                 tty_ ? "   " : "\n");
+  } else {
+    std::fprintf(stderr, "%s  %5.1f%%  step %ld/%ld  %.0f steps/s%s", tty_ ? "\r" : "",
+                 100.0 * step / total_, step, total_, rate, tty_ ? "   " : "\n");
+  }
+  if (last && tty_) std::fprintf(stderr, "\n");
+}
+
+nlohmann::ordered_json summary_head(const Case& c, const RunResult& r, double dt, double t_end,
+                                    double cfl, double step_seconds) {
+  nlohmann::ordered_json j;
+  j["title"] = c.title;
+  j["case"] = c.source;
+  j["steps"] = r.steps;
+  j["dt"] = dt;
+  j["t_end"] = t_end;
+  j["cfl"] = cfl;
+  j["wall_seconds"] = r.wall_seconds;
+  j["step_seconds"] = step_seconds;
+  return j;
+}
+
+nlohmann::ordered_json energy_json(const Energies& e) {
+  const double scale = std::max({std::abs(e.initial) + std::abs(e.external_work), 1e-300});
+  return nlohmann::ordered_json{{"kinetic", e.kinetic},
+                                {"elastic", e.elastic},
+                                {"dissipated", e.dissipated},
+                                {"absorbed", e.absorbed},
+                                {"external_work", e.external_work},
+                                {"initial", e.initial},
+                                {"imbalance", e.imbalance()},
+                                {"relative_imbalance", e.imbalance() / scale}};
+}
+
+nlohmann::ordered_json silents_json(const Solver& s) {
+  nlohmann::ordered_json sil = nlohmann::ordered_json::array();
+  for (const auto& sl : s.silents)
+    sil.push_back({{"name", sl.layer.name},
+                   {"particles", sl.layer.idx.size()},
+                   {"form", sl.form == SilentForm::Nodal ? "nodal" : "particle"},
+                   {"a", sl.a},
+                   {"b", sl.b},
+                   {"layer_width", sl.layer.width}});
+  return sil;
+}
+
+nlohmann::ordered_json fem_json(const fem::Solver& s) {
+  return nlohmann::ordered_json{{"nodes", s.nodes()},
+                                {"cells", s.cells()},
+                                {"degree", s.degree()},
+                                {"critical_dt", s.critical_dt()},
+                                {"dashpot_nodes", s.dashpots().size()}};
+}
+
+void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {
+  j["scheme"] = scheme_name(s.opt.scheme);
+  j["flip"] = s.opt.flip;
+  j["grid"] = {{"origin", {s.grid.x0, s.grid.y0}}, {"cells", {s.grid.nx, s.grid.ny}}, {"cell", s.grid.h}};
+}
+
+void write_summary(const fs::path& dir, const nlohmann::ordered_json& j) {
+  const fs::path tmp = dir / "summary.json.tmp";
+  {
+    std::ofstream f(tmp);
+    if (!f) throw std::runtime_error((dir / "summary.json").string() + ": cannot write");
+    f << std::setw(2) << j << "\n";
+  }
+  fs::rename(tmp, dir / "summary.json");
+}
+
+}  // namespace smpm::detail

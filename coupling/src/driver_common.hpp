@@ -1,0 +1,64 @@
+#pragma once
+// Internal: the pieces the three run drivers (driver.cpp: MPM, driver_fem.cpp: FEM,
+// driver_hybrid.cpp: MPM + FEM) share — output folder, history.csv columns and energy terms,
+// probe fields, the progress line, and the blocks and writing of summary.json.
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "silentmpm/case.hpp"
+#include "silentmpm/driver.hpp"
+
+namespace smpm::detail {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0);
+
+// Creates the output folder (throws if it cannot) and removes a previous summary.json, whose
+// presence marks a complete run.
+std::filesystem::path prepare_output_dir(const std::string& out_dir);
+
+// history.csv columns: "<probe>.<field>" for every probe, then "energy.<term>".
+std::vector<std::string> history_columns(const std::vector<ProbeSpec>& probes);
+// Writes the energy terms of history.csv into row[k...], advancing k.
+void put_energies(const Energies& e, std::vector<double>& row, std::size_t& k);
+inline bool energies_finite(const Energies& e) {
+  return std::isfinite(e.kinetic) && std::isfinite(e.elastic);
+}
+
+// One probe field ("sxx", "syy", "szz", "sxy", "J2", "vx", "vy"; FEM samples also "div", "curl").
+double probe_field(const ProbeSample& s, const std::string& f);
+double probe_field(const fem::Sample& s, const std::string& f);
+
+// The progress line on stderr (a carriage-return line on a terminal, else a line every 5 s).
+// With eta, the MPM form: "... steps/s  N s left", and the last step is always reported; without,
+// the FEM / hybrid form: no estimate, and runs shorter than 2 s print nothing.
+class Progress {
+ public:
+  Progress(bool on, long total, bool eta, Clock::time_point t0 = Clock::now());
+  void update(long step);
+
+ private:
+  bool on_;
+  long total_;
+  bool eta_;
+  bool tty_;
+  Clock::time_point t0_;
+  double last_ = 0;
+};
+
+// summary.json blocks. The head: "title", "case", "steps", "dt", "t_end", "cfl", "wall_seconds",
+// "step_seconds" (each driver adds its own keys after these).
+nlohmann::ordered_json summary_head(const Case& c, const RunResult& r, double dt, double t_end,
+                                    double cfl, double step_seconds);
+nlohmann::ordered_json energy_json(const Energies& e);       // "energy"
+nlohmann::ordered_json silents_json(const Solver& s);        // "silent_boundaries"
+nlohmann::ordered_json fem_json(const fem::Solver& s);       // "fem"
+void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s);  // "scheme", "flip", "grid"
+// Writes DIR/summary.json through a temporary file, so that it appears complete or not at all.
+void write_summary(const std::filesystem::path& dir, const nlohmann::ordered_json& j);
+
+}  // namespace smpm::detail
