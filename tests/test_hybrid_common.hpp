@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "silentmpm/geo_box.hpp"
 #include "common.hpp"
 #include "silentmpm/fem.hpp"
 #include "silentmpm/hybrid.hpp"
@@ -23,21 +24,7 @@ inline std::string box_geo(const std::string& name, double x0, double y0, double
   fs::create_directories(d);
   const fs::path p = d / (name + ".geo");
   std::ofstream f(p);
-  char buf[2048];
-  std::snprintf(buf, sizeof buf,
-                "DefineConstant[ h = {%.17g, Name \"Parameters/h\"} ];\n"
-                "Point(1) = {%.17g, %.17g, 0}; Point(2) = {%.17g, %.17g, 0};\n"
-                "Point(3) = {%.17g, %.17g, 0}; Point(4) = {%.17g, %.17g, 0};\n"
-                "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
-                "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
-                "Transfinite Curve{1, 3} = Round(%.17g / h) + 1;\n"
-                "Transfinite Curve{2, 4} = Round(%.17g / h) + 1;\n"
-                "Transfinite Surface{1}; Recombine Surface{1};\n"
-                "Physical Surface(\"body\", 1) = {1};\n"
-                "Physical Curve(\"left\", 11) = {4}; Physical Curve(\"right\", 12) = {2};\n"
-                "Physical Curve(\"bottom\", 13) = {1}; Physical Curve(\"top\", 14) = {3};\n",
-                h, x0, y0, x1, y0, x1, y1, x0, y1, x1 - x0, y1 - y0);
-  f << buf;
+  f << smpm::fem::box_geo_text(x0, y0, x1, y1, h);
   return p.string();
 }
 

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "silentmpm/geo_box.hpp"
 #include "silentmpm/fem.hpp"
 #include "silentmpm/lk_reflection.hpp"
 
@@ -62,21 +63,7 @@ inline std::string rectangle_geo(const std::string& name, double lx, double ly, 
   fs::create_directories(dir);
   const fs::path p = dir / (name + ".geo");
   std::ofstream f(p);
-  char buf[2048];
-  std::snprintf(buf, sizeof buf,
-                "DefineConstant[ h = {%.17g, Name \"Parameters/h\"} ];\n"
-                "Point(1) = {0, 0, 0}; Point(2) = {%.17g, 0, 0};\n"
-                "Point(3) = {%.17g, %.17g, 0}; Point(4) = {0, %.17g, 0};\n"
-                "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
-                "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
-                "Transfinite Curve{1, 3} = Round(%.17g / h) + 1;\n"
-                "Transfinite Curve{2, 4} = Round(%.17g / h) + 1;\n"
-                "Transfinite Surface{1}; Recombine Surface{1};\n"
-                "Physical Surface(\"body\", 1) = {1};\n"
-                "Physical Curve(\"left\", 11) = {4}; Physical Curve(\"right\", 12) = {2};\n"
-                "Physical Curve(\"bottom\", 13) = {1}; Physical Curve(\"top\", 14) = {3};\n",
-                h, lx, lx, ly, ly, lx, ly);
-  f << buf;
+  f << smpm::fem::box_geo_text(0, 0, lx, ly, h);
   return p.string();
 }
 
