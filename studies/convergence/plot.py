@@ -9,39 +9,23 @@ the particle spacing h/sqrt(ppc) for the particles-per-cell series), the model b
 s_h = s + C h^p.
 """
 import argparse
-import csv
 import json
 import math
 import os
-import subprocess
 
 import matplotlib
 import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import sys
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from history import compare, read_history as read  # noqa: E402
 
 CELLS = ["0.01", "0.005", "0.002"]
 EXTRA_CELLS = ["0.001"]  # a further level beyond the paper's, when present
 PPC = [1, 4, 9]
 SMOOTH_S = 5e-6  # moving-average width of the smoothed differences
-
-
-def read(path):
-    with open(path) as f:
-        r = csv.reader(f)
-        head = next(r)
-        cols = {h: [] for h in head}
-        for row in r:
-            for h, v in zip(head, row):
-                cols[h].append(float(v))
-    return cols
-
-
-def compare(binary, a, b, col="D.sxx"):
-    res = subprocess.run([binary, "compare", a, b, "--column", col], capture_output=True,
-                         text=True, check=True)
-    return float(res.stdout.strip())
 
 
 def smoothed_difference(fa, fb, width):
@@ -83,7 +67,7 @@ def series(out, binary, runs, sizes):
     diffs = []
     for k in range(len(runs) - 1):
         diffs.append({"coarse": runs[k], "fine": runs[k + 1],
-                      "relative_l2": compare(binary, files[k], files[k + 1]),
+                      "relative_l2": compare(binary, files[k], files[k + 1], "D.sxx"),
                       "relative_l2_smoothed": smoothed_difference(files[k], files[k + 1],
                                                                   SMOOTH_S)})
     m = {"runs": runs, "spacing_m": sizes, "successive_differences": diffs}

@@ -11,35 +11,20 @@ import argparse
 import csv
 import json
 import os
-import subprocess
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import sys
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from history import compare, read_history as columns  # noqa: E402
 
 
 def read_csv(path):
     with open(path) as f:
         rows = list(csv.DictReader(f))
     return rows
-
-
-def columns(path):
-    with open(path) as f:
-        r = csv.reader(f)
-        head = next(r)
-        cols = {h: [] for h in head}
-        for row in r:
-            for h, v in zip(head, row):
-                cols[h].append(float(v))
-    return cols
-
-
-def compare(binary, a, b, col, t0, t1):
-    res = subprocess.run([binary, "compare", a, b, "--column", col, "--from", str(t0), "--to", str(t1)],
-                         capture_output=True, text=True, check=True)
-    return float(res.stdout.strip())
 
 
 def main():

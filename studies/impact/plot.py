@@ -8,16 +8,17 @@ contact face), less 10 cells of travel (the discrete front runs ahead of x/c). T
 differences use `silentmpm compare`, the same implementation as the tests.
 """
 import argparse
-import csv
 import json
 import math
 import os
-import subprocess
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import sys
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from history import compare, read_history as read  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 BCS = ("free", "silent", "extended")
@@ -25,23 +26,6 @@ STYLE = {"free": ("tab:red", "--", "free boundary"),
          "silent": ("tab:blue", "-", "silent boundary"),
          "extended": ("black", ":", "extended region")}
 MARGIN_CELLS = 10
-
-
-def read(path):
-    with open(path) as f:
-        r = csv.reader(f)
-        head = next(r)
-        cols = {h: [] for h in head}
-        for row in r:
-            for h, v in zip(head, row):
-                cols[h].append(float(v))
-    return cols
-
-
-def compare(binary, a, b, col, t0, t1):
-    res = subprocess.run([binary, "compare", a, b, "--column", col, "--from", str(t0),
-                          "--to", str(t1)], capture_output=True, text=True, check=True)
-    return float(res.stdout.strip())
 
 
 def p_wave_speed(m):

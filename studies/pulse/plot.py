@@ -5,15 +5,16 @@ treatments, and computes the relative L2 differences against the extended run wi
 implementation the tests use (`silentmpm compare`).
 """
 import argparse
-import csv
 import json
 import os
-import subprocess
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import sys
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+from history import compare, read_history as read  # noqa: E402
 
 STYLE = {"free": ("tab:red", "--", "free boundary"),
          "silent": ("tab:blue", "-", "silent boundary"),
@@ -26,23 +27,6 @@ FIGURES = [("figure5.png", "compressive", "sxx", r"$\sigma_{xx}$ at A (MPa)",
             "Lateral stress at A, compressive pulse (paper Fig. 6)"),
            ("figure7.png", "shear", "sxy", r"$\tau_{xy}$ at A (MPa)",
             "Shear stress at A, shear pulse (paper Fig. 7)")]
-
-
-def read(path):
-    with open(path) as f:
-        r = csv.reader(f)
-        head = next(r)
-        cols = {h: [] for h in head}
-        for row in r:
-            for h, v in zip(head, row):
-                cols[h].append(float(v))
-    return cols
-
-
-def compare(binary, a, b, col, t0, t1):
-    res = subprocess.run([binary, "compare", a, b, "--column", col, "--from", str(t0),
-                          "--to", str(t1)], capture_output=True, text=True, check=True)
-    return float(res.stdout.strip())
 
 
 def main():
