@@ -1,5 +1,6 @@
 #pragma once
 // Helpers for the FEM tests: rectangular gmsh meshes written on the fly, and FEM models.
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,7 +15,7 @@ namespace smpm::fem_testing {
 namespace fs = std::filesystem;
 
 inline fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() / "smpm_fem_tests";
+  const fs::path d = fs::temp_directory_path() / ("smpm_fem_tests_" + std::to_string(::getpid()));
   fs::create_directories(d);
   return d;
 }

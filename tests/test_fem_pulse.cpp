@@ -9,6 +9,8 @@
 //    the grazing waves on the right side, not an MPM artefact.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <string>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -39,7 +41,7 @@ TEST(FemPulse, MpmAndFemAgreeOnThePulsePlate) {
   const auto study = nlohmann::json::parse(f);
   const double t0 = study["loads"]["compressive"]["window"][0];
   const double t1 = study["loads"]["compressive"]["window"][1];
-  const fs::path out = fs::temp_directory_path() / "smpm_fem_pulse_test";
+  const fs::path out = fs::temp_directory_path() / ("smpm_fem_pulse_test_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const std::vector<std::string> mpm = {"grid.cell=0.002", "boundaries.0.time.ramp=5e-6"};
   const std::vector<std::string> fem = {"fem.size=0.002", "fem.boundaries.0.time.ramp=5e-6"};

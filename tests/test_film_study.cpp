@@ -4,6 +4,8 @@
 // "j2_softening" case keys are validated with the key path in every message.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <string>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -40,7 +42,7 @@ History run_ci(const std::string& name, const fs::path& out) {
 }  // namespace
 
 TEST(FilmStudy, SilentTracksExtendedBetterThanFixedAtE) {
-  const fs::path out = fs::temp_directory_path() / "smpm_film_study_test";
+  const fs::path out = fs::temp_directory_path() / ("smpm_film_study_test_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const History ext = run_ci("extended", out);
   const History sil = run_ci("silent", out);
@@ -200,7 +202,7 @@ TEST(FilmStudy, SnapshotCarriesStateNormalAndJump) {
   Solver& s = *c.solver;
   const long n = std::lround(c.t_end / s.dt);
   for (long i = 0; i < n; ++i) s.step();
-  const fs::path dir = fs::temp_directory_path() / "smpm_film_snapshot_test";
+  const fs::path dir = fs::temp_directory_path() / ("smpm_film_snapshot_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   {

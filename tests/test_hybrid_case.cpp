@@ -3,6 +3,8 @@
 // all-FEM plate; history, summary and snapshots of both regions; errors name the key.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <string>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -27,7 +29,7 @@ const double W = 60 * h, Hgt = 30 * h, XI = 20 * h;
 const double cd = 5918.5;
 
 fs::path dir() {
-  const fs::path d = fs::temp_directory_path() / "smpm_hybrid_case";
+  const fs::path d = fs::temp_directory_path() / ("smpm_hybrid_case_" + std::to_string(::getpid()));
   fs::create_directories(d);
   return d;
 }

@@ -2,6 +2,7 @@
 // Helpers for the MPM-FEM hybrid tests: a tungsten strip [0, L] x [0, H] whose part x < xi is
 // particles and x > xi finite elements (a gmsh rectangle with curves 11 left = interface,
 // 12 right, 13 bottom, 14 top), or all particles, or all finite elements.
+#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,7 +21,7 @@ namespace fs = std::filesystem;
 // .geo of [x0, x1] x [y0, y1], square transfinite quads of size h.
 inline std::string box_geo(const std::string& name, double x0, double y0, double x1, double y1,
                            double h) {
-  const fs::path d = fs::temp_directory_path() / "smpm_hybrid_tests";
+  const fs::path d = fs::temp_directory_path() / ("smpm_hybrid_tests_" + std::to_string(::getpid()));
   fs::create_directories(d);
   const fs::path p = d / (name + ".geo");
   std::ofstream f(p);

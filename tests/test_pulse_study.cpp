@@ -3,6 +3,8 @@
 // window, and at most a tenth of what the free side departs, for both load cases.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <string>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -32,7 +34,7 @@ TEST(PulseStudy, SilentTracksExtendedAtReducedResolution) {
   std::ifstream f(root / "studies/pulse/study.json");
   ASSERT_TRUE(f.good());
   const auto study = nlohmann::json::parse(f);
-  const fs::path out = fs::temp_directory_path() / "smpm_pulse_study_test";
+  const fs::path out = fs::temp_directory_path() / ("smpm_pulse_study_test_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const std::string probe = study["probe"];
   for (const std::string load : {"compressive", "shear"}) {

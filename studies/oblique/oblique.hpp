@@ -20,6 +20,7 @@
 // |R_SP| = (c_d/c_s) div ratio (beyond the SV critical angle the reflected P is evanescent and
 // R_SP is not a travelling-wave amplitude: reported, not compared).
 #include <chrono>
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -59,7 +60,7 @@ struct Result {
 
 inline std::string rectangle_geo(const std::string& name, double lx, double ly, double h) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / "smpm_oblique";
+  const fs::path dir = fs::temp_directory_path() / ("smpm_oblique_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path p = dir / (name + ".geo");
   std::ofstream f(p);
