@@ -68,48 +68,122 @@ inline std::string rectangle_geo(const std::string& name, double lx, double ly, 
   return p.string();
 }
 
-inline Result measure(const Setup& su) {
-  const auto t_start = std::chrono::steady_clock::now();
-  const double h = su.h;
-  // Room for the beam: R sits (flat + taper + 20) cells above the bottom, the mesh is twice that
-  // plus 60 cells tall.
-  const int lx = 160, lext = 100;
-  const int yr = su.flat + su.taper + 20, ly = 2 * yr + 60;
+// The geometry, pulse, beam envelope and receiver windows of one measurement (the FEM and the
+// MPM runs share them).
+struct Plane {
+  bool sv;
+  double h;
+  int lx = 160, lext = 100;  // run A and the extension of run B (cells)
+  int yr, ly;                // receiver row and mesh height (cells)
   Material mat;
-  mat.name = "solid";
-  mat.E = 200e9;
-  mat.nu = su.nu;
-  mat.rho = 8000;
-  mat.derive();
-  const double th = su.angle_deg * M_PI / 180;
-  const double c = su.sv ? mat.cs : mat.cd;
-  const double nx = std::cos(th), ny = std::sin(th), tx = -ny, ty = nx;
-  const double dx = su.sv ? tx : nx, dy = su.sv ? ty : ny;
-  const double W = su.fwhm * h, F = su.flat * h, T = su.taper * h;
-  const double sig = W / 2.3548;  // Gaussian sigma of the pulse
-  const double rx = (lx - 20.5) * h, ry = (yr + 0.5) * h;
-  const double D = 4 * sig + 8 * h;
-  const double x0 = rx - D * nx, y0 = ry - D * ny;
-  // Gaussian displacement profile (smooth, so no grid-scale content that the coarse-mesh
-  // dispersion would smear over the reflected window), cut at 4 sigma.
-  auto G = [&](double s) { return std::abs(s) < 4 * sig ? std::exp(-0.5 * s * s / (sig * sig)) : 0.0; };
-  auto dG = [&](double s) { return -s / (sig * sig) * G(s); };
-  auto E = [&](double r) {
+  double th, c, nx, ny, tx, ty, dx, dy, F, T, sig, rx, ry, D, x0, y0;
+  // Windows at R: the incident pulse, and each reflected pulse around its plane-wave arrival
+  // (the reflected P returns after 2 d cos(theta_P) / c_d more, the reflected S after
+  // d (cos(theta_in) / c_in + cos(theta_S) / c_s)), each as long as the pulse plus 4 cells of
+  // travel on either side. Outside them R sees the waves the beam's tapered edges radiate.
+  double k, t_inc, t_p, t_s, half, t_end;
+  bool evanescent;
+
+  explicit Plane(const Setup& su) : sv(su.sv), h(su.h) {
+    // Room for the beam: R sits (flat + taper + 20) cells above the bottom, the mesh is twice
+    // that plus 60 cells tall.
+    yr = su.flat + su.taper + 20;
+    ly = 2 * yr + 60;
+    mat.name = "solid";
+    mat.E = 200e9;
+    mat.nu = su.nu;
+    mat.rho = 8000;
+    mat.derive();
+    th = su.angle_deg * M_PI / 180;
+    c = su.sv ? mat.cs : mat.cd;
+    nx = std::cos(th), ny = std::sin(th), tx = -ny, ty = nx;
+    dx = su.sv ? tx : nx, dy = su.sv ? ty : ny;
+    F = su.flat * h, T = su.taper * h;
+    sig = su.fwhm * h / 2.3548;  // Gaussian sigma of the pulse
+    rx = (lx - 20.5) * h, ry = (yr + 0.5) * h;
+    D = 4 * sig + 8 * h;
+    x0 = rx - D * nx, y0 = ry - D * ny;
+    k = mat.cs / mat.cd;
+    const double dr = lx * h - rx;  // distance from R to the boundary
+    const double sin_p = su.sv ? std::sin(th) / k : std::sin(th);  // reflected P angle
+    const double sin_s = su.sv ? std::sin(th) : k * std::sin(th);  // reflected S angle
+    evanescent = sin_p > 1;
+    const double cos_p = evanescent ? 0.0 : std::sqrt(1 - sin_p * sin_p);
+    const double cos_s = std::sqrt(1 - sin_s * sin_s);
+    t_inc = D / c;
+    t_p = t_inc + dr * (std::cos(th) / c + cos_p / mat.cd);
+    t_s = t_inc + dr * (std::cos(th) / c + cos_s / mat.cs);
+    half = 3 * sig / c + 4 * h / mat.cs;
+    t_end = std::max(t_p, t_s) + half;
+  }
+  // Beam envelope across the direction of travel: flat over |r| <= F, cos^2 taper over T.
+  double envelope(double r) const {
     const double a = std::abs(r);
     if (a <= F) return 1.0;
     if (a >= F + T) return 0.0;
     return std::pow(std::cos(M_PI * (a - F) / (2 * T)), 2);
-  };
+  }
+  double envelope_slope(double r) const {
+    const double a = std::abs(r);
+    if (a <= F || a >= F + T) return 0.0;
+    const double q = M_PI * (a - F) / (2 * T);
+    return -(r > 0 ? 1.0 : -1.0) * M_PI / (2 * T) * 2 * std::sin(q) * std::cos(q);
+  }
+  // One receiver sample: div and curl of run A and run B at R.
+  void record(Result& res, double t, double div_a, double curl_a, double div_b,
+              double curl_b) const {
+    const double inc = sv ? curl_b : div_b;
+    if (std::abs(t - t_inc) <= half) res.incident = std::max(res.incident, std::abs(inc));
+    if (std::abs(t - t_p) <= half) res.refl_div = std::max(res.refl_div, std::abs(div_a - div_b));
+    if (std::abs(t - t_s) <= half)
+      res.refl_curl = std::max(res.refl_curl, std::abs(curl_a - curl_b));
+    res.t.push_back(t);
+    res.inc.push_back(inc);
+    res.ddiv.push_back(div_a - div_b);
+    res.dcurl.push_back(curl_a - curl_b);
+  }
+  // The measured ratios beside the closed form.
+  void finish(Result& res, double dt) const {
+    res.window_incident = t_inc;
+    res.window_p = t_p;
+    res.window_s = t_s;
+    res.window_half = half;
+    const LKReflection ex = lk_reflection(mat.nu, 1, 1, th);
+    if (sv) {
+      res.r_same = res.refl_curl / res.incident;
+      res.r_conv = res.refl_div / res.incident / k;
+      res.exact_same = std::abs(ex.rss);
+      res.exact_conv = std::abs(ex.rsp);
+      res.evanescent = evanescent;
+    } else {
+      res.r_same = res.refl_div / res.incident;
+      res.r_conv = k * res.refl_curl / res.incident;
+      res.exact_same = std::abs(ex.rpp);
+      res.exact_conv = std::abs(ex.rps);
+    }
+    res.t_end = t_end;
+    res.dt = dt;
+  }
+};
+
+inline Result measure(const Setup& su) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const Plane w(su);
+  const double h = w.h, sig = w.sig, c = w.c;
+  // Gaussian displacement profile (smooth, so no grid-scale content that the coarse-mesh
+  // dispersion would smear over the reflected window), cut at 4 sigma.
+  auto G = [&](double s) { return std::abs(s) < 4 * sig ? std::exp(-0.5 * s * s / (sig * sig)) : 0.0; };
+  auto dG = [&](double s) { return -s / (sig * sig) * G(s); };
 
   auto build = [&](int cells_x, bool dashpot) {
     fem::Spec s;
     s.mesh = fem::load_mesh(
-        rectangle_geo("oblique_" + std::to_string(cells_x) + "x" + std::to_string(ly) + "_h" +
+        rectangle_geo("oblique_" + std::to_string(cells_x) + "x" + std::to_string(w.ly) + "_h" +
                           std::to_string(std::lround(h * 1e9)),
-                      cells_x * h, ly * h, h),
+                      cells_x * h, w.ly * h, h),
         h);
     s.degree = su.degree;
-    s.materials = {mat};
+    s.materials = {w.mat};
     s.region_material = {{1, 0}};
     s.threads = su.threads;
     if (dashpot) {
@@ -121,76 +195,35 @@ inline Result measure(const Setup& su) {
     }
     return std::make_unique<fem::Solver>(s);
   };
-  auto A = build(lx, true);
-  auto B = build(lx + lext, false);
+  auto A = build(w.lx, true);
+  auto B = build(w.lx + w.lext, false);
   const double dt = 0.5 * std::min(A->critical_dt(), B->critical_dt());
   for (fem::Solver* s : {A.get(), B.get()}) {
     s->set_dt(dt);
     auto& u = s->displacement();
     auto& v = s->velocity();
     for (std::size_t i = 0; i < s->nodes(); ++i) {
-      const double px = s->node_x()[i] - x0, py = s->node_y()[i] - y0;
-      const double sn = nx * px + ny * py, r = tx * px + ty * py;
-      const double e = E(r);
+      const double px = s->node_x()[i] - w.x0, py = s->node_y()[i] - w.y0;
+      const double sn = w.nx * px + w.ny * py, r = w.tx * px + w.ty * py;
+      const double e = w.envelope(r);
       const double g = G(sn) * e;
       // v at t = -dt/2: -c d G'(s + c dt / 2) E
       const double gv = -c * dG(sn + 0.5 * c * dt) * e;
-      u[2 * i] = dx * g;
-      u[2 * i + 1] = dy * g;
-      v[2 * i] = dx * gv;
-      v[2 * i + 1] = dy * gv;
+      u[2 * i] = w.dx * g;
+      u[2 * i + 1] = w.dy * g;
+      v[2 * i] = w.dx * gv;
+      v[2 * i + 1] = w.dy * gv;
     }
-    if (s->add_probe(rx, ry) != 0) throw std::runtime_error("oblique: receiver outside the mesh");
+    if (s->add_probe(w.rx, w.ry) != 0) throw std::runtime_error("oblique: receiver outside the mesh");
   }
-  // Windows at R: the incident pulse, and each reflected pulse around its plane-wave arrival
-  // (the reflected P returns after 2 d cos(theta_P) / c_d more, the reflected S after
-  // d (cos(theta_in) / c_in + cos(theta_S) / c_s)), each as long as the pulse plus 4 cells of
-  // travel on either side. Outside them R sees the waves the beam's tapered edges radiate.
-  const double k = mat.cs / mat.cd;
-  const double dr = lx * h - rx;  // distance from R to the boundary
-  const double sin_p = su.sv ? std::sin(th) / k : std::sin(th);  // reflected P angle
-  const double sin_s = su.sv ? std::sin(th) : k * std::sin(th);  // reflected S angle
-  const bool evanescent = sin_p > 1;
-  const double cos_p = evanescent ? 0.0 : std::sqrt(1 - sin_p * sin_p);
-  const double cos_s = std::sqrt(1 - sin_s * sin_s);
-  const double t_inc = D / c;
-  const double t_p = t_inc + dr * (std::cos(th) / c + cos_p / mat.cd);
-  const double t_s = t_inc + dr * (std::cos(th) / c + cos_s / mat.cs);
-  const double half = 3 * sig / c + 4 * h / mat.cs;
-  const double t_end = std::max(t_p, t_s) + half;
   Result res;
-  while (A->t < t_end) {
+  while (A->t < w.t_end) {
     A->step();
     B->step();
     const fem::Sample a = A->sample()[0], b = B->sample()[0];
-    const double tt = A->t;
-    if (std::abs(tt - t_inc) <= half) res.incident = std::max(res.incident, std::abs(su.sv ? b.curl : b.div));
-    if (std::abs(tt - t_p) <= half) res.refl_div = std::max(res.refl_div, std::abs(a.div - b.div));
-    if (std::abs(tt - t_s) <= half) res.refl_curl = std::max(res.refl_curl, std::abs(a.curl - b.curl));
-    res.t.push_back(tt);
-    res.inc.push_back(su.sv ? b.curl : b.div);
-    res.ddiv.push_back(a.div - b.div);
-    res.dcurl.push_back(a.curl - b.curl);
+    w.record(res, A->t, a.div, a.curl, b.div, b.curl);
   }
-  res.window_incident = t_inc;
-  res.window_p = t_p;
-  res.window_s = t_s;
-  res.window_half = half;
-  const LKReflection ex = lk_reflection(su.nu, 1, 1, th);
-  if (su.sv) {
-    res.r_same = res.refl_curl / res.incident;
-    res.r_conv = res.refl_div / res.incident / k;
-    res.exact_same = std::abs(ex.rss);
-    res.exact_conv = std::abs(ex.rsp);
-    res.evanescent = evanescent;
-  } else {
-    res.r_same = res.refl_div / res.incident;
-    res.r_conv = k * res.refl_curl / res.incident;
-    res.exact_same = std::abs(ex.rpp);
-    res.exact_conv = std::abs(ex.rps);
-  }
-  res.t_end = t_end;
-  res.dt = dt;
+  w.finish(res, dt);
   res.dofs_a = A->dofs();
   res.dofs_b = B->dofs();
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
