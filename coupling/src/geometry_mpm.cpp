@@ -221,15 +221,8 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
   for (long j = j0; j <= j1; ++j)
     for (long i = i0; i <= i1; ++i) {
       if (!mark[static_cast<std::size_t>(j - j0) * W + (i - i0)]) continue;
-      p.x[k] = G.x0 + (i + 0.5) * sp;
-      p.y[k] = G.y0 + (j + 0.5) * sp;
-      p.vx[k] = vx0;
-      p.vy[k] = vy0;
-      p.vol[k] = sp * sp;
-      p.mass[k] = rho * sp * sp;
-      p.id[k] = static_cast<uint32_t>(k);
-      p.body[k] = static_cast<uint16_t>(body);
-      p.group[k] = static_cast<uint16_t>(group);
+      p.place(k, G.x0 + (i + 0.5) * sp, G.y0 + (j + 0.5) * sp, sp * sp, rho, vx0, vy0, body,
+              group);
       ++k;
     }
   return count;

@@ -46,17 +46,8 @@ std::size_t Solver::seed_rectangle(double x0, double y0, double x1, double y1, i
   p.resize(first + cx * cy);
   std::size_t k = first;
   for (long j = 0; j < cy; ++j)
-    for (long i = 0; i < cx; ++i, ++k) {
-      p.x[k] = x0 + (i + 0.5) * dx;
-      p.y[k] = y0 + (j + 0.5) * dy;
-      p.vx[k] = vx0;
-      p.vy[k] = vy0;
-      p.vol[k] = dx * dy;
-      p.mass[k] = rho * dx * dy;
-      p.id[k] = static_cast<uint32_t>(k);
-      p.body[k] = static_cast<uint16_t>(body);
-      p.group[k] = static_cast<uint16_t>(group);
-    }
+    for (long i = 0; i < cx; ++i, ++k)
+      p.place(k, x0 + (i + 0.5) * dx, y0 + (j + 0.5) * dy, dx * dy, rho, vx0, vy0, body, group);
   return cx * cy;
 }
 

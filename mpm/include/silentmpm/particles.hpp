@@ -23,6 +23,20 @@ struct Particles {
 
   std::size_t size() const { return x.size(); }
   void resize(std::size_t n);
+  // Set the seeding fields of particle k (its id is k; stresses and history stay as resize left
+  // them, at zero).
+  void place(std::size_t k, double px, double py, double volume, double density, double v_x,
+             double v_y, int body_id, int group_id) {
+    x[k] = px;
+    y[k] = py;
+    vx[k] = v_x;
+    vy[k] = v_y;
+    vol[k] = volume;
+    mass[k] = density * volume;
+    id[k] = static_cast<uint32_t>(k);
+    body[k] = static_cast<uint16_t>(body_id);
+    group[k] = static_cast<uint16_t>(group_id);
+  }
   // Apply a permutation: new[k] = old[perm[k]].
   void permute(const std::vector<uint32_t>& perm);
   static constexpr std::size_t bytes_per_particle() {
