@@ -37,40 +37,35 @@ InclinedSpec ci_spec() {
   InclinedSpec s;
   s.theta_deg = 30;
   s.ppc = 4;       // 1 ppc carries the odd-even (hourglass) mode of one-point quadrature
-  s.fwhm = 8;
-  s.depth0 = 6;    // receivers 6-10 cells inside the edge
-  s.depth1 = 10;
+  s.fwhm = 16;
+  s.depth0 = 8;    // receivers 8-12 cells inside the edge
+  s.depth1 = 12;
   s.half_span = 6;
   return s;
 }
 
 // The measurement on a free edge (a = b = 0) against the closed form (|R_PP| = 0.754,
-// |R_PS| = 0.876 for nu = 0.33 at 30 degrees), then the silent edge at the same size.
-//
-// The silent edge does NOT reach the closed form (|R_PP| = 0.012, |R_PS| = 0.028) at this size:
-// the particle lattice makes the inclined edge a staircase, and the measured reflection is
-// dominated by the staircase's scattering, which decays with the distance from the edge and
-// with the pulse width (studies/geometry/README.md: |R_PP| 0.22 / 0.14 / 0.093 / 0.056 for
-// FWHM 8 / 12 / 16 / 24 cells, receivers 10-16 cells deep). What this test holds at CI size: the
-// measurement is right (free edge), the silent layer removes most of the free edge's reflection
-// on the inclined edge, and a grid-aligned silent edge reflects far less.
+// |R_PS| = 0.876 for nu = 0.33 at 30 degrees), then the silent edge (closed form |R_PP| = 0.0122,
+// |R_PS| = 0.0284) within the 20 %, and the grid-aligned silent edge (closed form 0).
+// R are displacement-amplitude ratios (div u, curl u; REFERENCE.md §4.1). Measured on velocities
+// the same runs give 0.04-0.3: the particle staircase of the inclined edge scatters a short-wave
+// near field that the time derivative weights one order more and that decays with the distance
+// from the edge (studies/geometry/README.md).
 TEST(GeometrySilent, Inclined30FreeAndSilentEdges) {
   InclinedSpec free_spec = ci_spec();
   free_spec.a = free_spec.b = 0;
   const InclinedResult f = run(free_spec);
-  EXPECT_NEAR(f.rpp, f.rpp_exact, 0.05 * f.rpp_exact);
-  EXPECT_NEAR(f.rps, f.rps_exact, 0.15 * f.rps_exact);
+  EXPECT_NEAR(f.rpp, f.rpp_exact, 0.03 * f.rpp_exact);  // measured +0.5 %
+  EXPECT_NEAR(f.rps, f.rps_exact, 0.06 * f.rps_exact);  // measured +2 %
 
   const InclinedResult r = run(ci_spec());
-  EXPECT_LT(r.rpp, 0.5 * f.rpp);   // measured 0.31 vs 0.74
-  EXPECT_LT(r.rps, 0.25 * f.rps);  // measured 0.16 vs 0.83
-  EXPECT_GT(r.rpp, r.rpp_exact);   // the staircase adds to the closed form's reflection
+  EXPECT_NEAR(r.rpp, r.rpp_exact, 0.2 * r.rpp_exact);   // measured 0.0127 vs 0.0122
+  EXPECT_NEAR(r.rps, r.rps_exact, 0.2 * r.rps_exact);   // measured 0.0312 vs 0.0284
 
   InclinedSpec s0 = ci_spec();
   s0.theta_deg = 0;
   const InclinedResult r0 = run(s0);
-  EXPECT_LT(r0.rpp, 0.15);         // measured 0.10 (div-based, receivers 6-10 cells deep)
-  EXPECT_LT(r0.rpp, 0.5 * r.rpp);
+  EXPECT_LT(r0.rpp, 6e-3);         // closed form 0; measured 0.0038 (the discrete layer at 16 cells)
   EXPECT_NEAR(r0.rps, 0.0, 1e-6);  // normal incidence: no SV at all
 }
 

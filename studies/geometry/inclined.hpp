@@ -45,6 +45,9 @@ struct InclinedSpec {
   double a = 1, b = 1;      // LK coefficients (0, 0: a free edge)
   std::string form, anchor; // silent layer options (empty: the defaults)
   double width = 0;         // silent layer depth, cells (0: the default, one cell)
+  // Measure div/curl of the displacement (REFERENCE.md §4.1: R are displacement-amplitude
+  // ratios) or, if false, of the velocity (weights the high frequencies one order more).
+  bool displacement = true;
 };
 
 struct InclinedResult {
@@ -166,8 +169,13 @@ inline InclinedResult measure_inclined(const std::string& source_dir, const Incl
                   std::vector<double>& vy) {
     for (std::size_t k = 0; k < sol.p.size(); ++k) {
       const long c = cell[sol.p.id[k]];
-      vx[c] = sol.p.vx[k];
-      vy[c] = sol.p.vy[k];
+      if (s.displacement) {  // u = x - X, X the particle's lattice point
+        vx[c] = sol.p.x[k] - (gx0 + (c % NI + 0.5) * sp);
+        vy[c] = sol.p.y[k] - (gy0 + (c / NI + 0.5) * sp);
+      } else {
+        vx[c] = sol.p.vx[k];
+        vy[c] = sol.p.vy[k];
+      }
     }
   };
   double max_div_b = 0, max_div_d = 0, max_curl_d = 0;
