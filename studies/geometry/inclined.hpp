@@ -7,11 +7,11 @@
 // normal traction, rollers (v_y = 0) on the bottom and top grid lines so the incident wave is
 // plane (uniaxial strain). Run B: the same plate extended far to the right (a box), nothing
 // returns from its end within the window. Same grid, same particle lattice where A has
-// particles, identical dt. The difference D = v_A - v_B on the particle lattice is the
-// reflected field; div D and curl D by central differences on the lattice (spacing h/n),
-// sampled every step at the receivers: particles between depth0 and depth1 cells inside the
-// edge, within half_span cells of its mid-height point along it.
-//   |R_PP| = max|div D| / max|div v_B|,   |R_PS| = (c_s / c_d) max|curl D| / max|div v_B|
+// particles, identical dt. The difference D = u_A - u_B of the particle displacements on the
+// particle lattice is the reflected field; div D and curl D by central differences on the
+// lattice (spacing h/n), sampled every step at the receivers: particles between depth0 and
+// depth1 cells inside the edge, within half_span cells of its mid-height point along it.
+//   |R_PP| = max|div D| / max|div u_B|,   |R_PS| = (c_s / c_d) max|curl D| / max|div u_B|
 // (REFERENCE.md §4.1), the maxima over the receivers and the window. The window ends before any
 // signal from the plate's corners can reach the receivers (checked; an error otherwise).
 #include <algorithm>

@@ -36,32 +36,46 @@ def main():
     metrics = {}
 
     # ---- inclined edge ----
-    rows = read_csv(os.path.join(out, "inclined.csv"))
-    var_path = os.path.join(out, "inclined_variants.csv")
-    variants = read_csv(var_path) if os.path.exists(var_path) else []
+    rows = read_csv(os.path.join(out, "inclined_widths.csv"))
+    opt = lambda name: read_csv(os.path.join(out, name)) if os.path.exists(os.path.join(out, name)) else []  # noqa: E731
+    depths, variants = opt("inclined_depths.csv"), opt("inclined_variants.csv")
     f = lambda r, k: float(r[k])  # noqa: E731
-    free = [r for r in rows if f(r, "a") == 0]
-    normal = [r for r in rows if f(r, "theta_deg") == 0]
-    silent = [r for r in rows if f(r, "a") == 1 and f(r, "theta_deg") == 30]
-    silent.sort(key=lambda r: f(r, "fwhm_cells"))
-    inc = {"method": "extended-domain differencing, div/curl of the particle-velocity difference on "
-                     "the particle lattice, receivers 10-16 cells inside the edge, 4 ppc, aluminium "
-                     "(nu = 0.33), sin^2 pulse",
+    disp = lambda rs: [r for r in rs if r["measure"] == "displacement"]  # noqa: E731
+    free = [r for r in disp(rows) if f(r, "a") == 0]
+    normal = [r for r in disp(rows) if f(r, "theta_deg") == 0]
+    silent30 = lambda rs: sorted([r for r in rs if f(r, "a") == 1 and f(r, "theta_deg") == 30],  # noqa: E731
+                                 key=lambda r: (f(r, "fwhm_cells"), f(r, "depth0_cells")))
+    silent = silent30(disp(rows))
+    silent_v = silent30([r for r in rows if r["measure"] == "velocity"])
+    row = lambda r: {"fwhm_cells": f(r, "fwhm_cells"), "receivers_cells": [f(r, "depth0_cells"), f(r, "depth1_cells")],  # noqa: E731
+                     "rpp": f(r, "rpp"), "rps": f(r, "rps"),
+                     "rpp_rel_error": f(r, "rpp") / f(r, "rpp_exact") - 1 if f(r, "rpp_exact") > 0 else None,
+                     "rps_rel_error": f(r, "rps") / f(r, "rps_exact") - 1 if f(r, "rps_exact") > 0 else None,
+                     "particles": int(f(r, "particles_a")) + int(f(r, "particles_b")),
+                     "wall_seconds": f(r, "wall_seconds")}
+    inc = {"method": "extended-domain differencing, div/curl of the particle-displacement difference on "
+                     "the particle lattice (R are displacement-amplitude ratios, REFERENCE.md §4.1), "
+                     "receivers 8-12 cells inside the edge unless stated, 4 ppc, aluminium (nu = 0.33), "
+                     "sin^2 pulse",
            "closed_form_30deg": {"rpp": f(silent[0], "rpp_exact"), "rps": f(silent[0], "rps_exact")},
-           "free_edge_30deg": [{"fwhm_cells": f(r, "fwhm_cells"), "rpp": f(r, "rpp"), "rpp_exact": f(r, "rpp_exact"),
-                                "rps": f(r, "rps"), "rps_exact": f(r, "rps_exact")} for r in free],
-           "silent_edge_0deg": [{"fwhm_cells": f(r, "fwhm_cells"), "rpp": f(r, "rpp")} for r in normal],
-           "silent_edge_30deg": [{"fwhm_cells": f(r, "fwhm_cells"), "rpp": f(r, "rpp"), "rps": f(r, "rps"),
-                                  "particles": int(f(r, "particles_a")) + int(f(r, "particles_b")),
-                                  "wall_seconds": f(r, "wall_seconds")} for r in silent],
-           "silent_edge_30deg_variants": [{"form": r["form"], "anchor": r["anchor"], "fwhm_cells": f(r, "fwhm_cells"),
-                                           "rpp": f(r, "rpp"), "rps": f(r, "rps")} for r in variants]}
+           "free_edge_30deg": [dict(row(r), rpp_exact=f(r, "rpp_exact"), rps_exact=f(r, "rps_exact")) for r in free],
+           "silent_edge_0deg": [row(r) for r in normal],
+           "silent_edge_30deg": [row(r) for r in silent],
+           "silent_edge_30deg_velocity_measure": [row(r) for r in silent_v],
+           "silent_edge_30deg_receiver_depth": [row(r) for r in silent30(depths)],
+           "silent_edge_30deg_variants": [dict(row(r), form=r["form"], anchor=r["anchor"]) for r in variants]}
     metrics["inclined_30deg"] = inc
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, axs = plt.subplots(1, 2, figsize=(10.5, 4.4))
+    ax = axs[0]
     w = [f(r, "fwhm_cells") for r in silent]
-    ax.loglog(w, [f(r, "rpp") for r in silent], "o-", color="tab:blue", label=r"$|R_{PP}|$ measured")
-    ax.loglog(w, [f(r, "rps") for r in silent], "s-", color="tab:red", label=r"$|R_{PS}|$ measured")
+    ax.loglog(w, [f(r, "rpp") for r in silent], "o-", color="tab:blue", label=r"$|R_{PP}|$ (div u)")
+    ax.loglog(w, [f(r, "rps") for r in silent], "s-", color="tab:red", label=r"$|R_{PS}|$ (curl u)")
+    wv = [f(r, "fwhm_cells") for r in silent_v]
+    ax.loglog(wv, [f(r, "rpp") for r in silent_v], "o--", color="tab:blue", alpha=0.5, mfc="none",
+              label=r"$|R_{PP}|$ on velocities")
+    ax.loglog(wv, [f(r, "rps") for r in silent_v], "s--", color="tab:red", alpha=0.5, mfc="none",
+              label=r"$|R_{PS}|$ on velocities")
     ax.axhline(f(silent[0], "rpp_exact"), color="tab:blue", ls=":", label=r"$|R_{PP}|$ closed form")
     ax.axhline(f(silent[0], "rps_exact"), color="tab:red", ls=":", label=r"$|R_{PS}|$ closed form")
     for r in variants:
@@ -69,10 +83,23 @@ def main():
         ax.plot([f(r, "fwhm_cells")], [f(r, "rps")], "+", color="tab:red", ms=9)
     ax.set_xlabel("pulse width (FWHM, cells)")
     ax.set_ylabel("reflected amplitude / incident")
-    ax.set_title("Silent edge at 30° (aluminium, 4 ppc)\n"
-                 "x, +: anchor at the particle (nodal and paper forms)", fontsize=10)
+    ax.set_title("Silent edge at 30° (aluminium, 4 ppc), receivers 8-12 cells deep\n"
+                 "x, +: anchor at the particle (nodal and paper forms)", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
+    ax = axs[1]
+    dr = silent30(depths)
+    if dr:
+        dm = [0.5 * (f(r, "depth0_cells") + f(r, "depth1_cells")) for r in dr]
+        ax.plot(dm, [f(r, "rpp") for r in dr], "o-", color="tab:blue", label=r"$|R_{PP}|$")
+        ax.plot(dm, [f(r, "rps") for r in dr], "s-", color="tab:red", label=r"$|R_{PS}|$")
+        ax.axhline(f(dr[0], "rpp_exact"), color="tab:blue", ls=":")
+        ax.axhline(f(dr[0], "rps_exact"), color="tab:red", ls=":")
+        ax.set_ylim(0, None)
+        ax.set_xlabel("receiver depth below the edge (cells, band centre)")
+        ax.set_title("FWHM 16 cells: the excess is a near field of the edge", fontsize=9)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "inclined_reflection.png"), dpi=130)
     plt.close(fig)
