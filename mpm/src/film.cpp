@@ -1,5 +1,5 @@
-// Bifurcation sweep, closed-form J2 criterion and the decohesion return mapping
-// (bifurcation.hpp, decohesion.hpp).
+// Bifurcation sweep, its Fourier-form fast check, the closed-form J2 criterion and the
+// decohesion return mapping (bifurcation.hpp, decohesion.hpp).
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -132,6 +132,224 @@ BifurcationResult bifurcation_sweep(const double C[16], const BifurcationParams&
   }
   r.bifurcated = best <= 0;
   return r;
+}
+
+// ------------------------------------------------------------------------------------------
+// Fourier form
+
+namespace {
+// Coefficients (c0, cos phi, sin phi, cos 2phi, sin 2phi) of (p1 + r1 cos phi + s1 sin phi) *
+// (p2 + r2 cos phi + s2 sin phi), added with the sign sg.
+inline void add_product(double sg, double p1, double r1, double s1, double p2, double r2,
+                        double s2, AcousticFourier& F) {
+  F.a0 += sg * (p1 * p2 + 0.5 * (r1 * r2 + s1 * s2));
+  F.a1 += sg * (p1 * r2 + p2 * r1);
+  F.b1 += sg * (p1 * s2 + p2 * s1);
+  F.a2 += sg * 0.5 * (r1 * r2 - s1 * s2);
+  F.b2 += sg * 0.5 * (r1 * s2 + r2 * s1);
+}
+}  // namespace
+
+AcousticFourier acoustic_fourier(const double C[16]) {
+  // Q_jk = A_jk c^2 + B_jk c s + D_jk s^2 (c = cos th, s = sin th)
+  //      = P_jk + R_jk cos 2th + S_jk sin 2th,  P = (A + D)/2, R = (A - D)/2, S = B/2.
+  double P[2][2], R[2][2], S[2][2];
+  for (int j = 0; j < 2; ++j)
+    for (int k = 0; k < 2; ++k) {
+      const double A = C[((0 * 2 + j) * 2 + k) * 2 + 0];
+      const double B = C[((0 * 2 + j) * 2 + k) * 2 + 1] + C[((1 * 2 + j) * 2 + k) * 2 + 0];
+      const double D = C[((1 * 2 + j) * 2 + k) * 2 + 1];
+      P[j][k] = 0.5 * (A + D);
+      R[j][k] = 0.5 * (A - D);
+      S[j][k] = 0.5 * B;
+    }
+  AcousticFourier F;
+  add_product(1, P[0][0], R[0][0], S[0][0], P[1][1], R[1][1], S[1][1], F);
+  add_product(-1, P[0][1], R[0][1], S[0][1], P[1][0], R[1][0], S[1][0], F);
+  return F;
+}
+
+double AcousticFourier::operator()(double th) const {
+  const double c = std::cos(2 * th), s = std::sin(2 * th);
+  return a0 + a1 * c + b1 * s + a2 * (c * c - s * s) + b2 * (2 * s * c);
+}
+
+double AcousticFourier::lower_bound() const {
+  return a0 - std::sqrt(a1 * a1 + b1 * b1) - std::sqrt(a2 * a2 + b2 * b2);
+}
+
+double AcousticFourier::magnitude() const {
+  return std::fabs(a0) + std::sqrt(a1 * a1 + b1 * b1) + std::sqrt(a2 * a2 + b2 * b2);
+}
+
+namespace {
+// cos and sin of phi_k = k 2 pi / 64, k = 0 .. 63: the sample points of the Fourier form (the
+// even ones) and their midpoints (the odd ones), without a trigonometric call per particle.
+constexpr int kTab = 64;
+struct Table {
+  double c[kTab], s[kTab];
+  Table() {
+    for (int k = 0; k < kTab; ++k) {
+      c[k] = std::cos(k * 2 * kPi / kTab);
+      s[k] = std::sin(k * 2 * kPi / kTab);
+    }
+  }
+};
+const Table kTable;
+
+// g(phi) = det Q at th = phi / 2 and its first two derivatives in phi, from cos phi and sin phi.
+struct FourierPhi {
+  const AcousticFourier& F;
+  double g(double c, double s) const {
+    return F.a0 + F.a1 * c + F.b1 * s + F.a2 * (c * c - s * s) + F.b2 * 2 * s * c;
+  }
+  double d1(double c, double s) const {
+    return -F.a1 * s + F.b1 * c + 2 * (-F.a2 * 2 * s * c + F.b2 * (c * c - s * s));
+  }
+  double d2(double c, double s) const {
+    return -F.a1 * c - F.b1 * s - 4 * (F.a2 * (c * c - s * s) + F.b2 * 2 * s * c);
+  }
+};
+}  // namespace
+
+BifurcationResult acoustic_min_fourier(const AcousticFourier& F, const BifurcationParams& P,
+                                       double scale) {
+  // In phi = 2 th in [0, 2 pi): g(phi) = a0 + a1 cos phi + b1 sin phi + a2 cos 2phi + b2 sin 2phi,
+  // whose derivatives are bounded: |g2| <= r1 + 4 r2 and |g3| <= r1 + 8 r2 (g2, g3 the second and
+  // third derivatives, r1 = |(a1,b1)|, r2 = |(a2,b2)|). An interval [a, b] is settled when
+  //   the slope g1 has one sign at both ends and |g1(a)| + |g1(b)| > (r1 + 4 r2)(b - a): no root
+  //     of g1 (it cannot go to zero and back within the width at that rate), or
+  //   |g2(mid)| > (r1 + 8 r2)(b - a)/2: g2 keeps its sign, g1 is monotone: no root (same signs)
+  //     or exactly one (a minimum of g when g1 goes from - to +: Newton in the bracket);
+  // otherwise it is halved. A root of g1 on a common end belongs to the interval on its right
+  // (g1 = 0 counts as negative), so no minimum is found twice. 32 starting intervals.
+  const double r1 = std::sqrt(F.a1 * F.a1 + F.b1 * F.b1), r2 = std::sqrt(F.a2 * F.a2 + F.b2 * F.b2);
+  BifurcationResult res;
+  if (!(r1 + r2 > 1e-14 * std::fabs(F.a0))) {  // constant: every angle is a minimum
+    res.theta = 0;
+    res.det_min = F.a0;
+    res.minima = 1;
+    res.bifurcated = F.a0 <= 0;
+    return res;
+  }
+  const FourierPhi G{F};
+  const double L2 = r1 + 4 * r2, L3 = r1 + 8 * r2;
+  constexpr int N = kTab / 2;
+  constexpr double h = 2 * kPi / N;
+  struct Iv { double a, b, ga, gb; int depth, k; };  // k: table index of the midpoint, or -1
+  constexpr int kStack = N + 256;
+  Iv stack[kStack];
+  int ns = 0;
+  double g1[N + 1];
+  for (int k = 0; k < N; ++k) g1[k] = G.d1(kTable.c[2 * k], kTable.s[2 * k]);
+  g1[N] = g1[0];  // periodic: the same value at 0 and 2 pi
+  for (int k = N - 1; k >= 0; --k) stack[ns++] = {k * h, (k + 1) * h, g1[k], g1[k + 1], 0, 2 * k + 1};
+  struct Cand { double phi, det; };
+  Cand cands[8];
+  int nc = 0;
+  while (ns > 0) {
+    const Iv iv = stack[--ns];
+    const bool neg_a = !(iv.ga > 0), neg_b = !(iv.gb > 0);
+    const double w = iv.b - iv.a, m = 0.5 * (iv.a + iv.b);
+    double cm, sm;
+    if (iv.k >= 0) {
+      cm = kTable.c[iv.k];
+      sm = kTable.s[iv.k];
+    } else {
+      cm = std::cos(m);
+      sm = std::sin(m);
+    }
+    const bool monotone = std::fabs(G.d2(cm, sm)) > L3 * 0.5 * w;
+    if (neg_a == neg_b) {
+      if (monotone || std::fabs(iv.ga) + std::fabs(iv.gb) > L2 * w) continue;
+    } else if (monotone) {
+      if (!neg_a) continue;  // + to -: a maximum of g
+      // One root of g1 in [a, b), g1 increasing: Newton kept inside the bracket.
+      double lo = iv.a, hi = iv.b, x = iv.a - iv.ga * w / (iv.gb - iv.ga);
+      for (int it = 0; it < 60; ++it) {
+        const double c = std::cos(x), s = std::sin(x);
+        const double f1 = G.d1(c, s);
+        if (!(f1 > 0)) lo = x; else hi = x;
+        if (f1 == 0) break;
+        double xn = x - f1 / G.d2(c, s);
+        if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
+        const bool done = std::fabs(xn - x) <= 1e-15 * (1 + std::fabs(x)) || hi - lo <= 1e-15;
+        x = xn;
+        if (done) break;
+      }
+      if (nc < 8) cands[nc++] = {x, G.g(std::cos(x), std::sin(x))};
+      continue;
+    }
+    if (iv.depth >= 40 || ns + 2 > kStack) {
+      // Not certified within 2 pi / 2^45: a degenerate critical point; take the midpoint.
+      if (neg_a && !neg_b && nc < 8) cands[nc++] = {m, G.g(cm, sm)};
+      continue;
+    }
+    const double gm = G.d1(cm, sm);
+    stack[ns++] = {m, iv.b, gm, iv.gb, iv.depth + 1, -1};
+    stack[ns++] = {iv.a, m, iv.ga, gm, iv.depth + 1, -1};
+  }
+  if (nc == 0) {  // cannot happen for a non-constant periodic g; keep the sampled minimum
+    int best = 0;
+    double gb = G.g(1, 0);
+    for (int k = 1; k < N; ++k) {
+      const double v = G.g(kTable.c[2 * k], kTable.s[2 * k]);
+      if (v < gb) gb = v, best = k;
+    }
+    cands[nc++] = {best * h, gb};
+  }
+  double best = cands[0].det;
+  for (int q = 1; q < nc; ++q) best = std::min(best, cands[q].det);
+  const double tol = P.tie_tolerance * std::fabs(scale);
+  res.det_min = best;
+  bool first = true;
+  for (int q = 0; q < nc; ++q) {
+    if (cands[q].det > best + tol) continue;
+    const double th = wrap_deg(cands[q].phi * 0.5 / kDeg);
+    ++res.minima;
+    const bool better = P.tie == TieBreak::SmallestAngle ? th < res.theta : th > res.theta;
+    if (first || better) res.theta = th;
+    first = false;
+  }
+  res.bifurcated = best <= 0;
+  return res;
+}
+
+double acoustic_sampled_bound(const AcousticFourier& F) {
+  // 32 samples in phi = 2 th (h = 2 pi / 32); between two samples g lies above the chord minus
+  // max|g2| h^2 / 8, max|g2| <= |(a1,b1)| + 4 |(a2,b2)| (g2 the second derivative in phi).
+  const FourierPhi G{F};
+  constexpr int N = kTab / 2;
+  constexpr double h = 2 * kPi / N;
+  double gmin = G.g(1, 0);
+  for (int k = 1; k < N; ++k) gmin = std::min(gmin, G.g(kTable.c[2 * k], kTable.s[2 * k]));
+  const double L2 = std::sqrt(F.a1 * F.a1 + F.b1 * F.b1) + 4 * std::sqrt(F.a2 * F.a2 + F.b2 * F.b2);
+  return gmin - L2 * h * h / 8;
+}
+
+BifurcationResult bifurcation_check(const double C[16], const BifurcationParams& P, double scale,
+                                    int* stage) {
+  const AcousticFourier F = acoustic_fourier(C);
+  const double margin = 1e-10 * F.magnitude();
+  BifurcationResult r;
+  r.minima = 1;
+  r.det_min = F.lower_bound();
+  if (r.det_min > margin) {
+    if (stage) *stage = 1;
+    return r;
+  }
+  r.det_min = acoustic_sampled_bound(F);
+  if (r.det_min > margin) {
+    if (stage) *stage = 2;
+    return r;
+  }
+  r = acoustic_min_fourier(F, P, scale);
+  if (r.det_min > margin) {
+    if (stage) *stage = 3;
+    return r;
+  }
+  if (stage) *stage = 4;
+  return bifurcation_sweep(C, P, scale);
 }
 
 double hcr_j2(double sxx, double syy, double szz, double sxy, double mu, double M, double th) {

@@ -37,6 +37,45 @@ double acoustic_det(const double C[16], double theta_rad);
 // (for the tie tolerance).
 BifurcationResult bifurcation_sweep(const double C[16], const BifurcationParams& P, double scale);
 
+// ------------------------------------------------------------------------------------------
+// Fourier form (the fast check). Q(n) is quadratic in n = (cos th, sin th), so det Q is a
+// homogeneous quartic in (cos th, sin th), i.e. exactly
+//   det Q(th) = a0 + a1 cos 2th + b1 sin 2th + a2 cos 4th + b2 sin 4th,
+// with the five coefficients in closed form from the tangent (acoustic_fourier). Then
+//   det Q(th) >= a0 - |(a1, b1)| - |(a2, b2)|   for every th   (lower_bound),
+// and the minimum over th is located from the derivative of this form (acoustic_min_fourier).
+struct AcousticFourier {
+  double a0 = 0, a1 = 0, b1 = 0, a2 = 0, b2 = 0;
+  double operator()(double theta_rad) const;  // det Q(theta)
+  double lower_bound() const;                 // a0 - |(a1,b1)| - |(a2,b2)|
+  double magnitude() const;                   // |a0| + |(a1,b1)| + |(a2,b2)| (round-off scale)
+};
+AcousticFourier acoustic_fourier(const double C[16]);
+
+// Every local minimum of the Fourier form located (critical points of d/dth det Q bracketed on
+// intervals certified by bounds on the second and third derivatives, then safeguarded Newton),
+// the global one chosen with the tie-break of bifurcation_sweep (minima within
+// tie_tolerance * |scale| tie). theta in degrees, [0, 180); bifurcated = det_min <= 0.
+BifurcationResult acoustic_min_fourier(const AcousticFourier& F, const BifurcationParams& P,
+                                       double scale);
+
+// A lower bound of det Q from 32 samples of the Fourier form: min over the samples minus
+// max|d2/dphi2| h^2 / 8 (phi = 2 theta, h = 2 pi / 32, max|d2/dphi2| <= |(a1,b1)| + 4 |(a2,b2)|).
+double acoustic_sampled_bound(const AcousticFourier& F);
+
+// The check the film model runs after every plastic step; same verdict and plane as
+// bifurcation_sweep, cheaper:
+//   1. lower bound > round-off margin: no bifurcation (theta = 0, det_min = the bound);
+//   2. else the sampled bound > margin: no bifurcation (theta = 0, det_min = that bound);
+//   3. else the Fourier minimum; above the margin: no bifurcation (theta, det_min from it);
+//   4. else (at or near bifurcation) bifurcation_sweep decides and gives the plane, so that the
+//      critical plane is the sweep's to the last bit.
+// The margin, 1e-10 * magnitude(), is far above the round-off of evaluating det Q, so whenever
+// 1, 2 or 3 answer "no", every evaluation of the sweep is positive too: the verdict is the same.
+// stage (optional) gets 1 to 4.
+BifurcationResult bifurcation_check(const double C[16], const BifurcationParams& P, double scale,
+                                    int* stage = nullptr);
+
 // Closed-form J2 criterion (REFERENCE.md §5): bifurcation on the plane of normal n iff
 // H <= H_cr(n) = 6G(|a|^2 - (a.n)^2) + (6G^2/M)(a.n)^2 - 3G, a = N n (in-plane block of s/|s|).
 double hcr_j2(double sxx, double syy, double szz, double sxy, double mu, double M, double theta_rad);

@@ -3,10 +3,12 @@
 // machine  elastic -> plastic -> decohesion -> separated  (REFERENCE.md §5).
 //
 //   elastic / plastic  J2 with hardening then softening (j2soft.hpp). After every plastic
-//                      loading step the acoustic tensor of the continuum tangent is swept
-//                      (bifurcation.hpp); at min det Q <= 0 the particle stores the critical
-//                      normal, the tractions on that plane (the strengths) and its smear length,
-//                      and turns to decohesion (if decohesion is enabled; otherwise it stays
+//                      loading step the acoustic tensor of the continuum tangent is checked
+//                      (bifurcation_check: exact bounds of the Fourier form of det Q first,
+//                      the reference sweep only at bifurcation; bifurcation.hpp); at
+//                      min det Q <= 0 the particle stores the critical normal, the tractions
+//                      on that plane (the strengths) and its smear length, and turns to
+//                      decohesion (if decohesion is enabled; otherwise it stays
 //                      plastic and keeps the first critical normal).
 //   decohesion         elastic continuum with frozen plastic strain plus the smeared jump
 //                      (decohesion.hpp); separated once ubar reaches 1.
@@ -43,7 +45,7 @@ inline double film_update(const Material& m, Particles& p, std::size_t k, double
   if (!m.bif.enabled || (!m.coh.enabled && (p.dnx[k] != 0 || p.dny[k] != 0))) return w;
   double C[16];
   j2_tangent(m.lambda, m.mu, sxx, syy, szz, sxy, j2_beta(m.mu, r.H), C);
-  const BifurcationResult b = bifurcation_sweep(C, m.bif, m.mu * m.M);
+  const BifurcationResult b = bifurcation_check(C, m.bif, m.mu * m.M);
   if (!b.bifurcated) return w;
   const double th = b.theta * 3.14159265358979323846 / 180.0;
   Discontinuity d;
