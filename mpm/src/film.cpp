@@ -458,21 +458,45 @@ double decohesion_update(const DecohesionParams& P, double lambda, double mu, Di
   };
   // Bracket: phi(0) > 0; grow the upper end until phi <= 0 (x -> infinity gives tau -> 0).
   double lo = 0, hi = 1.0 / (cn * kn + ct * kt), dn = 0, dt = 0;
+  double phi_lo = f0, phi_hi;
   int grow = 0;
-  while (eval(hi, dn, dt) > 0 && grow < 200) {
+  while ((phi_hi = eval(hi, dn, dt)) > 0 && grow < 200) {
     lo = hi;
+    phi_lo = phi_hi;
     hi *= 4;
     ++grow;
   }
   bool separates = grow >= 200;
   double x = hi;
   if (!separates) {
-    for (int it = 0; it < 200; ++it) {
-      x = 0.5 * (lo + hi);
-      if (eval(x, dn, dt) > 0) lo = x; else hi = x;
-      if (hi - lo <= 1e-14 * hi) break;
+    // phi decreases in x (the tractions fall, ubar grows): Newton from the secant point, kept
+    // inside the bracket (bisection when a step leaves it), to 1e-14 relative in x.
+    const double An = cn * kn, At = ct * kt;
+    const double iun2 = 1 / (P.u_nf * P.u_nf), iut2 = 1 / (P.u_tf * P.u_tf);
+    const double itn2 = 1 / (d.tnf * d.tnf), itt2 = 1 / (d.ttf * d.ttf);
+    x = lo + (hi - lo) * phi_lo / (phi_lo - phi_hi);
+    for (int it = 0; it < 100; ++it) {
+      const double en = 1 / (1 + An * x), et = 1 / (1 + At * x);
+      const double taun = tnp * en, taut = tt * et;
+      dn = kn * x * taun;
+      dt = kt * x * taut;
+      const double S = std::sqrt(taun * taun * itn2 + taut * taut * itt2);
+      const double U2 = dn * dn * iun2 + dt * dt * iut2;
+      const double U = std::sqrt(U2);
+      const double phi = S - (1 - d.ubar - U);
+      if (phi > 0) lo = x; else hi = x;
+      // phi' = dS/dx + dU/dx, with dtau/dx = -A tau e and d(du)/dx = k tau e.
+      const double dS = S > 0 ? -(taun * taun * An * en * itn2 + taut * taut * At * et * itt2) / S : 0.0;
+      const double vn = kn * taun * en, vt = kt * taut * et;
+      const double dU = U > 0 ? (dn * vn * iun2 + dt * vt * iut2) / U
+                              : std::sqrt(vn * vn * iun2 + vt * vt * iut2);
+      const double dphi = dS + dU;
+      double xn = dphi < 0 ? x - phi / dphi : 0.5 * (lo + hi);
+      if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
+      const bool done = std::fabs(xn - x) <= 1e-14 * x || hi - lo <= 1e-14 * hi;
+      x = xn;
+      if (done) break;
     }
-    x = hi;
     eval(x, dn, dt);
     const double ub = d.ubar + std::sqrt((dn / P.u_nf) * (dn / P.u_nf) + (dt / P.u_tf) * (dt / P.u_tf));
     separates = ub >= 1.0;
