@@ -197,6 +197,16 @@ struct Table {
 };
 const Table kTable;
 
+// (c, s) = (cos, sin) of the angle of (c0, s0) plus d, |d| <= 0.2: Taylor series of cos d and
+// sin d to round-off (the first omitted terms are below 1e-18), no trigonometric call.
+inline void rotate(double c0, double s0, double d, double& c, double& s) {
+  const double d2 = d * d;
+  const double sd = d * (1 - d2 / 6 * (1 - d2 / 20 * (1 - d2 / 42 * (1 - d2 / 72 * (1 - d2 / 110 * (1 - d2 / 156))))));
+  const double cd = 1 - d2 / 2 * (1 - d2 / 12 * (1 - d2 / 30 * (1 - d2 / 56 * (1 - d2 / 90 * (1 - d2 / 132 * (1 - d2 / 182))))));
+  c = c0 * cd - s0 * sd;
+  s = s0 * cd + c0 * sd;
+}
+
 // g(phi) = det Q at th = phi / 2 and its first two derivatives in phi, from cos phi and sin phi.
 struct FourierPhi {
   const AcousticFourier& F;
@@ -236,14 +246,15 @@ BifurcationResult acoustic_min_fourier(const AcousticFourier& F, const Bifurcati
   const double L2 = r1 + 4 * r2, L3 = r1 + 8 * r2;
   constexpr int N = kTab / 2;
   constexpr double h = 2 * kPi / N;
-  struct Iv { double a, b, ga, gb; int depth, k; };  // k: table index of the midpoint, or -1
+  struct Iv { double a, b, ga, gb, cm, sm; int depth; };  // (cm, sm): cos, sin of the midpoint
   constexpr int kStack = N + 256;
   Iv stack[kStack];
   int ns = 0;
   double g1[N + 1];
   for (int k = 0; k < N; ++k) g1[k] = G.d1(kTable.c[2 * k], kTable.s[2 * k]);
   g1[N] = g1[0];  // periodic: the same value at 0 and 2 pi
-  for (int k = N - 1; k >= 0; --k) stack[ns++] = {k * h, (k + 1) * h, g1[k], g1[k + 1], 0, 2 * k + 1};
+  for (int k = N - 1; k >= 0; --k)
+    stack[ns++] = {k * h, (k + 1) * h, g1[k], g1[k + 1], kTable.c[2 * k + 1], kTable.s[2 * k + 1], 0};
   struct Cand { double phi, det; };
   Cand cands[8];
   int nc = 0;
@@ -251,23 +262,18 @@ BifurcationResult acoustic_min_fourier(const AcousticFourier& F, const Bifurcati
     const Iv iv = stack[--ns];
     const bool neg_a = !(iv.ga > 0), neg_b = !(iv.gb > 0);
     const double w = iv.b - iv.a, m = 0.5 * (iv.a + iv.b);
-    double cm, sm;
-    if (iv.k >= 0) {
-      cm = kTable.c[iv.k];
-      sm = kTable.s[iv.k];
-    } else {
-      cm = std::cos(m);
-      sm = std::sin(m);
-    }
+    const double cm = iv.cm, sm = iv.sm;
     const bool monotone = std::fabs(G.d2(cm, sm)) > L3 * 0.5 * w;
     if (neg_a == neg_b) {
       if (monotone || std::fabs(iv.ga) + std::fabs(iv.gb) > L2 * w) continue;
     } else if (monotone) {
       if (!neg_a) continue;  // + to -: a maximum of g
-      // One root of g1 in [a, b), g1 increasing: Newton kept inside the bracket.
+      // One root of g1 in [a, b), g1 increasing: Newton kept inside the bracket; the point is
+      // x = m + d, its (cos, sin) rotated from the midpoint's (|d| <= w/2 <= 0.1).
       double lo = iv.a, hi = iv.b, x = iv.a - iv.ga * w / (iv.gb - iv.ga);
+      double c = cm, s = sm;
       for (int it = 0; it < 60; ++it) {
-        const double c = std::cos(x), s = std::sin(x);
+        rotate(cm, sm, x - m, c, s);
         const double f1 = G.d1(c, s);
         if (!(f1 > 0)) lo = x; else hi = x;
         if (f1 == 0) break;
@@ -277,7 +283,8 @@ BifurcationResult acoustic_min_fourier(const AcousticFourier& F, const Bifurcati
         x = xn;
         if (done) break;
       }
-      if (nc < 8) cands[nc++] = {x, G.g(std::cos(x), std::sin(x))};
+      rotate(cm, sm, x - m, c, s);
+      if (nc < 8) cands[nc++] = {x, G.g(c, s)};
       continue;
     }
     if (iv.depth >= 40 || ns + 2 > kStack) {
@@ -286,8 +293,11 @@ BifurcationResult acoustic_min_fourier(const AcousticFourier& F, const Bifurcati
       continue;
     }
     const double gm = G.d1(cm, sm);
-    stack[ns++] = {m, iv.b, gm, iv.gb, iv.depth + 1, -1};
-    stack[ns++] = {iv.a, m, iv.ga, gm, iv.depth + 1, -1};
+    double cl, sl, cr, sr;
+    rotate(cm, sm, -0.25 * w, cl, sl);
+    rotate(cm, sm, 0.25 * w, cr, sr);
+    stack[ns++] = {m, iv.b, gm, iv.gb, cr, sr, iv.depth + 1};
+    stack[ns++] = {iv.a, m, iv.ga, gm, cl, sl, iv.depth + 1};
   }
   if (nc == 0) {  // cannot happen for a non-constant periodic g; keep the sampled minimum
     int best = 0;
