@@ -22,7 +22,7 @@ namespace {
 History run_level(const std::string& cell, const std::string& extra = "") {
   std::vector<std::string> ov = {
       "grid.origin=[-0.048, -0.008]", "grid.size=[0.096, 0.056]", "grid.cell=" + cell,
-      "bodies.0.box=[-0.04, 0, 0, 0.04]", "bodies.1.box=[0, 0, 0.04, 0.04]", "time.end=4e-5",
+      "geometry.parameters={\"L\": 0.04}", "time.end=4e-5",  // plates 0.04 m (meshes/convergence.geo)
       "probes.0.at=[0.02, 0.02]", "scheme.threads=1", "output.snapshots=0",
       "output.progress=false"};
   if (!extra.empty()) ov.push_back(extra);
