@@ -631,18 +631,28 @@ TimeFunction parse_time_function(Obj o) {
   return f;
 }
 
-ProbeSpec parse_probe(Obj o, const GridSpec& g, const std::vector<std::string>& body_names) {
-  o.allow({"name", "at", "fields", "body"});
+// A point probe ("at"), or with along_curve the keys a probe along a curve shares with it (the
+// caller reads the curve keys and calls o.done()).
+ProbeSpec parse_probe(Obj& o, const GridSpec& g, const std::vector<std::string>& body_names,
+                      bool along_curve = false) {
+  if (along_curve) {
+    if (o.has("at")) o.fail("at", "give either at (a point) or curve (points along a curve), not both");
+    o.allow({"name", "curve", "count", "spacing", "reverse", "fields", "body"}, "for a probe along a curve");
+  } else {
+    o.allow({"name", "at", "curve", "fields", "body"});
+  }
   ProbeSpec p;
   p.name = o.str("name");
   static const std::regex ok("[A-Za-z0-9_]+");
   if (!std::regex_match(p.name, ok))
     o.fail("name", "must be letters, digits and _ only, got \"" + p.name + "\"");
-  const auto at = o.nums("at", 2);
-  p.x = at[0];
-  p.y = at[1];
-  if (!(p.x >= g.x0 && p.x < g.x1() && p.y >= g.y0 && p.y < g.y1()))
-    o.fail("at", "outside the grid " + g.describe() + ": (" + fmt(p.x) + ", " + fmt(p.y) + ")");
+  if (!along_curve) {
+    const auto at = o.nums("at", 2);
+    p.x = at[0];
+    p.y = at[1];
+    if (!(p.x >= g.x0 && p.x < g.x1() && p.y >= g.y0 && p.y < g.y1()))
+      o.fail("at", "outside the grid " + g.describe() + ": (" + fmt(p.x) + ", " + fmt(p.y) + ")");
+  }
   static const std::vector<std::string> all = {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"};
   if (const ojson* f = o.find("fields")) {
     const std::string path = o.at("fields");
@@ -668,7 +678,7 @@ ProbeSpec parse_probe(Obj o, const GridSpec& g, const std::vector<std::string>& 
                          "; bodies: " + join(body_names));
     p.body = static_cast<int>(it - body_names.begin());
   }
-  o.done();
+  if (!along_curve) o.done();
   return p;
 }
 
@@ -715,6 +725,15 @@ class Builder {
     parse_materials(top);
     if (const ojson* g = top.find("geometry")) parse_geometry(Obj(ctx_, *g, "geometry"));
     parse_bodies(top.array("bodies"));
+    for (const auto& b : bodies_) {
+      BodyInfo info{b.name, "", "", b.x0, b.y0, b.x1, b.y1};
+      for (const auto& [name, index] : material_index_)
+        if (index == b.material) info.material = name;
+      if (b.surface >= 0)
+        info.surface = Geometry::label("physical surface", geo_->surfaces[b.surface].tag,
+                                       geo_->surfaces[b.surface].name);
+      c.bodies.push_back(std::move(info));
+    }
     if (const ojson* p = top.find("probes")) parse_probes(*p, c);
     // Boundaries select seeded particles and nodes, so they are built after seeding.
     const ojson* bnd = top.find("boundaries");
@@ -887,11 +906,79 @@ class Builder {
     if (!arr.is_array()) ctx_.fail("probes", "expected an array, got " + a_type(arr));
     for (std::size_t i = 0; i < arr.size(); ++i) {
       Obj o(ctx_, arr[i], index_path("probes", i));
-      ProbeSpec p = parse_probe(o, grid_, body_names());
-      for (const auto& q : c.probes)
-        if (q.name == p.name) o.fail("name", "probe name \"" + p.name + "\" is used twice");
-      c.probes.push_back(std::move(p));
+      const bool along = o.has("curve");
+      ProbeSpec p = parse_probe(o, grid_, body_names(), along);
+      std::vector<ProbeSpec> points;
+      if (along) points = curve_probe(o, p);
+      else points.push_back(std::move(p));
+      for (const auto& pt : points)
+        for (const auto& q : c.probes)
+          if (q.name == pt.name)
+            o.fail("name", "probe name \"" + pt.name + "\" is used twice" +
+                               (along ? " (a point of this probe along a curve)" : ""));
+      for (auto& pt : points) c.probes.push_back(std::move(pt));
     }
+  }
+
+  // probes[i] with "curve": points evenly spaced by arc length along a physical curve, named
+  // <name>_00, <name>_01, ... (geometry_probes.cpp). Each must lie in its body (or in a body).
+  std::vector<ProbeSpec> curve_probe(Obj& o, const ProbeSpec& base) {
+    const int ci = geometry_group(o, "curve", false);
+    const auto& C = geo_->curves[ci];
+    const std::string label = Geometry::label("physical curve", C.tag, C.name);
+    const bool has_count = o.has("count"), has_spacing = o.has("spacing");
+    if (has_count == has_spacing)
+      o.fail("", has_count ? "give either count or spacing, not both"
+                           : "needs count (number of points) or spacing (m) along the curve");
+    long count = 0;
+    double spacing = 0;
+    if (has_count) {
+      count = o.integer("count", 0);
+      if (count < 2) o.fail("count", "must be >= 2 (the points include both ends), got " + std::to_string(count));
+      if (count > 100000) o.fail("count", "must be <= 100000, got " + std::to_string(count));
+    } else {
+      spacing = o.num("spacing");
+      o.gt("spacing", spacing, 0);
+    }
+    const bool reverse = o.boolean("reverse", false);
+    o.done();
+    CurvePoints cp;
+    try {
+      cp = curve_points(*geo_, C, static_cast<int>(count), spacing, reverse);
+    } catch (const GeometryError& e) {
+      o.fail(has_count ? "curve" : "spacing", e.what());
+    }
+    const std::size_t n = cp.points.size();
+    const int width = std::max<int>(2, static_cast<int>(std::to_string(n - 1).size()));
+    const double tol = 1e-6 * grid_.h;
+    std::vector<ProbeSpec> out;
+    for (std::size_t k = 0; k < n; ++k) {
+      const CurvePoint& q = cp.points[k];
+      ProbeSpec p = base;
+      std::string idx = std::to_string(k);
+      p.name = base.name + "_" + std::string(width - idx.size(), '0') + idx;
+      p.x = q.x;
+      p.y = q.y;
+      p.along = base.name;
+      p.curve = label;
+      p.s = q.s;
+      // Inside the body: its surface's elements (tested at the point's place on the meshed
+      // segment) or its box.
+      auto inside = [&](const BodySpec& b) {
+        if (b.surface >= 0) return geo_->contains(geo_->surfaces[b.surface], q.cx, q.cy, tol);
+        return q.x >= b.x0 - tol && q.x <= b.x1 + tol && q.y >= b.y0 - tol && q.y <= b.y1 + tol;
+      };
+      bool ok = false;
+      if (p.body >= 0) ok = inside(bodies_[p.body]);
+      else for (const auto& b : bodies_) ok = ok || inside(b);
+      if (!ok)
+        o.fail("curve", geo_->file + ": " + label + ": point " + p.name + " at (" + fmt(q.x) + ", " +
+                            fmt(q.y) + ") (arc length " + fmt(q.s) + " of " + fmt(cp.length) +
+                            ") is outside " +
+                            (p.body >= 0 ? "body \"" + bodies_[p.body].name + "\"" : "every body"));
+      out.push_back(std::move(p));
+    }
+    return out;
   }
 
   void seed() {

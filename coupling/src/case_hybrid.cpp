@@ -66,6 +66,9 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
     for (std::size_t i = 0; i < probes->size(); ++i) {
       const ojson& p = (*probes)[i];
       if (!p.is_object()) fail(source, probe_path(i), "expected an object");
+      if (p.contains("curve"))
+        fail(source, probe_path(i) + ".curve",
+             "probes along a curve are not available in hybrid cases; give points with \"at\"");
       const ojson* at = p.contains("at") ? &p["at"] : nullptr;
       int idx = -1;
       if (at && at->is_array() && at->size() == 2 && (*at)[0].is_number() && (*at)[1].is_number())

@@ -32,6 +32,7 @@ RunResult run_case(Case& c, const std::string& out_dir) {
     probe_bodies.push_back(pr.body);
   }
   const std::vector<std::string> cols = detail::history_columns(c.probes);
+  detail::write_probe_table(dir, c.probes);
   HistoryWriter hist;
   hist.open((dir / "history.csv").string(), cols);
   std::vector<double> row(cols.size());
@@ -88,7 +89,10 @@ RunResult run_case(Case& c, const std::string& out_dir) {
   j["energy"] = detail::energy_json(s.energy);
   j["silent_boundaries"] = detail::silents_json(s);
   j["loads"] = c.notes;
+  j["bodies"] = detail::bodies_json(c, s);
+  j["curve_probes"] = detail::curve_probes_json(c.probes);
   j["outputs"] = {{"history", "history.csv"},
+                  {"probes", "probes.csv"},
                   {"snapshots", snap_every ? snap.count() : 0},
                   {"xdmf", snap_every ? "particles.xdmf" : ""}};
   detail::write_summary(dir, j);

@@ -139,6 +139,50 @@ void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {
   j["grid"] = {{"origin", {s.grid.x0, s.grid.y0}}, {"cells", {s.grid.nx, s.grid.ny}}, {"cell", s.grid.h}};
 }
 
+void write_probe_table(const fs::path& dir, const std::vector<ProbeSpec>& probes) {
+  std::ofstream f(dir / "probes.csv");
+  if (!f) throw std::runtime_error((dir / "probes.csv").string() + ": cannot write");
+  f << "name,x,y,along,s\n" << std::setprecision(17);
+  for (const auto& p : probes) {
+    f << p.name << ',' << p.x << ',' << p.y << ',' << p.along << ',';
+    if (!p.along.empty()) f << p.s;
+    f << '\n';
+  }
+}
+
+nlohmann::ordered_json curve_probes_json(const std::vector<ProbeSpec>& probes) {
+  nlohmann::ordered_json a = nlohmann::ordered_json::array();
+  for (std::size_t k = 0; k < probes.size(); ++k) {
+    if (probes[k].along.empty() || (k > 0 && probes[k - 1].along == probes[k].along)) continue;
+    std::size_t e = k;
+    while (e + 1 < probes.size() && probes[e + 1].along == probes[k].along) ++e;
+    a.push_back({{"name", probes[k].along},
+                 {"curve", probes[k].curve},
+                 {"points", e - k + 1},
+                 {"first", probes[k].name},
+                 {"last", probes[e].name},
+                 {"spacing", probes[k + 1].s - probes[k].s},
+                 {"last_arc_length", probes[e].s}});
+  }
+  return a;
+}
+
+nlohmann::ordered_json bodies_json(const Case& c, const Solver& s) {
+  std::vector<std::size_t> count(c.bodies.size(), 0);
+  for (std::size_t k = 0; k < s.p.size(); ++k)
+    if (s.p.body[k] < count.size()) ++count[s.p.body[k]];
+  nlohmann::ordered_json a = nlohmann::ordered_json::array();
+  for (std::size_t b = 0; b < c.bodies.size(); ++b) {
+    const BodyInfo& i = c.bodies[b];
+    a.push_back({{"name", i.name},
+                 {"material", i.material},
+                 {"surface", i.surface},
+                 {"extent", {i.x0, i.y0, i.x1, i.y1}},
+                 {"particles", count[b]}});
+  }
+  return a;
+}
+
 void write_summary(const fs::path& dir, const nlohmann::ordered_json& j) {
   const fs::path tmp = dir / "summary.json.tmp";
   {

@@ -58,6 +58,11 @@ nlohmann::ordered_json energy_json(const Energies& e);       // "energy"
 nlohmann::ordered_json silents_json(const Solver& s);        // "silent_boundaries"
 nlohmann::ordered_json fem_json(const fem::Solver& s);       // "fem"
 void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s);  // "scheme", "flip", "grid"
+// DIR/probes.csv: one row per probe column group of history.csv, "name,x,y,along,s" (along: the
+// probe along a curve a point belongs to, s its arc length; empty for a point probe).
+void write_probe_table(const std::filesystem::path& dir, const std::vector<ProbeSpec>& probes);
+nlohmann::ordered_json curve_probes_json(const std::vector<ProbeSpec>& probes);  // "curve_probes"
+nlohmann::ordered_json bodies_json(const Case& c, const Solver& s);              // "bodies"
 // Writes DIR/summary.json through a temporary file, so that it appears complete or not at all.
 void write_summary(const std::filesystem::path& dir, const nlohmann::ordered_json& j);
 

@@ -85,6 +85,29 @@ std::array<double, 4> Geometry::bounds(const Surface& s) const {
   return b;
 }
 
+bool Geometry::contains(const Surface& s, double px, double py, double tol) const {
+  auto seg_dist = [&](int a, int b) {
+    const double ex = x[b] - x[a], ey = y[b] - y[a], L2 = ex * ex + ey * ey;
+    const double t = L2 > 0 ? std::clamp(((px - x[a]) * ex + (py - y[a]) * ey) / L2, 0.0, 1.0) : 0.0;
+    return std::hypot(px - (x[a] + t * ex), py - (y[a] + t * ey));
+  };
+  for (const auto& e : s.elems) {
+    const int n = e[3] < 0 ? 3 : 4;
+    // Inside a convex element: on the same side of every edge (either orientation).
+    int pos = 0, neg = 0;
+    double dmin = HUGE_VAL;
+    for (int k = 0; k < n; ++k) {
+      const int a = e[k], b = e[(k + 1) % n];
+      const double cr = (x[b] - x[a]) * (py - y[a]) - (y[b] - y[a]) * (px - x[a]);
+      pos += cr > 0;
+      neg += cr < 0;
+      dmin = std::min(dmin, seg_dist(a, b));
+    }
+    if (pos == 0 || neg == 0 || dmin <= tol) return true;
+  }
+  return false;
+}
+
 double Geometry::length(const Curve& c) const {
   double L = 0;
   for (const auto& s : c.segs) L += std::hypot(x[s[1]] - x[s[0]], y[s[1]] - y[s[0]]);
@@ -195,6 +218,41 @@ int element_order(int type) {
   } catch (...) {
   }
   return order;
+}
+
+// Curve::mid: the chord midpoint of every segment, projected onto the gmsh curve entity it was
+// meshed from (a .geo's CAD curve; `entities` lists (entity, first segment) and is empty for a
+// .msh). A projection that fails or lands far from the chord (more than a quarter of its length)
+// keeps the chord midpoint. Exceptions are swallowed and the log is not consulted: a failed
+// projection only costs the exactness of curve probe positions.
+void curve_mids(const Geometry& g, Geometry::Curve& c,
+                const std::vector<std::pair<int, std::size_t>>& entities) {
+  c.mid.resize(c.segs.size());
+  for (std::size_t k = 0; k < c.segs.size(); ++k) {
+    const auto& sg = c.segs[k];
+    c.mid[k] = {0.5 * (g.x[sg[0]] + g.x[sg[1]]), 0.5 * (g.y[sg[0]] + g.y[sg[1]])};
+  }
+  for (std::size_t e = 0; e < entities.size(); ++e) {
+    const std::size_t k0 = entities[e].second;
+    const std::size_t k1 = e + 1 < entities.size() ? entities[e + 1].second : c.segs.size();
+    if (k1 <= k0) continue;
+    std::vector<double> xyz, closest, param;
+    for (std::size_t k = k0; k < k1; ++k) xyz.insert(xyz.end(), {c.mid[k][0], c.mid[k][1], 0.0});
+    try {
+      gmsh::model::getClosestPoint(1, entities[e].first, xyz, closest, param);
+    } catch (...) {
+      continue;
+    }
+    if (closest.size() != xyz.size()) continue;
+    for (std::size_t k = k0; k < k1; ++k) {
+      const double px = closest[3 * (k - k0)], py = closest[3 * (k - k0) + 1];
+      const auto& sg = c.segs[k];
+      const double len = std::hypot(g.x[sg[1]] - g.x[sg[0]], g.y[sg[1]] - g.y[sg[0]]);
+      if (std::isfinite(px) && std::isfinite(py) &&
+          std::hypot(px - c.mid[k][0], py - c.mid[k][1]) <= 0.25 * len)
+        c.mid[k] = {px, py};
+    }
+  }
 }
 
 }  // namespace
@@ -308,7 +366,9 @@ Geometry load_geometry(const std::string& file, double size,
     gmsh::model::getEntitiesForPhysicalGroup(dim, tag, entities);
     Geometry::Surface surf;
     Geometry::Curve curve;
+    std::vector<std::pair<int, std::size_t>> curve_entities;  // (entity, first segment)
     for (int ent : entities) {
+      if (dim == 1) curve_entities.push_back({ent, curve.segs.size()});
       std::vector<int> types;
       std::vector<std::vector<std::size_t>> etags, ntags;
       gmsh_call(file, "read the elements", [&] {
@@ -353,6 +413,7 @@ Geometry load_geometry(const std::string& file, double size,
                             (geo ? " (is the curve part of a meshed surface?)" : ""));
       curve.tag = tag;
       curve.name = name;
+      curve_mids(g, curve, geo ? curve_entities : std::vector<std::pair<int, std::size_t>>{});
       g.curves.push_back(std::move(curve));
     }
   }

@@ -1,6 +1,7 @@
 """Figures 8-10 and metrics.json of the oblique impact study (called by studies/impact/run).
 
-Reads the case files (geometry, materials, probes) and OUTDIR/<bc>/history.csv and
+Reads the case files (materials, probes), the body extents from OUTDIR/<bc>/summary.json
+("bodies": the gmsh surfaces of meshes/impact*.geo as built), OUTDIR/<bc>/history.csv and
 OUTDIR/multi_<bc>/history.csv for bc in free, silent, extended. The comparison window of each
 probe is computed from the geometry and the steel's P-wave speed: it ends when the first wave
 reflected at the extended plate's far end can reach the probe (image-point distance from the
@@ -140,6 +141,11 @@ def main():
     ap.add_argument("--bin", required=True)
     args = ap.parse_args()
     cases = {bc: json.load(open(os.path.join(args.cases, f"{bc}.json"))) for bc in BCS}
+    for bc in BCS:  # bodies from gmsh surfaces: their extent as built, from the run's summary
+        built = {b["name"]: b["extent"]
+                 for b in json.load(open(os.path.join(args.out, bc, "summary.json")))["bodies"]}
+        for b in cases[bc]["bodies"]:
+            b.setdefault("box", built[b["name"]])
     h = cases["extended"]["grid"]["cell"]
     probes = {p["name"]: p["at"] for p in cases["extended"]["probes"]}
     runs = [p + bc for p in ("", "multi_") for bc in BCS]

@@ -27,6 +27,18 @@ struct ProbeSpec {
   std::vector<std::string> fields;
   int body = -1;  // sample only this body's particles (-1: all bodies)
   int fem_index = -1;  // hybrid case: index of the FEM probe (the point is in the FEM region), -1: particles
+  // A point of a probe along a curve ("curve" key; name = "<along>_<k>"): the curve probe's
+  // name, its physical curve (e.g. `14 "top"`) and the point's arc length from the first point.
+  std::string along;   // empty for a point probe
+  std::string curve;
+  double s = 0;
+};
+
+// One body as built (summary.json "bodies"): name, material, extent [x0, y0, x1, y1] (its box,
+// or its gmsh surface's bounding box) and the surface (e.g. `1 "plate"`; empty for a box).
+struct BodyInfo {
+  std::string name, material, surface;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
 };
 
 struct OutputSpec {
@@ -40,6 +52,7 @@ struct Case {
   std::string title;
   double t_end = 0;
   std::vector<ProbeSpec> probes;
+  std::vector<BodyInfo> bodies;  // MPM bodies, in the order of "bodies"
   OutputSpec output;
   std::unique_ptr<Solver> solver;  // seeded, boundary conditions added, finalize() called
   // FEM region (a case with "fem"): mesh read, boundaries added, dt set; probes added in the

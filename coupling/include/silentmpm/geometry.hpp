@@ -43,6 +43,10 @@ struct Geometry {
     int tag = 0;
     std::string name;
     std::vector<std::array<int, 2>> segs;  // node indices of each 2-node line
+    // Per segment: the point of the CAD curve over the segment's middle (the chord midpoint
+    // projected onto the gmsh curve; the chord midpoint itself for a .msh or a straight curve).
+    // Curve probes treat each segment as the circular arc through its ends and this point.
+    std::vector<std::array<double, 2>> mid;
   };
 
   std::string file;                  // as given (for messages)
@@ -64,6 +68,8 @@ struct Geometry {
   double area(const Surface& s) const;
   std::array<double, 4> bounds(const Surface& s) const;  // xmin, ymin, xmax, ymax
   double length(const Curve& c) const;
+  // True if (px, py) lies in an element of s or within tol of one.
+  bool contains(const Surface& s, double px, double py, double tol) const;
 };
 
 // Read a .geo (meshed with mesh size `size`; size <= 0 keeps the file's own `h`) or a .msh.
@@ -102,6 +108,27 @@ BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geo
                                  const BodyRegion& region, int body, double depth,
                                  const std::string& name,
                                  LayerWeights weights = LayerWeights::Volume);
+
+// Points evenly spaced by arc length along a physical curve (probes along a curve,
+// geometry_probes.cpp). The curve's segments must form one chain, open or closed; it runs in the
+// direction of its first segment (the first gmsh curve of the group), or the opposite one with
+// `reverse`. Each segment is the circular arc through its end points and Curve::mid (exact for
+// straight lines and circles). Open chain: `count` points from end to end, s_k = k L / (count-1);
+// closed: `count` points s_k = k L / count. With spacing > 0 instead of count (count = 0):
+// s_k = k * spacing for as many points as fit (the last one <= L; < L on a closed chain).
+// Throws GeometryError naming the file and the curve.
+struct CurvePoint {
+  double x, y;    // on the curve
+  double cx, cy;  // the same point on the meshed segment (for inside tests)
+  double s;       // arc length from the first point
+};
+struct CurvePoints {
+  std::vector<CurvePoint> points;
+  double length = 0;  // arc length of the whole curve
+  bool closed = false;
+};
+CurvePoints curve_points(const Geometry& g, const Geometry::Curve& c, int count, double spacing,
+                         bool reverse);
 
 // Grid nodes within `tol` of curve `c` (closest point not beyond an open end, to 1e-6 h).
 std::vector<uint32_t> nodes_near_curve(const Solver& sol, const Geometry& g,

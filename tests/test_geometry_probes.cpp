@@ -1,0 +1,355 @@
+// Probes along a physical curve (probes[i].curve; geometry_probes.cpp): the points are evenly
+// spaced by arc length and lie exactly on an inclined straight edge and on a circle (not on the
+// inscribed polygon of its mesh); a uniform stress and velocity state is read back at every point
+// (solver samples and history.csv); the point table (probes.csv) and summary.json list them; and
+// each bad input gives one clear error naming the case file, the key path, the gmsh file and the
+// group, with a non-zero exit of the CLI.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "silentmpm/case.hpp"
+#include "silentmpm/driver.hpp"
+#include "silentmpm/history.hpp"
+#include "test_geometry_common.hpp"
+
+#ifndef SMPM_CLI
+#define SMPM_CLI ""
+#endif
+#ifndef SMPM_SOURCE_DIR
+#define SMPM_SOURCE_DIR "."
+#endif
+
+namespace {
+
+using namespace smpm::geotest;
+
+const double kAngle = 30.0 * M_PI / 180.0;
+
+// A case on the inclined plate of test_geometry_common.hpp (right edge: curve 12, from (xb, 0) to
+// (xt, H)), with the given probes.
+std::string inclined_case(const std::string& geo, const std::string& probes) {
+  return R"({
+  "grid": { "origin": [-0.004, -0.004], "size": [0.034, 0.028], "cell": 0.001 },
+  "time": { "end": 1e-7, "cfl": 0.3 },
+  "materials": { "w": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 } },
+  "geometry": { "file": ")" + geo + R"(" },
+  "bodies": [ { "name": "plate", "material": "w", "surface": 1, "particles_per_cell": 4 } ],
+  "probes": [ )" + probes + R"( ],
+  "output": { "snapshots": 0, "progress": false }
+})";
+}
+
+// The ring of studies/geometry (meshes/ring.geo: hole r = a = 0.01 (curve 15), rim r = R = 0.05
+// (curve 16), both counter-clockwise from the +x axis), 1 mm cells.
+std::string ring_case(const std::string& probes) {
+  return R"({
+  "grid": { "origin": [-0.052, -0.052], "size": [0.104, 0.104], "cell": 0.001 },
+  "time": { "end": 1e-7, "cfl": 0.3 },
+  "materials": { "al": { "model": "elastic", "young": 70e9, "poisson": 0.33, "density": 2700 } },
+  "geometry": { "file": ")" + std::string(SMPM_SOURCE_DIR) + R"(/meshes/ring.geo", "size": 0.001,
+                "parameters": { "a": 0.01, "R": 0.05 } },
+  "bodies": [ { "name": "ring", "material": "al", "surface": 1 } ],
+  "probes": [ )" + probes + R"( ],
+  "output": { "snapshots": 0, "progress": false }
+})";
+}
+
+smpm::Case load(const std::string& name, const std::string& json) {
+  return smpm::load_case(write_file(name, json).string());
+}
+
+// The probes of `c` named <along>_*, in order.
+std::vector<smpm::ProbeSpec> points_of(const smpm::Case& c, const std::string& along) {
+  std::vector<smpm::ProbeSpec> v;
+  for (const auto& p : c.probes)
+    if (p.along == along) v.push_back(p);
+  return v;
+}
+
+TEST(GeometryProbes, InclinedEdgeExactPositionsAndSpacing) {
+  write_file("probes_inclined.geo", inclined_geo(kAngle));
+  const smpm::Case c = load(
+      "probes_inclined.json",
+      inclined_case("probes_inclined.geo",
+                    R"({ "name": "edge", "curve": 12, "count": 11 },
+                       { "name": "back", "curve": "inclined", "count": 5, "reverse": true },
+                       { "name": "every", "curve": 12, "spacing": 0.003, "fields": ["sxx", "vy"] })"));
+  const double xb = kIncXb, xt = kIncXb - kIncH * std::tan(kAngle), H = kIncH;
+  const double L = H / std::cos(kAngle);
+  const double tol = 1e-12 * L;
+  // count 11: s_k = k L / 10, from (xb, 0) (the curve's direction) to (xt, H).
+  const auto e = points_of(c, "edge");
+  ASSERT_EQ(e.size(), 11u);
+  for (std::size_t k = 0; k < e.size(); ++k) {
+    const double f = k / 10.0;
+    EXPECT_EQ(e[k].name, "edge_" + std::string(k < 10 ? "0" : "") + std::to_string(k));
+    EXPECT_NEAR(e[k].x, xb + f * (xt - xb), tol) << k;
+    EXPECT_NEAR(e[k].y, f * H, tol) << k;
+    EXPECT_NEAR(e[k].s, f * L, tol) << k;
+    EXPECT_EQ(e[k].fields.size(), 7u);  // all point-probe quantities by default
+  }
+  // reverse: from (xt, H) to (xb, 0).
+  const auto b = points_of(c, "back");
+  ASSERT_EQ(b.size(), 5u);
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    const double f = 1 - k / 4.0;
+    EXPECT_NEAR(b[k].x, xb + f * (xt - xb), tol) << k;
+    EXPECT_NEAR(b[k].y, f * H, tol) << k;
+  }
+  // spacing 3 mm: floor(L / 3 mm) + 1 = 8 points at s = 0, 3, ..., 21 mm (L = 23.09 mm).
+  const auto s = points_of(c, "every");
+  ASSERT_EQ(s.size(), static_cast<std::size_t>(std::floor(L / 0.003)) + 1);
+  ASSERT_EQ(s.size(), 8u);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const double f = 0.003 * k / L;
+    EXPECT_NEAR(s[k].s, 0.003 * k, tol);
+    EXPECT_NEAR(s[k].x, xb + f * (xt - xb), tol) << k;
+    EXPECT_NEAR(s[k].y, f * H, tol) << k;
+    EXPECT_EQ(s[k].fields, (std::vector<std::string>{"sxx", "vy"}));
+  }
+}
+
+TEST(GeometryProbes, CircleExactPositionsByArcLength) {
+  const smpm::Case c = load("probes_ring.json",
+                            ring_case(R"({ "name": "rim", "curve": 16, "count": 24 },
+                                         { "name": "hole", "curve": "hole", "spacing": 0.01 })"));
+  const double R = 0.05, a = 0.01;
+  // Closed curve, count 24: 24 points at theta_k = 2 pi k / 24 from (R, 0), counter-clockwise.
+  const auto rim = points_of(c, "rim");
+  ASSERT_EQ(rim.size(), 24u);
+  double worst = 0;
+  for (std::size_t k = 0; k < rim.size(); ++k) {
+    const double th = 2 * M_PI * k / 24;
+    worst = std::max(worst, std::hypot(rim[k].x - R * std::cos(th), rim[k].y - R * std::sin(th)));
+    EXPECT_NEAR(rim[k].s, R * th, 1e-10 * R) << k;
+  }
+  std::printf("  rim: largest distance from R (cos, sin)(2 pi k / 24): %.3g m (R = %g m)\n", worst, R);
+  EXPECT_LT(worst, 1e-10 * R);
+  // The mesh's chords (1 mm on R = 50 mm) would put a midpoint s^2 / 8R = 2.5e-6 m inside the
+  // circle and shorten the perimeter by 1.6e-5 relative: the exact positions are not the polygon's.
+  // spacing 10 mm on the hole (perimeter 2 pi a = 62.8 mm): 7 points at theta = 0, 1, ..., 6 rad.
+  const auto hole = points_of(c, "hole");
+  ASSERT_EQ(hole.size(), 7u);
+  for (std::size_t k = 0; k < hole.size(); ++k) {
+    EXPECT_NEAR(hole[k].x, a * std::cos(static_cast<double>(k)), 1e-10 * a) << k;
+    EXPECT_NEAR(hole[k].y, a * std::sin(static_cast<double>(k)), 1e-10 * a) << k;
+    EXPECT_NEAR(hole[k].s, 0.01 * k, 1e-12) << k;
+  }
+}
+
+// A uniform state (stress and velocity of every particle) is read back at every point of the
+// curve probes, boundary points included: by the solver's sampling to round-off, and through
+// run_case in history.csv to its 10 printed digits; probes.csv and summary.json list the points.
+TEST(GeometryProbes, UniformStateReadBackAtEveryPoint) {
+  smpm::Case c = load("probes_uniform.json",
+                      ring_case(R"({ "name": "P", "at": [0.03, 0.0] },
+                                   { "name": "rim", "curve": 16, "count": 16, "body": "ring" },
+                                   { "name": "hole", "curve": 15, "count": 9, "fields": ["sxy", "vx"] })"));
+  ASSERT_EQ(c.probes.size(), 1u + 16u + 9u);
+  smpm::Solver& s = *c.solver;
+  const double sxx = -123.456e6, syy = 78.9e6, szz = -11.5e6, sxy = 42.25e6, vx = 3.5, vy = -1.25;
+  for (std::size_t k = 0; k < s.p.size(); ++k) {
+    s.p.sxx[k] = sxx; s.p.syy[k] = syy; s.p.szz[k] = szz; s.p.sxy[k] = sxy;
+    s.p.vx[k] = vx; s.p.vy[k] = vy;
+  }
+  std::vector<std::array<double, 2>> pts;
+  std::vector<int> bodies;
+  for (const auto& p : c.probes) pts.push_back({p.x, p.y}), bodies.push_back(p.body);
+  const auto samples = s.sample(pts, bodies);
+  for (std::size_t q = 0; q < samples.size(); ++q) {
+    ASSERT_TRUE(samples[q].valid) << c.probes[q].name;
+    EXPECT_NEAR(samples[q].sxx, sxx, 1e-13 * std::fabs(sxx)) << c.probes[q].name;
+    EXPECT_NEAR(samples[q].syy, syy, 1e-13 * std::fabs(syy)) << c.probes[q].name;
+    EXPECT_NEAR(samples[q].szz, szz, 1e-13 * std::fabs(szz)) << c.probes[q].name;
+    EXPECT_NEAR(samples[q].sxy, sxy, 1e-13 * std::fabs(sxy)) << c.probes[q].name;
+    EXPECT_NEAR(samples[q].vx, vx, 1e-13 * std::fabs(vx)) << c.probes[q].name;
+    EXPECT_NEAR(samples[q].vy, vy, 1e-13 * std::fabs(vy)) << c.probes[q].name;
+  }
+  // Through the driver: the first row of history.csv is the state before the first step.
+  const fs::path out = scratch() / "probes_uniform_out";
+  smpm::run_case(c, out.string());
+  const smpm::History h = smpm::read_history((out / "history.csv").string());
+  std::vector<std::string> expect_cols = {"P.sxx", "P.syy", "P.szz", "P.sxy", "P.J2", "P.vx", "P.vy"};
+  for (int k = 0; k < 16; ++k)
+    for (const char* f : {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"})
+      expect_cols.push_back("rim_" + std::string(k < 10 ? "0" : "") + std::to_string(k) + "." + f);
+  for (int k = 0; k < 9; ++k)
+    for (const char* f : {"sxy", "vx"}) expect_cols.push_back("hole_0" + std::to_string(k) + "." + f);
+  ASSERT_GE(h.columns.size(), expect_cols.size());
+  for (std::size_t i = 0; i < expect_cols.size(); ++i) EXPECT_EQ(h.columns[i], expect_cols[i]);
+  auto first = [&](const std::string& col) {
+    for (std::size_t i = 0; i < h.columns.size(); ++i)
+      if (h.columns[i] == col) return h.data[i].at(0);
+    ADD_FAILURE() << "no column " << col;
+    return std::nan("");
+  };
+  for (int k = 0; k < 16; ++k) {
+    const std::string n = "rim_" + std::string(k < 10 ? "0" : "") + std::to_string(k);
+    EXPECT_NEAR(first(n + ".sxx"), sxx, 1e-9 * std::fabs(sxx)) << n;
+    EXPECT_NEAR(first(n + ".syy"), syy, 1e-9 * std::fabs(syy)) << n;
+    EXPECT_NEAR(first(n + ".sxy"), sxy, 1e-9 * std::fabs(sxy)) << n;
+    EXPECT_NEAR(first(n + ".vy"), vy, 1e-9 * std::fabs(vy)) << n;
+  }
+  for (int k = 0; k < 9; ++k) {
+    const std::string n = "hole_0" + std::to_string(k);
+    EXPECT_NEAR(first(n + ".sxy"), sxy, 1e-9 * std::fabs(sxy)) << n;
+    EXPECT_NEAR(first(n + ".vx"), vx, 1e-9 * std::fabs(vx)) << n;
+  }
+  // probes.csv: one row per probe, the positions to 17 digits, the arc length of curve points.
+  std::ifstream f(out / "probes.csv");
+  std::string line;
+  std::getline(f, line);
+  EXPECT_EQ(line, "name,x,y,along,s");
+  std::size_t rows = 0;
+  while (std::getline(f, line)) {
+    std::stringstream ss(line);
+    std::string name, x, y, along, sarc;
+    std::getline(ss, name, ','); std::getline(ss, x, ','); std::getline(ss, y, ',');
+    std::getline(ss, along, ','); std::getline(ss, sarc, ',');
+    ASSERT_LT(rows, c.probes.size());
+    const auto& p = c.probes[rows++];
+    EXPECT_EQ(name, p.name);
+    EXPECT_EQ(std::stod(x), p.x);
+    EXPECT_EQ(std::stod(y), p.y);
+    EXPECT_EQ(along, p.along);
+    if (!p.along.empty()) {
+      EXPECT_EQ(std::stod(sarc), p.s);
+    }
+  }
+  EXPECT_EQ(rows, c.probes.size());
+  std::ifstream js(out / "summary.json");
+  const auto sum = nlohmann::json::parse(js);
+  ASSERT_EQ(sum["curve_probes"].size(), 2u);
+  EXPECT_EQ(sum["curve_probes"][0]["name"], "rim");
+  EXPECT_EQ(sum["curve_probes"][0]["points"], 16);
+  EXPECT_EQ(sum["curve_probes"][0]["last"], "rim_15");
+  EXPECT_NEAR(sum["curve_probes"][0]["spacing"].get<double>(), 2 * M_PI * 0.05 / 16, 1e-12);
+  EXPECT_EQ(sum["curve_probes"][1]["points"], 9);
+  EXPECT_EQ(sum["bodies"][0]["particles"], s.p.size());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors.
+
+// The inclined plate plus a separate lid (surface 2, not a body of the cases below) whose bottom
+// edge is curve 15; curve 16: three free lines meeting at one point; curve 17: two separate
+// lines (the plate's bottom and top).
+std::string odd_geo() {
+  return inclined_geo(kAngle) + R"(
+Point(11) = {0, 0.022, 0, h}; Point(12) = {0.005, 0.022, 0, h};
+Point(13) = {0.005, 0.023, 0, h}; Point(14) = {0, 0.023, 0, h};
+Line(11) = {11, 12}; Line(12) = {12, 13}; Line(13) = {13, 14}; Line(14) = {14, 11};
+Curve Loop(2) = {11, 12, 13, 14}; Plane Surface(2) = {2};
+Point(21) = {0.010, 0.0235, 0, h}; Point(22) = {0.014, 0.0235, 0, h};
+Point(23) = {0.012, 0.0215, 0, h}; Point(24) = {0.012, 0.0235, 0, h};
+Line(21) = {21, 24}; Line(22) = {24, 22}; Line(23) = {24, 23};
+Physical Surface("lid", 2) = {2};
+Physical Curve("lid_bottom", 15) = {11};
+Physical Curve("branched", 16) = {21, 22, 23};
+Physical Curve("apart", 17) = {3, 4};
+)";
+}
+
+struct Bad {
+  std::string name, probes;
+  std::vector<std::string> expect;  // substrings of the message
+};
+
+std::vector<Bad> bad_probes() {
+  return {
+      {"missing_curve", R"({ "name": "t", "curve": 99, "count": 5 })",
+       {"probes[0].curve", "probes_odd.geo", "no physical curve 99", "12 \"inclined\""}},
+      {"missing_curve_name", R"({ "name": "t", "curve": "rim", "count": 5 })",
+       {"probes[0].curve", "probes_odd.geo", "no physical curve named \"rim\""}},
+      {"count_one", R"({ "name": "t", "curve": 12, "count": 1 })",
+       {"probes[0].count", "must be >= 2", "got 1"}},
+      {"count_not_integer", R"({ "name": "t", "curve": 12, "count": 2.5 })", {"probes[0].count"}},
+      {"count_and_spacing", R"({ "name": "t", "curve": 12, "count": 3, "spacing": 0.001 })",
+       {"probes[0]", "either count or spacing"}},
+      {"neither", R"({ "name": "t", "curve": 12 })", {"probes[0]", "needs count", "or spacing"}},
+      {"spacing_zero", R"({ "name": "t", "curve": 12, "spacing": 0 })", {"probes[0].spacing", "must be > 0"}},
+      {"spacing_too_long", R"({ "name": "t", "curve": 12, "spacing": 0.05 })",
+       {"probes[0].spacing", "probes_odd.geo", "physical curve 12 \"inclined\"", "fewer than 2 points"}},
+      {"outside_body", R"({ "name": "t", "curve": "lid_bottom", "count": 3, "body": "plate" })",
+       {"probes[0].curve", "probes_odd.geo", "physical curve 15 \"lid_bottom\"", "t_00",
+        "outside body \"plate\""}},
+      {"outside_every_body", R"({ "name": "P", "at": [0, 0] }, { "name": "t", "curve": 15, "count": 3 })",
+       {"probes[1].curve", "probes_odd.geo", "physical curve 15 \"lid_bottom\"", "outside every body"}},
+      {"branched", R"({ "name": "t", "curve": 16, "count": 3 })",
+       {"probes[0].curve", "probes_odd.geo", "physical curve 16 \"branched\"", "branches at"}},
+      {"disconnected", R"({ "name": "t", "curve": "apart", "count": 3 })",
+       {"probes[0].curve", "probes_odd.geo", "physical curve 17 \"apart\"", "not one connected curve"}},
+      {"at_and_curve", R"({ "name": "t", "at": [0, 0], "curve": 12, "count": 3 })",
+       {"probes[0].at", "either at (a point) or curve"}},
+      {"unknown_key", R"({ "name": "t", "curve": 12, "count": 3, "spcing": 1 })",
+       {"probes[0].spcing", "unknown key", "spacing"}},
+      {"name_clash", R"({ "name": "t_01", "at": [0.001, 0.001] }, { "name": "t", "curve": 12, "count": 3 })",
+       {"probes[1].name", "\"t_01\" is used twice"}},
+  };
+}
+
+void PrintTo(const Bad& b, std::ostream* os) { *os << b.name; }
+
+fs::path write_bad(const Bad& b) {
+  write_file("probes_odd.geo", odd_geo());
+  return write_file("probes_bad_" + b.name + ".json", inclined_case("probes_odd.geo", b.probes));
+}
+
+class GeometryProbeErrors : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(GeometryProbeErrors, LibraryMessage) {
+  const Bad& b = GetParam();
+  const fs::path file = write_bad(b);
+  try {
+    smpm::load_case(file.string());
+    FAIL() << b.name << ": no error";
+  } catch (const smpm::CaseError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(file.string() + ": ", 0), 0u) << m;
+    for (const auto& s : b.expect)
+      EXPECT_NE(m.find(s), std::string::npos) << "missing \"" << s << "\" in: " << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+  }
+}
+
+TEST_P(GeometryProbeErrors, CliExitAndMessage) {
+  const std::string cli = SMPM_CLI;
+  if (cli.empty() || !fs::exists(cli)) GTEST_SKIP() << "CLI binary not built";
+  const Bad& b = GetParam();
+  const fs::path file = write_bad(b);
+  const fs::path err = scratch() / ("probes_err_" + b.name + ".txt");
+  const std::string cmd = "\"" + cli + "\" check \"" + file.string() + "\" >/dev/null 2>\"" + err.string() + "\"";
+  EXPECT_NE(std::system(cmd.c_str()), 0) << b.name;
+  const std::string m = read_text(err);
+  for (const auto& s : b.expect)
+    EXPECT_NE(m.find(s), std::string::npos) << "missing \"" << s << "\" in: " << m;
+}
+
+std::string bad_name(const ::testing::TestParamInfo<Bad>& info) { return info.param.name; }
+INSTANTIATE_TEST_SUITE_P(Bad, GeometryProbeErrors, ::testing::ValuesIn(bad_probes()), bad_name);
+
+// No geometry key: the probe names the missing key.
+TEST(GeometryProbes, CurveWithoutGeometryIsAnError) {
+  const fs::path file = write_file("probes_nogeo.json", R"({
+  "grid": { "size": [0.03, 0.02], "cell": 0.001 }, "time": { "end": 1e-6, "cfl": 0.3 },
+  "materials": { "w": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 } },
+  "bodies": [ { "name": "plate", "material": "w", "box": [0, 0, 0.02, 0.01] } ],
+  "probes": [ { "name": "t", "curve": 12, "count": 3 } ] })");
+  try {
+    smpm::load_case(file.string());
+    FAIL() << "no error";
+  } catch (const smpm::CaseError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("probes[0].curve"), std::string::npos) << m;
+    EXPECT_NE(m.find("needs the top-level key \"geometry\""), std::string::npos) << m;
+  }
+}
+
+}  // namespace
