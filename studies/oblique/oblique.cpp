@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
                             ", lumped mass, semi-implicit LK dashpots a = b = 1; extended-domain "
                             "differencing"
                       : std::string("MPM, 1 particle per cell, MUSL, nodal semi-implicit silent layer "
-                                    "a = b = 1, CFL 0.3; extended-domain differencing (div v, curl v)");
+                                    "a = b = 1, CFL 0.3; extended-domain differencing (div u, curl u: the sampled velocity's div and curl integrated over the steps)");
     j["nu"] = base.nu;
     j["pulse_fwhm_cells"] = base.fwhm;
     j["results"] = nlohmann::ordered_json::array();
