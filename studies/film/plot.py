@@ -1,9 +1,10 @@
 #!/usr/bin/python3
-"""Figures 16-24 and metrics.json of the film study (studies/film/README.md).
+"""Figures 16-25 and metrics.json of the film study (studies/film/README.md).
 
     /usr/bin/python3 studies/film/plot.py OUTDIR
 
-Reads OUTDIR/<run>/history.csv, summary.json and particles.h5 as written by studies/film/run.
+Reads OUTDIR/<run>/history.csv, summary.json, probes.csv and particles.h5 as written by
+studies/film/run.
 """
 import json
 import os
@@ -119,6 +120,60 @@ def figure_lines(runs, col, ylabel, title, path, scale):
     plt.close(fig)
 
 
+def interface_columns(h, field):
+    """Columns I_00.<field>, I_01.<field>, ... of the probe along the interface, in order."""
+    return sorted(k for k in h if k.startswith("I_") and k.endswith("." + field))
+
+
+def interface_positions(out, name):
+    """x (m) of the interface probe points, from OUTDIR/<run>/probes.csv."""
+    xs = {}
+    with open(os.path.join(out, name, "probes.csv")) as f:
+        f.readline()
+        for line in f:
+            n, x, y, along, s = line.strip().split(",")
+            if along == "I":
+                xs[n] = float(x)
+    return xs
+
+
+def interface_rel_l2(a, b, field, t1):
+    """Relative L2 over the interface points and 0 <= t <= t1 (space-time field)."""
+    num = den = 0.0
+    for col in interface_columns(b, field):
+        t = b["time"]
+        m = t <= t1 + 1e-15
+        x = np.interp(t[m], a["time"], a[col])
+        num += float(np.sum((x - b[col][m]) ** 2))
+        den += float(np.sum(b[col][m] ** 2))
+    return float(np.sqrt(num / den))
+
+
+def figure_interface(out, H, path):
+    """sigma_yy along the W-Si interface (probe along the gmsh curve "interface") at three times."""
+    xs = interface_positions(out, "silent")
+    cols = interface_columns(H["silent"], "syy")
+    x = np.array([xs[c.split(".")[0]] for c in cols]) * 1e6
+    times = (1.0e-9, 2.0e-9, T_FIG)
+    fig, axes = plt.subplots(1, len(times), figsize=(12, 3.8), sharey=True)
+    for ax, t in zip(axes, times):
+        for (label, name), ls in zip([("fixed 5 µm", "fixed"), ("extended 15 µm", "extended"),
+                                      ("silent 5 µm", "silent")], ["-", "--", ":"]):
+            h = H[name]
+            k = int(np.argmin(np.abs(h["time"] - t)))
+            ax.plot(x, [h[c][k] * 1e-9 for c in cols], ls, marker="o", ms=3, lw=1.2, label=label)
+        ax.set_title(f"t = {t * 1e9:.2f} ns", fontsize=10)
+        ax.set_xlabel("x along the interface (µm)")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("σyy at the interface, substrate side (GPa)")
+    axes[0].legend(fontsize=8)
+    fig.suptitle("σyy along the W–Si interface (21 points of a probe along the gmsh curve "
+                 "\"interface\")", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "out")
     H = {}
@@ -133,6 +188,14 @@ def main():
             "silent_vs_extended": rel_l2(H["silent"], H["extended"], col, T_CMP),
             "fixed_vs_extended": rel_l2(H["fixed"], H["extended"], col, T_CMP),
         }
+    # The whole interface (21 points of the probe along the gmsh curve "interface").
+    if interface_columns(H["silent"], "syy"):
+        metrics["interface_relative_l2"] = {
+            f: {"silent_vs_extended": interface_rel_l2(H["silent"], H["extended"], f, T_CMP),
+                "fixed_vs_extended": interface_rel_l2(H["fixed"], H["extended"], f, T_CMP)}
+            for f in ("syy", "sxy")}
+        metrics["interface_relative_l2"]["points"] = len(interface_columns(H["silent"], "syy"))
+        figure_interface(out, H, os.path.join(out, "figure25.png"))
     titles = {
         "fixed": ("figure16.png", "Fixed bottom, substrate 5 µm"),
         "extended": ("figure17.png", "Fixed bottom, substrate 15 µm (extended; upper 5 µm shown)"),
