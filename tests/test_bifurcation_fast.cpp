@@ -103,10 +103,15 @@ TEST(FastBifurcation, BoundsAreLowerBounds) {
     const double dmin = brute_min(C);
     const double tiny = 1e-13 * F.magnitude();
     EXPECT_LE(F.lower_bound(), dmin + tiny) << trial;
-    EXPECT_LE(acoustic_sampled_bound(F), dmin + tiny) << trial;
-    // The sampled bound is within max|g''| h^2 / 8 of the minimum (h = 2 pi / 32 in 2 theta).
+    // The sampled bounds (32 samples: threshold -inf; 64: threshold +inf) are within
+    // max|g''| h^2 / 8 of the minimum (h = 2 pi / 32 or 2 pi / 64 in 2 theta).
     const double L2 = std::hypot(F.a1, F.b1) + 4 * std::hypot(F.a2, F.b2);
-    EXPECT_GE(acoustic_sampled_bound(F), dmin - L2 * std::pow(2 * kPi / 32, 2) / 8 - tiny) << trial;
+    const double b32 = acoustic_sampled_bound(F, -1e300), b64 = acoustic_sampled_bound(F, 1e300);
+    EXPECT_LE(b32, dmin + tiny) << trial;
+    EXPECT_LE(b64, dmin + tiny) << trial;
+    EXPECT_GE(b32, dmin - L2 * std::pow(2 * kPi / 32, 2) / 8 - tiny) << trial;
+    EXPECT_GE(b64, dmin - L2 * std::pow(2 * kPi / 64, 2) / 8 - tiny) << trial;
+    EXPECT_GE(b64, b32) << trial;
   }
   AcousticFourier F;
   F.a0 = 3; F.a1 = -1.25;

@@ -59,9 +59,10 @@ AcousticFourier acoustic_fourier(const double C[16]);
 BifurcationResult acoustic_min_fourier(const AcousticFourier& F, const BifurcationParams& P,
                                        double scale);
 
-// A lower bound of det Q from 32 samples of the Fourier form: min over the samples minus
-// max|d2/dphi2| h^2 / 8 (phi = 2 theta, h = 2 pi / 32, max|d2/dphi2| <= |(a1,b1)| + 4 |(a2,b2)|).
-double acoustic_sampled_bound(const AcousticFourier& F);
+// A lower bound of det Q from samples of the Fourier form: min over the samples minus
+// max|d2/dphi2| h^2 / 8 (phi = 2 theta, max|d2/dphi2| <= |(a1,b1)| + 4 |(a2,b2)|), from 32
+// samples (h = 2 pi / 32), and from 64 (h = 2 pi / 64) when the first is not above threshold.
+double acoustic_sampled_bound(const AcousticFourier& F, double threshold = 1e300);
 
 // The check the film model runs after every plastic step; same verdict and plane as
 // bifurcation_sweep, cheaper:
