@@ -916,6 +916,13 @@ class Builder {
           if (q.name == pt.name)
             o.fail("name", "probe name \"" + pt.name + "\" is used twice" +
                                (along ? " (a point of this probe along a curve)" : ""));
+      if (along && points.size() >= 2) {
+        const ProbeSpec &a = points.front(), &z = points.back();
+        c.notes.push_back("probe \"" + a.along + "\" along the " + a.curve + ": " +
+                          std::to_string(points.size()) + " points " + a.name + " (" + fmt(a.x) +
+                          ", " + fmt(a.y) + ") ... " + z.name + " (" + fmt(z.x) + ", " + fmt(z.y) +
+                          "), every " + fmt(points[1].s - a.s) + " m of arc length");
+      }
       for (auto& pt : points) c.probes.push_back(std::move(pt));
     }
   }
