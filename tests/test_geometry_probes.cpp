@@ -235,6 +235,37 @@ TEST(GeometryProbes, UniformStateReadBackAtEveryPoint) {
   EXPECT_EQ(sum["bodies"][0]["particles"], s.p.size());
 }
 
+// Many probes are sampled through a cell index (Solver::sample with more than 8 points): the
+// same numbers, bit for bit, as sampling each point alone, for a non-uniform state.
+TEST(GeometryProbes, IndexedSamplingMatchesOnePointAtATime) {
+  smpm::Case c = load("probes_indexed.json",
+                      ring_case(R"({ "name": "rim", "curve": 16, "count": 40 },
+                                   { "name": "hole", "curve": 15, "count": 12, "body": "ring" },
+                                   { "name": "P", "at": [0.03, 0.001] })"));
+  smpm::Solver& s = *c.solver;
+  for (std::size_t k = 0; k < s.p.size(); ++k) {
+    s.p.sxx[k] = 1e9 * s.p.x[k] + 3e8 * s.p.y[k] * s.p.y[k] / 0.05;
+    s.p.syy[k] = -2e9 * s.p.x[k] * s.p.y[k] / 0.05;
+    s.p.sxy[k] = 5e6 * std::sin(100 * s.p.x[k]);
+    s.p.vx[k] = std::cos(80 * s.p.y[k]);
+  }
+  std::vector<std::array<double, 2>> pts;
+  std::vector<int> bodies;
+  for (const auto& p : c.probes) pts.push_back({p.x, p.y}), bodies.push_back(p.body);
+  ASSERT_GT(pts.size(), 8u);
+  const auto all = s.sample(pts, bodies);
+  for (std::size_t q = 0; q < pts.size(); ++q) {
+    const auto one = s.sample({pts[q]}, {bodies[q]})[0];
+    EXPECT_EQ(all[q].valid, one.valid) << c.probes[q].name;
+    EXPECT_EQ(all[q].sxx, one.sxx) << c.probes[q].name;
+    EXPECT_EQ(all[q].syy, one.syy) << c.probes[q].name;
+    EXPECT_EQ(all[q].sxy, one.sxy) << c.probes[q].name;
+    EXPECT_EQ(all[q].vx, one.vx) << c.probes[q].name;
+  }
+  // And the rim reads the radial-ish field it should: sxx = 1e9 x + ... at x = R cos(theta).
+  EXPECT_NEAR(all[0].sxx, 1e9 * 0.05, 0.02 * 1e9 * 0.05);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Errors.
 

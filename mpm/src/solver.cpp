@@ -741,12 +741,37 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
     acc[q].ci = acc[q].sf.ci;
     acc[q].cj = acc[q].sf.cj;
   }
+  // Many probes (curve probes): the probes near each cell (their cell within one of it) as a
+  // sorted (cell, probe) list, so that a particle visits only the probes it can reach; with
+  // few probes every particle checks them all. Either way each probe accumulates its particles
+  // in the same order.
+  const bool indexed = np > 8;
+  std::vector<std::pair<long, uint32_t>> near;  // (cell key, probe), sorted
+  if (indexed) {
+    near.reserve(9 * np);
+    const long W = static_cast<long>(grid.nx) + 3;  // keys of cells -1 .. nx + 1
+    for (std::size_t q = 0; q < np; ++q)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di)
+          near.push_back({(static_cast<long>(acc[q].cj) + dj + 1) * W + (acc[q].ci + di + 1),
+                          static_cast<uint32_t>(q)});
+    std::sort(near.begin(), near.end());
+  }
   Bilinear sf;
   for (std::size_t k = 0; k < p.size(); ++k) {
     sf.eval(p.x[k], p.y[k], grid.x0, grid.y0, grid.inv_h);
-    for (std::size_t q = 0; q < np; ++q) {
+    std::size_t e = 0, e1 = np;
+    if (indexed) {
+      const long key = (static_cast<long>(sf.cj) + 1) * (static_cast<long>(grid.nx) + 3) + sf.ci + 1;
+      e = static_cast<std::size_t>(
+          std::lower_bound(near.begin(), near.end(), std::make_pair(key, uint32_t(0))) - near.begin());
+      e1 = e;
+      while (e1 < near.size() && near[e1].first == key) ++e1;
+    }
+    for (; e < e1; ++e) {
+      const std::size_t q = indexed ? near[e].second : e;
       Acc& A = acc[q];
-      if (std::abs(sf.ci - A.ci) > 1 || std::abs(sf.cj - A.cj) > 1) continue;
+      if (!indexed && (std::abs(sf.ci - A.ci) > 1 || std::abs(sf.cj - A.cj) > 1)) continue;
       if (!bodies.empty() && bodies[q] >= 0 && p.body[k] != bodies[q]) continue;
       const double vals[6] = {p.sxx[k], p.syy[k], p.szz[k], p.sxy[k], p.vx[k], p.vy[k]};
       for (int a = 0; a < 4; ++a) {
