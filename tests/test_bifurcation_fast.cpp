@@ -243,5 +243,39 @@ TEST(FastBifurcation, CheckGivesTheSweepVerdictAndPlane) {
   }
 }
 
+// The closed-form maximum of H_cr over the normal (the film model's pre-check) against the
+// sweep-and-refine hcr_j2_max on random stresses, and the exact relation behind the pre-check,
+// det Q(n) = G M (H - H_cr(n)) / (3G + H), against acoustic_det.
+TEST(FastBifurcation, ClosedFormCriticalModulus) {
+  const Material m = tungsten();
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-2e9, 2e9), hh(-0.5, 0.5), th(0, kPi);
+  double worst = 0, worst_det = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const double sxx = u(rng), syy = u(rng), szz = u(rng), sxy = u(rng);
+    const double ref = hcr_j2_max(sxx, syy, szz, sxy, m.mu, m.M);
+    const double cf = hcr_j2_max_closed(sxx, syy, szz, sxy, m.mu, m.M);
+    worst = std::max(worst, std::fabs(cf - ref) / m.mu);
+    EXPECT_LE(cf, 1e-12 * m.mu) << trial;  // never above zero
+    const double H = hh(rng) * m.mu;
+    double C[16];
+    j2_tangent(m.lambda, m.mu, sxx, syy, szz, sxy, j2_beta(m.mu, H), C);
+    for (int k = 0; k < 10; ++k) {
+      const double t = th(rng);
+      const double d = m.mu * m.M * (H - hcr_j2(sxx, syy, szz, sxy, m.mu, m.M, t)) / (3 * m.mu + H);
+      worst_det = std::max(worst_det, std::fabs(d - acoustic_det(C, t)) / (m.mu * m.M));
+    }
+  }
+  std::printf("closed-form max H_cr vs sweep: worst %.2e G; det Q relation: worst %.2e G M\n", worst,
+              worst_det);
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(worst_det, 1e-13);
+  // Pure shear in plane: 0 (REFERENCE.md §5); uniaxial strain: about -0.64 G.
+  EXPECT_NEAR(hcr_j2_max_closed(1e9, -1e9, 0, 0, m.mu, m.M), 0.0, 1e-12 * m.mu);
+  const double lat = m.lambda / m.M * -1.6e9;
+  EXPECT_NEAR(hcr_j2_max_closed(-1.6e9, lat, lat, 0, m.mu, m.M),
+              hcr_j2_max(-1.6e9, lat, lat, 0, m.mu, m.M), 1e-9 * m.mu);
+}
+
 }  // namespace
 }  // namespace smpm

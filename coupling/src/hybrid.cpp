@@ -295,7 +295,6 @@ void Hybrid::step() {
   fe_.external_force(S.t, fext_.data());
   const auto& mfe = fe_.mass();
   std::vector<double>& v = fe_.velocity();
-  std::copy(v.begin(), v.end(), vold_.begin());
   for (std::size_t k = 0; k < shared_.size(); ++k) {
     const std::uint32_t e = shared_[k][0], n = shared_[k][1];
     // The particles' own velocity at the node, for their FLIP increment (below).

@@ -11,6 +11,9 @@
 //   LargestAngle   the candidate with the larger angle (135.3 deg = -44.7 deg; n along y)
 // Two minima tie when their determinants differ by less than tie_tolerance * mu * M.
 
+#include <algorithm>
+#include <cmath>
+
 namespace smpm {
 
 enum class TieBreak { SmallestAngle, LargestAngle };
@@ -83,5 +86,27 @@ double hcr_j2(double sxx, double syy, double szz, double sxy, double mu, double 
 // max over the normal angle of hcr_j2 (fine sweep and refinement); theta_deg gets the argmax.
 double hcr_j2_max(double sxx, double syy, double szz, double sxy, double mu, double M,
                   double* theta_deg = nullptr);
+
+// The same maximum in closed form. With N = s/|s|, its in-plane block N2, w = a.n = n.N2.n and
+// u = cos(2 th - phi0): w = P + R u, |a|^2 = T + 2 P R u, P = (Nxx + Nyy)/2,
+// R = |((Nxx - Nyy)/2, Nxy)|, T = (Nxx^2 + Nyy^2)/2 + Nxy^2, so
+//   H_cr = 6G T - 3G - 12G P^2 + 12G P w - 6G (1 - G/M) w^2,   w in [P - R, P + R],
+// a concave parabola in w: its maximum at w* = P / (1 - G/M), clamped to the interval.
+// (For every stress H_cr <= 0: associated J2 never bifurcates while it hardens.)
+inline double hcr_j2_max_closed(double sxx, double syy, double szz, double sxy, double mu,
+                                double M) {
+  const double p = (sxx + syy + szz) / 3.0;
+  const double a = sxx - p, b = syy - p, c = szz - p;
+  const double n2 = a * a + b * b + c * c + 2 * sxy * sxy;
+  if (!(n2 > 0)) return -3 * mu;
+  const double in = 1 / std::sqrt(n2);
+  const double Nxx = a * in, Nyy = b * in, Nxy = sxy * in;
+  const double P = 0.5 * (Nxx + Nyy), D = 0.5 * (Nxx - Nyy);
+  const double R = std::sqrt(D * D + Nxy * Nxy);
+  const double T = 0.5 * (Nxx * Nxx + Nyy * Nyy) + Nxy * Nxy;
+  const double k = 1 - mu / M;
+  const double w = std::min(P + R, std::max(P - R, P / k));
+  return 6 * mu * (T - 0.5 - 2 * P * P + 2 * P * w - k * w * w);
+}
 
 }  // namespace smpm
