@@ -5,11 +5,14 @@
   ring_history.png         radial stress at P (30 mm from the centre of the ring) for the free,
                            silent and extended outer circle
   ring_energy.png          energy left in the ring / absorbed by the silent ring over time
+  ring_circle.png          sigma_rr around the circle r = 30 mm (probe C along a gmsh curve):
+                           relative L2 vs extended by angle, and the direct wave's peak by angle
   metrics.json             every number of the README
 """
 import argparse
 import csv
 import json
+import math
 import os
 
 import matplotlib
@@ -122,6 +125,36 @@ def main():
         ring[k]["Q_syy_L2_vs_extended"] = compare(args.bin, hist[k], hist["extended"], "Q.syy", 0, t_end)
     metrics["ring"] = ring
 
+    # sigma_rr around the circle r = 30 mm: probe C along the gmsh curve "probe_circle" (24 points
+    # every 15 degrees, counter-clockwise from +x; positions from probes.csv).
+    circle = None
+    if os.path.exists(os.path.join(out, "ring_silent", "probes.csv")):
+        pts = [r for r in read_csv(os.path.join(out, "ring_silent", "probes.csv")) if r["along"] == "C"]
+
+        def srr(c, r):
+            th = math.atan2(float(r["y"]), float(r["x"]))
+            cs, sn = math.cos(th), math.sin(th)
+            n = r["name"]
+            return [a * cs * cs + b * sn * sn + 2 * d * sn * cs
+                    for a, b, d in zip(c[n + ".sxx"], c[n + ".syy"], c[n + ".sxy"])]
+
+        cols = {k: columns(hist[k]) for k in ("free", "silent", "extended")}
+        angles = [math.degrees(math.atan2(float(r["y"]), float(r["x"]))) % 360 for r in pts]
+        circle = {"angles_deg": angles}
+        ext = [srr(cols["extended"], r) for r in pts]
+        for k in ("free", "silent"):
+            assert cols[k]["time"] == cols["extended"]["time"]
+            l2 = []
+            for r, e in zip(pts, ext):
+                v = srr(cols[k], r)
+                l2.append(math.sqrt(sum((a - b) ** 2 for a, b in zip(v, e)) / sum(b * b for b in e)))
+            circle[k] = {"srr_L2_vs_extended": l2, "min": min(l2), "max": max(l2),
+                         "mean": sum(l2) / len(l2)}
+        peaks = [max(-v for v in e) for e in ext]  # the direct wave is compressive
+        circle["extended_peak_compression_MPa"] = [p / 1e6 for p in peaks]
+        circle["extended_peak_spread"] = (max(peaks) - min(peaks)) / (sum(peaks) / len(peaks))
+        metrics["ring"]["circle_r30mm"] = circle
+
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     style = {"free": ("tab:red", "--", "free outer circle"), "silent": ("tab:blue", "-", "silent outer circle"),
              "extended": ("black", ":", "extended ring (R = 150 mm)")}
@@ -154,6 +187,28 @@ def main():
     fig.tight_layout()
     fig.savefig(os.path.join(out, "ring_energy.png"), dpi=130)
     plt.close(fig)
+
+    if circle:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+        for k in ("free", "silent"):
+            axes[0].plot(circle["angles_deg"], circle[k]["srr_L2_vs_extended"], "o" + style[k][1],
+                         color=style[k][0], ms=4, label=style[k][2])
+        axes[0].set_yscale("log")
+        axes[0].set_xlabel("angle on the circle r = 30 mm (degrees from +x)")
+        axes[0].set_ylabel(r"relative L2 of $\sigma_{rr}$ vs extended, 0-30 µs")
+        axes[0].set_xticks(range(0, 361, 45))
+        axes[0].grid(True, alpha=0.3, which="both")
+        axes[0].legend(fontsize=8)
+        axes[1].plot(circle["angles_deg"], circle["extended_peak_compression_MPa"], "ko-", ms=4)
+        axes[1].set_xlabel("angle on the circle r = 30 mm (degrees from +x)")
+        axes[1].set_ylabel(r"peak compression $-\sigma_{rr}$ of the direct wave (MPa)")
+        axes[1].set_xticks(range(0, 361, 45))
+        axes[1].grid(True, alpha=0.3)
+        fig.suptitle("Ring: 24 points of a probe along the gmsh curve \"probe_circle\" (r = 30 mm)",
+                     fontsize=10)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "ring_circle.png"), dpi=130)
+        plt.close(fig)
 
     with open(os.path.join(out, "metrics.json"), "w") as fo:
         json.dump(metrics, fo, indent=2)
