@@ -144,6 +144,28 @@ TEST(GeometryProbes, CircleExactPositionsByArcLength) {
   }
 }
 
+// A physical curve made of two gmsh curves whose end points coincide but are distinct points
+// (meshes/convergence.geo: "bottom" = the bottoms of the two plates, which share no point) is
+// one chain: 5 points from x = -L to L.
+TEST(GeometryProbes, CoincidentEndsJoinTheChain) {
+  const smpm::Case c = load("probes_plates.json", R"({
+  "grid": { "origin": [-0.12, -0.02], "size": [0.24, 0.14], "cell": 0.01 },
+  "time": { "end": 1e-6, "cfl": 0.3 },
+  "materials": { "w": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 } },
+  "geometry": { "file": ")" + std::string(SMPM_SOURCE_DIR) + R"(/meshes/convergence.geo", "size": 0.01 },
+  "bodies": [ { "name": "al", "material": "w", "surface": "aluminium" },
+              { "name": "st", "material": "w", "surface": "steel" } ],
+  "probes": [ { "name": "b", "curve": "bottom", "count": 5 } ] })");
+  const auto b = points_of(c, "b");
+  ASSERT_EQ(b.size(), 5u);
+  // Line 3 of the file runs from (-L, 0) to (0, 0): the chain starts at x = -L.
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    EXPECT_NEAR(b[k].x, -0.1 + 0.05 * k, 1e-14) << k;
+    EXPECT_NEAR(b[k].y, 0.0, 1e-14) << k;
+    EXPECT_NEAR(b[k].s, 0.05 * k, 1e-14) << k;
+  }
+}
+
 // A uniform state (stress and velocity of every particle) is read back at every point of the
 // curve probes, boundary points included: by the solver's sampling to round-off, and through
 // run_case in history.csv to its 10 printed digits; probes.csv and summary.json list the points.

@@ -79,9 +79,33 @@ CurvePoints curve_points(const Geometry& g, const Geometry::Curve& c, int count,
         (g.x[c.segs[k][0]] != g.x[c.segs[k][1]] || g.y[c.segs[k][0]] != g.y[c.segs[k][1]]))
       segs.push_back(k);
   if (segs.empty()) throw GeometryError(where + " has no segment of positive length");
+  // Ends of pieces that lie on each other (two gmsh curves with distinct but coincident end
+  // points, e.g. the bottoms of two plates side by side) are joined: they count as one node.
+  std::unordered_map<int, int> uses, alias;
+  for (std::size_t q : segs) ++uses[c.segs[q][0]], ++uses[c.segs[q][1]];
+  {
+    std::vector<int> ends;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const auto& [node, n] : uses) {
+      if (n == 1) ends.push_back(node);
+      lo = std::min({lo, g.x[node], g.y[node]});
+      hi = std::max({hi, g.x[node], g.y[node]});
+    }
+    std::sort(ends.begin(), ends.end());
+    const double tol = 1e-9 * std::max(hi - lo, 1e-300);
+    for (std::size_t i = 0; i < ends.size(); ++i)
+      for (std::size_t j = i + 1; j < ends.size(); ++j)
+        if (!alias.count(ends[i]) && !alias.count(ends[j]) &&
+            std::hypot(g.x[ends[i]] - g.x[ends[j]], g.y[ends[i]] - g.y[ends[j]]) <= tol)
+          alias[ends[j]] = ends[i];
+  }
+  auto rep = [&](int node) {
+    const auto it = alias.find(node);
+    return it == alias.end() ? node : it->second;
+  };
   std::unordered_map<int, std::vector<std::size_t>> at;  // node -> positions in segs
   for (std::size_t q = 0; q < segs.size(); ++q)
-    for (int e = 0; e < 2; ++e) at[c.segs[segs[q]][e]].push_back(q);
+    for (int e = 0; e < 2; ++e) at[rep(c.segs[segs[q]][e])].push_back(q);
   for (const auto& [node, v] : at)
     if (v.size() > 2)
       throw GeometryError(where + " branches at (" + num(g.x[node]) + ", " + num(g.y[node]) +
@@ -100,16 +124,16 @@ CurvePoints curve_points(const Geometry& g, const Geometry::Curve& c, int count,
       if (next == segs.size()) return node;
       used[next] = 1;
       const auto& sg = c.segs[segs[next]];
-      const bool fwd = sg[0] == node;
+      const bool fwd = rep(sg[0]) == node;
       out.push_back({next, fwd});
-      node = fwd ? sg[1] : sg[0];
+      node = rep(fwd ? sg[1] : sg[0]);
       cur = next;
     }
   };
   used[0] = 1;
   std::vector<std::pair<std::size_t, bool>> ahead{{0, true}}, behind;
-  const int first = c.segs[segs[0]][0];
-  const int end = walk(c.segs[segs[0]][1], 0, ahead);
+  const int first = rep(c.segs[segs[0]][0]);
+  const int end = walk(rep(c.segs[segs[0]][1]), 0, ahead);
   const bool closed = end == first;
   if (!closed) walk(first, 0, behind);
   const std::size_t n_used = ahead.size() + behind.size();

@@ -110,7 +110,8 @@ BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geo
                                  LayerWeights weights = LayerWeights::Volume);
 
 // Points evenly spaced by arc length along a physical curve (probes along a curve,
-// geometry_probes.cpp). The curve's segments must form one chain, open or closed; it runs in the
+// geometry_probes.cpp). The curve's segments must form one chain, open or closed (end points of
+// its pieces that coincide to 1e-9 of its extent are joined); it runs in the
 // direction of its first segment (the first gmsh curve of the group), or the opposite one with
 // `reverse`. Each segment is the circular arc through its end points and Curve::mid (exact for
 // straight lines and circles). Open chain: `count` points from end to end, s_k = k L / (count-1);
