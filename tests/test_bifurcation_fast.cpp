@@ -270,6 +270,20 @@ TEST(FastBifurcation, ClosedFormCriticalModulus) {
               worst_det);
   EXPECT_LT(worst, 1e-9);
   EXPECT_LT(worst_det, 1e-13);
+  // The film model's pre-check (no square root, no normalisation) is the same test as
+  // H - max H_cr > 1e-8 G, away from the margin itself.
+  int excluded = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double sxx = u(rng), syy = u(rng), szz = u(rng), sxy = u(rng);
+    const double hcr = hcr_j2_max_closed(sxx, syy, szz, sxy, m.mu, m.M);
+    const double H = hcr + hh(rng) * 1e-2 * m.mu;
+    if (std::fabs(H - hcr - 1e-8 * m.mu) < 1e-12 * m.mu) continue;
+    const bool ref = H - hcr > 1e-8 * m.mu;
+    EXPECT_EQ(j2_cannot_bifurcate(sxx, syy, szz, sxy, m.mu, m.M, H), ref) << trial;
+    excluded += ref;
+  }
+  EXPECT_GT(excluded, 500);
+  EXPECT_LT(excluded, 1500);
   // Pure shear in plane: 0 (REFERENCE.md §5); uniaxial strain: about -0.64 G.
   EXPECT_NEAR(hcr_j2_max_closed(1e9, -1e9, 0, 0, m.mu, m.M), 0.0, 1e-12 * m.mu);
   const double lat = m.lambda / m.M * -1.6e9;

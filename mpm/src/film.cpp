@@ -488,7 +488,16 @@ double decohesion_update(const DecohesionParams& P, double lambda, double mu, Di
     const double An = cn * kn, At = ct * kt;
     const double iun2 = 1 / (P.u_nf * P.u_nf), iut2 = 1 / (P.u_tf * P.u_tf);
     const double itn2 = 1 / (d.tnf * d.tnf), itt2 = 1 / (d.ttf * d.ttf);
-    x = lo + (hi - lo) * phi_lo / (phi_lo - phi_hi);
+    // Start: the Newton step from x = 0 (phi(0) = f0; at x = 0, dS/dx = -(A_n tau_n^2 / tnf^2 +
+    // A_t tau_t^2 / ttf^2) / S and dU/dx = |(k_n tau_n / u_nf, k_t tau_t / u_tf)|), close to the
+    // root when the trial state is just outside the surface (the usual step); else the secant.
+    {
+      const double S0 = f0 + r0;
+      const double dS0 = S0 > 0 ? -(tnp * tnp * An * itn2 + tt * tt * At * itt2) / S0 : 0.0;
+      const double dU0 = std::sqrt(kn * kn * tnp * tnp * iun2 + kt * kt * tt * tt * iut2);
+      const double x0 = dS0 + dU0 < 0 ? -f0 / (dS0 + dU0) : -1.0;
+      x = x0 > lo && x0 < hi ? x0 : lo + (hi - lo) * phi_lo / (phi_lo - phi_hi);
+    }
     for (int it = 0; it < 100; ++it) {
       const double en = 1 / (1 + An * x), et = 1 / (1 + At * x);
       const double taun = tnp * en, taut = tt * et;
@@ -507,7 +516,8 @@ double decohesion_update(const DecohesionParams& P, double lambda, double mu, Di
       const double dphi = dS + dU;
       double xn = dphi < 0 ? x - phi / dphi : 0.5 * (lo + hi);
       if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
-      const bool done = std::fabs(xn - x) <= 1e-14 * x || hi - lo <= 1e-14 * hi;
+      // Quadratic convergence: after a relative step of 1e-12 the error is at round-off.
+      const bool done = std::fabs(xn - x) <= 1e-12 * x || hi - lo <= 1e-14 * hi;
       x = xn;
       if (done) break;
     }

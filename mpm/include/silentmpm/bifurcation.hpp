@@ -109,4 +109,29 @@ inline double hcr_j2_max_closed(double sxx, double syy, double szz, double sxy, 
   return 6 * mu * (T - 0.5 - 2 * P * P + 2 * P * w - k * w * w);
 }
 
+// The film model's pre-check: true when H - max_n H_cr(n) > margin * G, i.e. no normal can
+// bifurcate (det Q(n) = G M (H - H_cr(n)) / (3G + H) > 0 for all n; requires 3G + H > 0).
+// hcr_j2_max_closed without normalising s (H_cr = 6G (f / |s|^2 - 1/2), f quadratic in s),
+// so with one square root at most and none when the maximum is interior.
+inline bool j2_cannot_bifurcate(double sxx, double syy, double szz, double sxy, double mu,
+                                double M, double H, double margin = 1e-8) {
+  if (!(3 * mu + H > 0)) return false;
+  const double p = (sxx + syy + szz) / 3.0;
+  const double a = sxx - p, b = syy - p, c = szz - p;
+  const double n2 = a * a + b * b + c * c + 2 * sxy * sxy;
+  const double P = 0.5 * (a + b), D = 0.5 * (a - b);
+  const double T = 0.5 * (a * a + b * b) + sxy * sxy;
+  const double R2 = D * D + sxy * sxy;
+  const double ik = M / (M - mu);  // 1 / (1 - G/M)
+  const double e = P * (ik - 1);   // w* - P
+  double f;
+  if (e * e <= R2) {
+    f = T - 2 * P * P + P * P * ik;  // interior maximum, w = P / k
+  } else {
+    const double w = P + std::copysign(std::sqrt(R2), e);
+    f = T - 2 * P * P + 2 * P * w - (1 - mu / M) * w * w;
+  }
+  return (H + 3 * mu - margin * mu) * n2 > 6 * mu * f;
+}
+
 }  // namespace smpm

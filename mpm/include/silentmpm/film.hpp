@@ -46,9 +46,7 @@ inline double film_update(const Material& m, Particles& p, std::size_t k, double
   // Exact J2 pre-check: det Q(n) = G M (H - H_cr(n)) / (3G + H), so no normal bifurcates while
   // H exceeds max H_cr (closed form, bifurcation.hpp); the margin 1e-8 G keeps det Q far above
   // round-off, so the verdict is that of the check below and of the sweep.
-  if (3 * m.mu + r.H > 0 &&
-      r.H - hcr_j2_max_closed(sxx, syy, szz, sxy, m.mu, m.M) > 1e-8 * m.mu)
-    return w;
+  if (j2_cannot_bifurcate(sxx, syy, szz, sxy, m.mu, m.M, r.H)) return w;
   double C[16];
   j2_tangent(m.lambda, m.mu, sxx, syy, szz, sxy, j2_beta(m.mu, r.H), C);
   const BifurcationResult b = bifurcation_check(C, m.bif, m.mu * m.M);
