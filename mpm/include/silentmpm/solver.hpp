@@ -125,7 +125,7 @@ class Solver {
   void layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, Bilinear& sf,
                    long nodes[4]) const;
   void grid_update();
-  void boundary_work();
+  void boundary_work(const std::vector<double>* wx = nullptr, const std::vector<double>* wy = nullptr);
   void g2p_velocity(bool remap, bool move);
   void update_stress_and_position(const std::vector<double>& gx, const std::vector<double>& gy,
                                   bool move);
