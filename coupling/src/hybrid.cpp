@@ -103,6 +103,15 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
           fe_cell_[j * g.nx + i] = 1;
   }
 
+  fe_row_lo_ = g.ny;
+  fe_row_hi_ = -1;
+  for (long j = 0; j < g.ny; ++j)
+    for (long i = 0; i < g.nx; ++i)
+      if (fe_cell_[j * g.nx + i]) {
+        fe_row_lo_ = std::min(fe_row_lo_, j);
+        fe_row_hi_ = std::max(fe_row_hi_, j);
+      }
+
   // Particles: none in an FE cell; volume per grid cell.
   check_particles_in_fe_cells(true);
   std::vector<double> cell_vol(fe_cell_.size(), 0.0);
@@ -255,6 +264,17 @@ void Hybrid::check_particles_in_fe_cells(bool at_setup) const {
   const Particles& P = mpm_.p;
   const long n = static_cast<long>(P.size());
   const std::uint8_t* fc = fe_cell_.data();
+  if (!at_setup) {
+    // The step that moved the particles recorded the rows they occupy, per strip: when none of
+    // those rows holds an FE cell (the film: particles above the interface), nothing to check.
+    long lo = std::numeric_limits<long>::max(), hi = std::numeric_limits<long>::min();
+    for (int s = 0; s < mpm_.nstrips_; ++s)
+      if (mpm_.strip_lo_[s] <= mpm_.strip_hi_[s]) {
+        lo = std::min<long>(lo, mpm_.strip_lo_[s]);
+        hi = std::max<long>(hi, mpm_.strip_hi_[s]);
+      }
+    if (lo > hi || hi < fe_row_lo_ || lo > fe_row_hi_) return;
+  }
   long first = n;
 #pragma omp parallel for schedule(static) reduction(min : first) num_threads(mpm_.thread_count())
   for (long k = 0; k < n; ++k) {

@@ -91,6 +91,7 @@ class Hybrid {
   std::vector<std::int64_t> grid_of_fe_;   // shared grid node of each FE node, or -1
   std::vector<std::int32_t> dash_of_fe_;   // index into fe.dashpots(), or -1
   std::vector<std::uint8_t> fe_cell_;      // per grid cell
+  long fe_row_lo_ = 0, fe_row_hi_ = -1;    // grid rows holding an FE cell (empty: lo > hi)
   std::vector<std::uint8_t> has_mpm_mass_; // per shared pair: node had MPM mass at setup
   std::size_t interface_count_ = 0;
   std::vector<double> fint_, fext_, vold_; // FE per-dof work arrays
