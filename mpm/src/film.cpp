@@ -6,6 +6,7 @@
 
 #include "silentmpm/bifurcation.hpp"
 #include "silentmpm/decohesion.hpp"
+#include "silentmpm/film.hpp"
 
 namespace smpm {
 
@@ -364,6 +365,39 @@ BifurcationResult bifurcation_check(const double C[16], const BifurcationParams&
   }
   if (stage) *stage = 4;
   return bifurcation_sweep(C, P, scale);
+}
+
+// ------------------------------------------------------------------------------------------
+// The film model's off-hot-path parts (film.hpp)
+
+double film_decohesion(const Material& m, Particles& p, std::size_t k, double& sxx, double& syy,
+                       double& szz, double& sxy) {
+  Discontinuity d;
+  d.nx = p.dnx[k]; d.ny = p.dny[k]; d.L = p.dL[k];
+  d.tnf = p.dtnf[k]; d.ttf = p.dttf[k];
+  d.un = p.jump_n[k]; d.ut = p.jump_t[k]; d.ubar = p.ubar[k];
+  const double w = decohesion_update(m.coh, m.lambda, m.mu, d, p.state[k], sxx, syy, szz, sxy);
+  p.jump_n[k] = d.un; p.jump_t[k] = d.ut; p.ubar[k] = d.ubar;
+  return w;
+}
+
+void film_bifurcation(const Material& m, Particles& p, std::size_t k, double H, double sxx,
+                      double syy, double szz, double sxy) {
+  double C[16];
+  j2_tangent(m.lambda, m.mu, sxx, syy, szz, sxy, j2_beta(m.mu, H), C);
+  const BifurcationResult b = bifurcation_check(C, m.bif, m.mu * m.M);
+  if (!b.bifurcated) return;
+  const double th = b.theta * kPi / 180.0;
+  Discontinuity d;
+  d.nx = std::cos(th);
+  d.ny = std::sin(th);
+  p.dnx[k] = d.nx;
+  p.dny[k] = d.ny;
+  if (!m.coh.enabled) return;
+  decohesion_start(m.coh, m.M, m.mu, sxx, syy, sxy, std::sqrt(p.vol[k]), d);
+  p.dL[k] = d.L; p.dtnf[k] = d.tnf; p.dttf[k] = d.ttf;
+  p.jump_n[k] = 0; p.jump_t[k] = 0; p.ubar[k] = 0;
+  p.state[k] = kDecohesion;
 }
 
 double hcr_j2(double sxx, double syy, double szz, double sxy, double mu, double M, double th) {

@@ -24,20 +24,20 @@
 
 namespace smpm {
 
+// The parts of film_update off its hot path (film.cpp): a particle in decohesion or separated
+// (decohesion_update on its stored discontinuity), and a plastic step the J2 pre-check could not
+// clear (tangent, bifurcation_check, and on bifurcation the start of decohesion).
+double film_decohesion(const Material& m, Particles& p, std::size_t k, double& sxx, double& syy,
+                       double& szz, double& sxy);
+void film_bifurcation(const Material& m, Particles& p, std::size_t k, double H, double sxx,
+                      double syy, double szz, double sxy);
+
 inline double film_update(const Material& m, Particles& p, std::size_t k, double dexx,
                           double deyy, double dgxy, double& sxx, double& syy, double& szz,
                           double& sxy) {
   elastic_increment(m, dexx, deyy, dgxy, sxx, syy, szz, sxy);
   uint8_t& st = p.state[k];
-  if (st >= kDecohesion) {
-    Discontinuity d;
-    d.nx = p.dnx[k]; d.ny = p.dny[k]; d.L = p.dL[k];
-    d.tnf = p.dtnf[k]; d.ttf = p.dttf[k];
-    d.un = p.jump_n[k]; d.ut = p.jump_t[k]; d.ubar = p.ubar[k];
-    const double w = decohesion_update(m.coh, m.lambda, m.mu, d, st, sxx, syy, szz, sxy);
-    p.jump_n[k] = d.un; p.jump_t[k] = d.ut; p.ubar[k] = d.ubar;
-    return w;
-  }
+  if (st >= kDecohesion) return film_decohesion(m, p, k, sxx, syy, szz, sxy);
   const J2Return r = j2soft_return(m.j2, m.mu, sxx, syy, szz, sxy, p.eps_p[k]);
   if (!r.plastic) return 0.0;
   st = kPlastic;
@@ -45,23 +45,9 @@ inline double film_update(const Material& m, Particles& p, std::size_t k, double
   if (!m.bif.enabled || (!m.coh.enabled && (p.dnx[k] != 0 || p.dny[k] != 0))) return w;
   // Exact J2 pre-check: det Q(n) = G M (H - H_cr(n)) / (3G + H), so no normal bifurcates while
   // H exceeds max H_cr (closed form, bifurcation.hpp); the margin 1e-8 G keeps det Q far above
-  // round-off, so the verdict is that of the check below and of the sweep.
+  // round-off, so the verdict is that of bifurcation_check and of the sweep.
   if (j2_cannot_bifurcate(sxx, syy, szz, sxy, m.mu, m.M, r.H)) return w;
-  double C[16];
-  j2_tangent(m.lambda, m.mu, sxx, syy, szz, sxy, j2_beta(m.mu, r.H), C);
-  const BifurcationResult b = bifurcation_check(C, m.bif, m.mu * m.M);
-  if (!b.bifurcated) return w;
-  const double th = b.theta * 3.14159265358979323846 / 180.0;
-  Discontinuity d;
-  d.nx = std::cos(th);
-  d.ny = std::sin(th);
-  p.dnx[k] = d.nx;
-  p.dny[k] = d.ny;
-  if (!m.coh.enabled) return w;
-  decohesion_start(m.coh, m.M, m.mu, sxx, syy, sxy, std::sqrt(p.vol[k]), d);
-  p.dL[k] = d.L; p.dtnf[k] = d.tnf; p.dttf[k] = d.ttf;
-  p.jump_n[k] = 0; p.jump_t[k] = 0; p.ubar[k] = 0;
-  st = kDecohesion;
+  film_bifurcation(m, p, k, r.H, sxx, syy, szz, sxy);
   return w;
 }
 
