@@ -2,7 +2,10 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <fstream>
 #include <iostream>
+
+#include <nlohmann/json.hpp>
 
 #include "silentmpm/case.hpp"
 #include "silentmpm/driver.hpp"
@@ -51,8 +54,22 @@ int main(int argc, char** argv) {
       std::printf("%.6e\n", smpm::relative_l2(a, b, column, t0, t1));
       return 0;
     }
-    if (*run && threads >= 0) overrides.push_back("scheme.threads=" + std::to_string(threads));
-    if (*run && quiet) overrides.push_back("output.progress=false");
+    // The command line's own settings: a section the case leaves out is created with the key
+    // (overrides given with --set must name existing sections, so typos are caught).
+    auto setting = [&](const std::string& section, const std::string& key, const std::string& value) {
+      bool has = false;
+      try {
+        std::ifstream in(case_path);
+        const auto doc = nlohmann::json::parse(in, nullptr, false, true);
+        has = doc.is_object() && doc.contains(section);
+      } catch (const std::exception&) {
+        // unreadable or malformed: load_case reports it
+      }
+      overrides.insert(overrides.begin(), has ? section + "." + key + "=" + value
+                                              : section + "={\"" + key + "\":" + value + "}");
+    };
+    if (*run && threads >= 0) setting("scheme", "threads", std::to_string(threads));
+    if (*run && quiet) setting("output", "progress", "false");
     smpm::Case c = smpm::load_case(case_path, overrides);
     if (!c.solver && c.fem) {  // FEM-only case
       const smpm::fem::Solver& f = *c.fem;

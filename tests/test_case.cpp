@@ -385,4 +385,27 @@ TEST(CaseCliValid, CheckSucceeds) {
   EXPECT_EQ(r.status, 0) << "stderr:\n" << r.err;
 }
 
+
+// The CLI's --threads and --quiet on a case without "scheme" and "output" sections (they are
+// created; --set, in contrast, must name existing sections): the run uses the thread count given.
+TEST(CaseCliValid, RunThreadsWithoutSchemeOrOutputSection) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  std::string text = kValid;
+  for (const char* key : {"  \"scheme\":", "  \"output\":"}) {
+    const std::size_t a = text.find(key);
+    ASSERT_NE(a, std::string::npos) << key;
+    const std::size_t b = text.find('\n', a);
+    text.erase(a, b - a + 1);
+  }
+  if (text.find(",\n}") != std::string::npos) text.replace(text.find(",\n}"), 3, "\n}");
+  const fs::path file = write_file("no_scheme_cli.json", text.c_str());
+  const fs::path out = scratch() / "no_scheme_cli_out";
+  const CliResult r = run_cli("run \"" + file.string() + "\" --out \"" + out.string() + "\" --threads 1 --quiet",
+                              "no_scheme");
+  ASSERT_EQ(r.status, 0) << "stderr:\n" << r.err;
+  const std::string summary = read_file(out / "summary.json");
+  EXPECT_NE(summary.find("\"threads\": 1"), std::string::npos) << summary;
+  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+}
+
 }  // namespace
