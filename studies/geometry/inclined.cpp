@@ -4,7 +4,7 @@
 //     widths    (default) free edge, grid-aligned edge, silent edge at FWHM 8/12/16/24 cells,
 //               measured on displacements (REFERENCE.md §4.1) and, for comparison, on velocities
 //     depths    FWHM 16: receivers from 3-6 to 16-22 cells inside the edge
-//     variants  FWHM 16: the silent layer's form and anchor
+//     variants  FWHM 16: the silent layer's form and anchor; LK coefficients a = b = 0.5 and 2
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
     for (auto d : {std::pair{3.0, 6.0}, {5.0, 8.0}, {10.0, 16.0}, {16.0, 22.0}})
       runs.push_back({30, 1, 16, d.first, d.second, true, "", ""});
   } else if (mode == "variants") {
-    runs = {{30, 1, 16, 8, 12, true, "nodal", "particle"}, {30, 1, 16, 8, 12, true, "particle", "particle"}};
+    runs = {{30, 1, 16, 8, 12, true, "nodal", "particle"}, {30, 1, 16, 8, 12, true, "particle", "particle"},
+            {30, 0.5, 16, 8, 12, true, "", ""}, {30, 2, 16, 8, 12, true, "", ""}};
   } else {
     std::fprintf(stderr, "%s: unknown mode '%s' (widths, depths or variants)\n", argv[0], mode.c_str());
     return 2;

@@ -66,7 +66,10 @@ def main():
            "silent_edge_30deg": [row(r) for r in silent],
            "silent_edge_30deg_velocity_measure": [row(r) for r in silent_v],
            "silent_edge_30deg_receiver_depth": [row(r) for r in silent30(depths)],
-           "silent_edge_30deg_variants": [dict(row(r), form=r["form"], anchor=r["anchor"]) for r in variants]}
+           "silent_edge_30deg_variants": [dict(row(r), form=r["form"], anchor=r["anchor"]) for r in variants
+                                          if f(r, "a") == 1],
+           "edge_30deg_other_lk_coefficients": [dict(row(r), a=f(r, "a"), b=f(r, "b"), rpp_exact=f(r, "rpp_exact"),
+                                                     rps_exact=f(r, "rps_exact")) for r in variants if f(r, "a") != 1]}
     metrics["inclined_30deg"] = inc
 
     fig, axs = plt.subplots(1, 2, figsize=(10.5, 4.4))
@@ -81,7 +84,7 @@ def main():
               label=r"$|R_{PS}|$ on velocities")
     ax.axhline(f(silent[0], "rpp_exact"), color="tab:blue", ls=":", label=r"$|R_{PP}|$ closed form")
     ax.axhline(f(silent[0], "rps_exact"), color="tab:red", ls=":", label=r"$|R_{PS}|$ closed form")
-    for r in variants:
+    for r in [r for r in variants if f(r, "a") == 1]:
         ax.plot([f(r, "fwhm_cells")], [f(r, "rpp")], "x", color="tab:blue", ms=8)
         ax.plot([f(r, "fwhm_cells")], [f(r, "rps")], "+", color="tab:red", ms=9)
     ax.set_xlabel("pulse width (FWHM, cells)")
