@@ -235,6 +235,8 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   fint_.assign(2 * nfe, 0.0);
   fext_.assign(2 * nfe, 0.0);
   vold_.assign(2 * nfe, 0.0);
+  inv_mfe_.resize(nfe);
+  for (std::size_t i = 0; i < nfe; ++i) inv_mfe_[i] = 1.0 / fe_.mass()[i];
   mpm_v_.assign(2 * shared_.size(), 0.0);
   sum_v_.assign(2 * shared_.size(), 0.0);
   fe_.internal_force(fe_.displacement().data(), fint_.data());
@@ -382,6 +384,7 @@ void Hybrid::step() {
     const auto& mask = fe_.constraint_mask();
     const std::int64_t* gof = grid_of_fe_.data();
     const std::int32_t* dof = dash_of_fe_.data();
+    const double* im = inv_mfe_.data();
     double work = 0, abs2 = 0;
 #pragma omp parallel for schedule(static) reduction(+ : work, abs2) num_threads(fe_.thread_count())
     for (std::int64_t i = 0; i < nn; ++i) {
@@ -390,8 +393,8 @@ void Hybrid::step() {
       const double vx0 = v[2 * i], vy0 = v[2 * i + 1], mi = mfe[i];
       double vx, vy;
       if (dof[i] < 0) {
-        vx = (mask[i] & 1) ? 0.0 : vx0 + dt * fx / mi;
-        vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy / mi;
+        vx = (mask[i] & 1) ? 0.0 : vx0 + dt * fx * im[i];
+        vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy * im[i];
       } else {
         const auto& c = D[dof[i]];
         const double hh = 0.5 * dt;
