@@ -54,6 +54,13 @@ int Geometry::find_curve(const std::string& name) const { return find_name(curve
 std::string Geometry::list_surfaces() const { return list_groups(surfaces); }
 std::string Geometry::list_curves() const { return list_groups(curves); }
 
+std::string Geometry::num(double v) {
+  std::ostringstream o;
+  o.precision(6);
+  o << v;
+  return o.str();
+}
+
 std::string Geometry::label(const char* kind, int tag, const std::string& name) {
   return std::string(kind) + " " + std::to_string(tag) + (name.empty() ? "" : " \"" + name + "\"");
 }

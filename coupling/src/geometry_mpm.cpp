@@ -13,15 +13,9 @@
 namespace smpm {
 namespace {
 
-std::string num(double v) {
-  std::ostringstream o;
-  o.precision(6);
-  o << v;
-  return o.str();
-}
 
 std::string grid_text(const Grid& G) {
-  return "[" + num(G.x0) + ", " + num(G.x1()) + "] x [" + num(G.y0) + ", " + num(G.y1()) + "]";
+  return "[" + Geometry::num(G.x0) + ", " + Geometry::num(G.x1()) + "] x [" + Geometry::num(G.y0) + ", " + Geometry::num(G.y1()) + "]";
 }
 
 inline double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
@@ -179,8 +173,8 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
   const std::string label = Geometry::label("physical surface", s.tag, s.name);
   if (b[0] < G.x0 - tol || b[1] < G.y0 - tol || b[2] > G.x1() + tol || b[3] > G.y1() + tol)
     throw GeometryError(g.file + ": " + label + " reaches outside the grid " + grid_text(G) +
-                        ": its extent is [" + num(b[0]) + ", " + num(b[2]) + "] x [" + num(b[1]) +
-                        ", " + num(b[3]) + "]");
+                        ": its extent is [" + Geometry::num(b[0]) + ", " + Geometry::num(b[2]) + "] x [" + Geometry::num(b[1]) +
+                        ", " + Geometry::num(b[3]) + "]");
   const double sp = G.h / n;
   const long NX = static_cast<long>(G.nx) * n, NY = static_cast<long>(G.ny) * n;
   auto lo = [&](double v, double o, long N) {
@@ -266,10 +260,10 @@ BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geo
       auto it = edge_elems.find(key(s.na, s.nb));
       if (it == edge_elems.end()) {
         problem = "is not on the boundary of " + body_label + " (no element of the surface has "
-                  "the segment (" + num(s.ax) + ", " + num(s.ay) + ")-(" + num(s.bx) + ", " +
-                  num(s.by) + ") as an edge)";
+                  "the segment (" + Geometry::num(s.ax) + ", " + Geometry::num(s.ay) + ")-(" + Geometry::num(s.bx) + ", " +
+                  Geometry::num(s.by) + ") as an edge)";
       } else if (it->second.second > 1) {
-        problem = "runs through the inside of " + body_label + " at (" + num(mx) + ", " + num(my) + ")";
+        problem = "runs through the inside of " + body_label + " at (" + Geometry::num(mx) + ", " + Geometry::num(my) + ")";
       } else {
         const auto& e = region.surface->elems[it->second.first];
         const int nn = e[3] < 0 ? 3 : 4;
@@ -283,7 +277,7 @@ BoundaryLayer select_curve_layer(const Solver& sol, const Geometry& g, const Geo
       const bool minus = in_box(region, mx - d * s.nx, my - d * s.ny);
       if (plus == minus)
         problem = std::string(plus ? "runs through the inside of " : "does not touch ") +
-                  body_label + " at (" + num(mx) + ", " + num(my) + ")";
+                  body_label + " at (" + Geometry::num(mx) + ", " + Geometry::num(my) + ")";
       else side = plus ? 1 : -1;
     }
     if (!problem.empty()) throw GeometryError(g.file + ": " + label + " " + problem);

@@ -13,12 +13,6 @@
 namespace smpm {
 namespace {
 
-std::string num(double v) {
-  std::ostringstream o;
-  o.precision(6);
-  o << v;
-  return o.str();
-}
 
 // One segment of the chain, oriented along it.
 struct Piece {
@@ -108,7 +102,7 @@ CurvePoints curve_points(const Geometry& g, const Geometry::Curve& c, int count,
     for (int e = 0; e < 2; ++e) at[rep(c.segs[segs[q]][e])].push_back(q);
   for (const auto& [node, v] : at)
     if (v.size() > 2)
-      throw GeometryError(where + " branches at (" + num(g.x[node]) + ", " + num(g.y[node]) +
+      throw GeometryError(where + " branches at (" + Geometry::num(g.x[node]) + ", " + Geometry::num(g.y[node]) +
                           "): " + std::to_string(v.size()) +
                           " segments meet there; a probe needs one unbranched curve");
 
@@ -184,9 +178,9 @@ CurvePoints curve_points(const Geometry& g, const Geometry::Curve& c, int count,
     const bool wraps = closed && std::fabs(n * spacing - L) <= 1e-9 * L;
     const double m = wraps ? n : n + 1;
     if (m < 2)
-      throw GeometryError(where + ": spacing " + num(spacing) + " gives fewer than 2 points on its length " + num(L));
+      throw GeometryError(where + ": spacing " + Geometry::num(spacing) + " gives fewer than 2 points on its length " + Geometry::num(L));
     if (m > 100000)
-      throw GeometryError(where + ": spacing " + num(spacing) + " gives " + num(m) + " points (at most 100000)");
+      throw GeometryError(where + ": spacing " + Geometry::num(spacing) + " gives " + Geometry::num(m) + " points (at most 100000)");
     for (long k = 0; k < static_cast<long>(m); ++k) s.push_back(std::min(k * spacing, L));
   }
   std::size_t piece = 0;

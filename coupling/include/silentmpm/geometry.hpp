@@ -64,6 +64,8 @@ struct Geometry {
   std::string list_curves() const;
   // "physical surface 2 \"steel\"" for messages.
   static std::string label(const char* kind, int tag, const std::string& name);
+  // A coordinate or length for messages (6 significant digits).
+  static std::string num(double v);
 
   double area(const Surface& s) const;
   std::array<double, 4> bounds(const Surface& s) const;  // xmin, ymin, xmax, ymax
