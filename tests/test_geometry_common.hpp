@@ -1,15 +1,24 @@
 #pragma once
 // Helpers of the geometry tests: a scratch directory, .geo texts, point-in-element.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
 #include "common.hpp"
+#include "silentmpm/case.hpp"
 #include "silentmpm/geometry.hpp"
+
+#ifndef SMPM_CLI
+#define SMPM_CLI ""
+#endif
 
 namespace smpm::geotest {
 
@@ -39,6 +48,34 @@ inline fs::path write_file(const std::string& name, const std::string& text) {
 inline std::string read_text(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+// Loading the case file fails with one line that starts with the file's path and contains every
+// string of `expect`.
+inline void expect_case_error(const fs::path& file, const std::vector<std::string>& expect,
+                              const std::string& name) {
+  try {
+    smpm::load_case(file.string());
+    ADD_FAILURE() << name << ": no error";
+  } catch (const smpm::CaseError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(file.string() + ": ", 0), 0u) << m;  // starts with the case file
+    for (const auto& s : expect) EXPECT_NE(m.find(s), std::string::npos) << "missing \"" << s << "\" in: " << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+  }
+}
+
+// `silentmpm check FILE` exits non-zero with every string of `expect` on stderr (skipped when the
+// CLI is not built).
+inline void expect_cli_error(const fs::path& file, const std::vector<std::string>& expect,
+                             const std::string& name) {
+  const std::string cli = SMPM_CLI;
+  if (cli.empty() || !fs::exists(cli)) GTEST_SKIP() << "CLI binary not built";
+  const fs::path err = scratch() / ("cli_err_" + name + ".txt");
+  const std::string cmd = "\"" + cli + "\" check \"" + file.string() + "\" >/dev/null 2>\"" + err.string() + "\"";
+  EXPECT_NE(std::system(cmd.c_str()), 0) << name;
+  const std::string m = read_text(err);
+  for (const auto& s : expect) EXPECT_NE(m.find(s), std::string::npos) << "missing \"" << s << "\" in: " << m;
 }
 
 inline std::string num(double v) {
