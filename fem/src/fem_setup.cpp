@@ -439,6 +439,11 @@ Solver::~Solver() = default;
 int Solver::add_probe(double x, double y) {
   Impl& m = *impl_;
   Deal& d = *m.deal;
+  // Outside the mesh's bounding box: not in the mesh (deal.II's search below builds its vertex
+  // maps on every call; a hybrid asks for every probe, most of them in the MPM region).
+  const double tol = 1e-9 * std::hypot(m.box[2] - m.box[0], m.box[3] - m.box[1]);
+  if (x < m.box[0] - tol || x > m.box[2] + tol || y < m.box[1] - tol || y > m.box[3] + tol)
+    return -1;
   const Point<2> p(x, y);
   using CellPoint = std::pair<DoFHandler<2>::active_cell_iterator, Point<2>>;
   std::vector<CellPoint> found;
