@@ -59,6 +59,17 @@ J2State random_j2(const Material& m, std::mt19937& rng) {
   return s;
 }
 
+// A random tangent: a J2 state's (j2 true) or 16 independent entries in [-M, M] (no symmetry).
+void random_tangent(const Material& m, std::mt19937& rng, bool j2, double C[16]) {
+  if (j2) {
+    const J2State s = random_j2(m, rng);
+    std::copy(s.C, s.C + 16, C);
+  } else {
+    std::uniform_real_distribution<double> e(-1, 1);
+    for (int k = 0; k < 16; ++k) C[k] = e(rng) * m.M;
+  }
+}
+
 // The five-term form is det Q itself: equal to acoustic_det to round-off at every angle, on
 // random J2 tangents and on tangents with 16 independent random entries (no symmetry at all).
 TEST(FastBifurcation, FourierFormEqualsAcousticDet) {
@@ -68,12 +79,7 @@ TEST(FastBifurcation, FourierFormEqualsAcousticDet) {
   double worst = 0;
   for (int trial = 0; trial < 400; ++trial) {
     double C[16];
-    if (trial % 2 == 0) {
-      const J2State s = random_j2(m, rng);
-      std::copy(s.C, s.C + 16, C);
-    } else {
-      for (double& c : C) c = e(rng) * m.M;
-    }
+    random_tangent(m, rng, trial % 2 == 0, C);
     const AcousticFourier F = acoustic_fourier(C);
     for (int k = 0; k < 50; ++k) {
       const double t = th(rng);
@@ -93,12 +99,7 @@ TEST(FastBifurcation, BoundsAreLowerBounds) {
   std::uniform_real_distribution<double> e(-1, 1);
   for (int trial = 0; trial < 200; ++trial) {
     double C[16];
-    if (trial % 2 == 0) {
-      const J2State s = random_j2(m, rng);
-      std::copy(s.C, s.C + 16, C);
-    } else {
-      for (double& c : C) c = e(rng) * m.M;
-    }
+    random_tangent(m, rng, trial % 2 == 0, C);
     const AcousticFourier F = acoustic_fourier(C);
     const double dmin = brute_min(C);
     const double tiny = 1e-13 * F.magnitude();
