@@ -234,7 +234,6 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
 
   fint_.assign(2 * nfe, 0.0);
   fext_.assign(2 * nfe, 0.0);
-  vold_.assign(2 * nfe, 0.0);
   inv_mfe_.resize(nfe);
   for (std::size_t i = 0; i < nfe; ++i) inv_mfe_[i] = 1.0 / fe_.mass()[i];
   mpm_v_.assign(2 * shared_.size(), 0.0);
@@ -314,7 +313,7 @@ void Hybrid::step() {
 
   // FE: forces at u^n, then their share at the shared nodes.
   fe_.internal_force(fe_.displacement().data(), fint_.data());
-  fe_.external_force(S.t, fext_.data());
+  fe_.refresh_external_force(S.t, fext_.data());
   const auto& mfe = fe_.mass();
   std::vector<double>& v = fe_.velocity();
   for (std::size_t k = 0; k < shared_.size(); ++k) {
@@ -385,6 +384,9 @@ void Hybrid::step() {
     const std::int64_t* gof = grid_of_fe_.data();
     const std::int32_t* dof = dash_of_fe_.data();
     const double* im = inv_mfe_.data();
+    // FE-only nodes advance u^{n+1} = u^n + dt v+ here (USL and MUSL alike: MUSL's re-mapped
+    // velocity differs from v+ only at nodes with particle mass, the shared ones, done below).
+    double* u = fe_.displacement().data();
     double work = 0, abs2 = 0;
 #pragma omp parallel for schedule(static) reduction(+ : work, abs2) num_threads(fe_.thread_count())
     for (std::int64_t i = 0; i < nn; ++i) {
@@ -419,6 +421,8 @@ void Hybrid::step() {
       work += dt * (fext_[2 * i] * 0.5 * (vx0 + vx) + fext_[2 * i + 1] * 0.5 * (vy0 + vy));
       v[2 * i] = vx;
       v[2 * i + 1] = vy;
+      u[2 * i] += dt * vx;
+      u[2 * i + 1] += dt * vy;
     }
     absorbed += abs2;
     fe_work_ += work;
@@ -446,15 +450,9 @@ void Hybrid::step() {
     }
     S.nodal_velocity(g.qx, g.qy, g.qx, g.qy);
     S.update_stress_and_position(g.qx, g.qy, true);
-    std::copy(v.begin(), v.end(), vold_.begin());
-    for (std::size_t k = 0; k < shared_.size(); ++k) {
-      const std::uint32_t e = shared_[k][0], n = shared_[k][1];
-      vold_[2 * e] = g.qx[n];
-      vold_[2 * e + 1] = g.qy[n];
-    }
-    fe_.advance_displacement(vold_.data(), dt);
+    advance_shared_displacement(g.qx, g.qy);
   } else {
-    fe_.advance_displacement(v.data(), dt);
+    advance_shared_displacement(g.vnx, g.vny);
     S.g2p_velocity(false, false);
     S.update_stress_and_position(g.vnx, g.vny, true);
   }
@@ -464,6 +462,16 @@ void Hybrid::step() {
   ++fe_.steps;
   S.check_outside();
   check_particles_in_fe_cells(false);
+}
+
+// u^{n+1} = u^n + dt w at the shared nodes, w the grid velocity that strains the particles.
+void Hybrid::advance_shared_displacement(const std::vector<double>& wx, const std::vector<double>& wy) {
+  double* u = fe_.displacement().data();
+  const double dt = mpm_.dt;
+  for (const auto& s : shared_) {
+    u[2 * s[0]] += dt * wx[s[1]];
+    u[2 * s[0] + 1] += dt * wy[s[1]];
+  }
 }
 
 // FE energies: kinetic 1/2 v M v; elastic 1/2 u^n K u^{n+1} (fint_ = -K u^n of the last step) or

@@ -122,6 +122,12 @@ void Solver::external_force(double time, double* f) const {
   add_loads(*impl_, time, f);
 }
 
+void Solver::refresh_external_force(double time, double* f) const {
+  for (const auto& l : impl_->loads)
+    for (const auto nd : l.nodes) f[2 * nd] = f[2 * nd + 1] = 0.0;
+  add_loads(*impl_, time, f);
+}
+
 void Solver::advance_displacement(const double* v, double h) {
   Impl& m = *impl_;
   const std::int64_t n = static_cast<std::int64_t>(m.u.size());
@@ -181,9 +187,7 @@ void Solver::step() {
   // f_ext is zero away from the loaded nodes (fext is zero-initialised and only these entries
   // are ever written): refresh just those, not the whole vector (a serial pass over every dof
   // would cap the two-thread speed-up).
-  for (const auto& l : m.loads)
-    for (const auto nd : l.nodes) m.fext[2 * nd] = m.fext[2 * nd + 1] = 0.0;
-  add_loads(m, t, m.fext.data());
+  refresh_external_force(t, m.fext.data());
   double* __restrict u = m.u.data();
   double* __restrict v = m.v.data();
   const double* __restrict fi = m.ku.data();

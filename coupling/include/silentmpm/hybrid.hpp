@@ -94,7 +94,7 @@ class Hybrid {
   long fe_row_lo_ = 0, fe_row_hi_ = -1;    // grid rows holding an FE cell (empty: lo > hi)
   std::vector<std::uint8_t> has_mpm_mass_; // per shared pair: node had MPM mass at setup
   std::size_t interface_count_ = 0;
-  std::vector<double> fint_, fext_, vold_; // FE per-dof work arrays
+  std::vector<double> fint_, fext_;        // FE per-dof work arrays
   std::vector<double> inv_mfe_;            // 1 / lumped mass per FE node
   std::vector<double> mpm_v_, sum_v_;      // per shared node: p_MPM / m_MPM, (p_MPM + m_FE v_FE) / m
   double fe_kinetic_ = 0, fe_elastic_ = 0;
@@ -103,6 +103,7 @@ class Hybrid {
 
   void check_particles_in_fe_cells(bool at_setup) const;
   void fe_energies(bool with_step_force);
+  void advance_shared_displacement(const std::vector<double>& wx, const std::vector<double>& wy);
 };
 
 }  // namespace smpm
