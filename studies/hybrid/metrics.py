@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Metrics and figures of the hybrid study: relative L2 differences of the probe histories against
-the all-MPM extended runs, CPU time, wall time and peak memory of each run (best of the timing
-runs), the hybrid's speed-up. Usage: metrics.py OUTDIR (the folder studies/hybrid/run wrote)."""
+the all-MPM extended runs, each film run's error against the all-MPM extended run at half the cell
+size, CPU time, wall time and peak memory of each run (best of the timing runs), the hybrid's
+speed-up, and the figures of build/bench_hybrid (step loops in one process). Usage: metrics.py OUTDIR (the folder studies/hybrid/run wrote)."""
 import csv
 import json
 import os
@@ -66,7 +67,8 @@ def timing(out, name):
 
 def main(out):
     film = ["film_extended", "film_silent", "film_hybrid_fixed", "film_hybrid_dashpot",
-            "film_hybrid_graded_fixed", "film_hybrid_coarse_fixed", "film_extended_elastic",
+            "film_hybrid_graded_fixed", "film_hybrid_coarse_fixed", "film_hybrid_unstructured_fixed",
+            "film_hybrid_unstructured_1um_fixed", "film_extended_elastic",
             "film_hybrid_fixed_elastic", "film_hybrid_graded_fixed_elastic",
             "film_hybrid_coarse_fixed_elastic"]
     pulse = ["pulse_extended", "pulse_silent", "pulse_hybrid_extended", "pulse_hybrid_dashpot"]
@@ -92,6 +94,27 @@ def main(out):
         s = json.load(open(os.path.join(out, n, "summary.json")))
         r["energy_relative_imbalance"] = s["energy"]["relative_imbalance"]
         m["runs"][n] = r
+    # Accuracy: each MUSL film run's error, its difference from the all-MPM extended run at half
+    # the cell size (0.05 um), against the extended run's own error. Equal accuracy: a hybrid's
+    # error within 5 % (relative) of the extended run's at every probe quantity.
+    fine_dir = os.path.join(out, "film_extended_fine")
+    if os.path.exists(os.path.join(fine_dir, "history.csv")):
+        fine = history(os.path.join(fine_dir, "history.csv"))
+        w = m["window"]["film"]
+        cols = ["E.syy", "F.syy", "E.J2", "F.J2", "E.sxx"]
+        err = {n: {c: rel_l2(H[n], fine, c, w[0], w[1]) for c in cols}
+               for n in film if not n.endswith("_elastic")}
+        acc = {"yardstick": "film_extended at 0.05 um cells, dt 1.6 ps (70 000 particles)",
+               "error_vs_fine": err, "error_ratio_to_extended": {}, "equal_accuracy": {}}
+        for n in err:
+            ratio = {c: err[n][c] / err["film_extended"][c] for c in cols}
+            acc["error_ratio_to_extended"][n] = ratio
+            acc["equal_accuracy"][n] = bool(all(abs(r - 1) <= 0.05 for r in ratio.values()))
+        m["accuracy_vs_fine"] = acc
+    # Issue 7's benchmark (build/bench_hybrid): step loops in one process, process CPU clock.
+    bj = os.path.join(out, "bench_hybrid.json")
+    if os.path.exists(bj):
+        m["benchmark"] = json.load(open(bj))
     # Process start alone (silentmpm --help: the shared libraries), best of the repetitions.
     starts = [cpu(os.path.join(out, "start_%d.txt" % k)) for k in repetitions(out, "start")]
     start = min(starts) if starts else None
@@ -104,6 +127,8 @@ def main(out):
     for hyb, ref in [("film_hybrid_fixed", "film_extended"), ("film_hybrid_dashpot", "film_extended"),
                      ("film_hybrid_graded_fixed", "film_extended"),
                      ("film_hybrid_coarse_fixed", "film_extended"),
+                     ("film_hybrid_unstructured_fixed", "film_extended"),
+                     ("film_hybrid_unstructured_1um_fixed", "film_extended"),
                      ("film_hybrid_fixed_elastic", "film_extended_elastic"),
                      ("film_hybrid_graded_fixed_elastic", "film_extended_elastic"),
                      ("film_hybrid_coarse_fixed_elastic", "film_extended_elastic"),
@@ -125,12 +150,40 @@ def main(out):
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(1, 2, figsize=(11, 4))
         for n, st in [("film_extended", "k-"), ("film_silent", "b--"), ("film_hybrid_fixed", "r-."),
-                      ("film_hybrid_dashpot", "g:"), ("film_hybrid_coarse_fixed", "m--")]:
+                      ("film_hybrid_dashpot", "g:"), ("film_hybrid_coarse_fixed", "m--"),
+                      ("film_hybrid_unstructured_fixed", "c-")]:
             for a, p in zip(ax, "EF"):
                 a.plot(H[n]["time"] * 1e9, H[n][p + ".syy"] / 1e9, st, label=n)
+        if "accuracy_vs_fine" in m:
+            for a, p in zip(ax, "EF"):
+                a.plot(fine["time"] * 1e9, fine[p + ".syy"] / 1e9, color="0.6", lw=0.8,
+                       label="film_extended at 0.05 um (yardstick)")
         for a, p in zip(ax, "EF"):
             a.set_xlabel("t (ns)"); a.set_ylabel("sigma_yy at %s (GPa)" % p); a.legend(fontsize=7)
         fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_film.png"), dpi=120)
+        # Cost against accuracy: step-loop CPU time (build/bench_hybrid where it ran, else the
+        # timing runs' step wall time) and the error against the 0.05 um run.
+        if "accuracy_vs_fine" in m:
+            bc = m.get("benchmark", {}).get("cases", {})
+            show = [("film_extended", "extended", "ks"), ("film_silent", "film_silent", "bv"),
+                    ("film_hybrid_coarse_fixed", "film_hybrid_coarse_fixed", "m^"),
+                    ("film_hybrid_unstructured_fixed", "film_hybrid_unstructured_fixed", "co"),
+                    ("film_hybrid_unstructured_1um_fixed", "film_hybrid_unstructured_1um_fixed", "rD")]
+            fig, ax = plt.subplots(1, 4, figsize=(14, 3.6), sharex=True)
+            for a, c in zip(ax, ["E.syy", "F.syy", "E.J2", "F.J2"]):
+                top = 0
+                for n, bn, st in show:
+                    if not m["runs"][n]["timing"]:
+                        continue
+                    t = bc[bn]["step_cpu_seconds_min"] if bn in bc else m["runs"][n]["timing"]["step_wall_seconds"]
+                    e = m["accuracy_vs_fine"]["error_vs_fine"][n][c]
+                    top = max(top, e)
+                    a.plot([t], [e], st, label=n)
+                a.set_xlabel("step loop, one thread (s)")
+                a.set_title("%s: error vs the 0.05 um run" % c, fontsize=9)
+                a.set_xlim(left=0); a.set_ylim(0, 1.15 * top)
+            ax[0].legend(fontsize=6, loc="lower right")
+            fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_cost_accuracy.png"), dpi=120)
         fig, ax = plt.subplots(1, 2, figsize=(11, 4))
         for n, st in [("pulse_extended", "k-"), ("pulse_silent", "b--"), ("pulse_hybrid_extended", "r-."),
                       ("pulse_hybrid_dashpot", "g:")]:
@@ -142,6 +195,17 @@ def main(out):
     except ImportError:
         pass
     print(json.dumps(sp, indent=2))
+    if "benchmark" in m:
+        print("benchmark (step loops, one thread, CPU):")
+        for n, b in m["benchmark"]["cases"].items():
+            print("  %-36s %6.3f s  x %.2f (min)  x %.2f (median)" % (
+                n, b["step_cpu_seconds_min"], b["speedup_over_reference_min"],
+                b["speedup_over_reference_median"]))
+    if "accuracy_vs_fine" in m:
+        print("error vs the 0.05 um extended run (E.syy F.syy E.J2 F.J2 E.sxx), equal accuracy:")
+        for n, e in m["accuracy_vs_fine"]["error_vs_fine"].items():
+            print("  %-36s %s  %s" % (n, " ".join("%.4f" % v for v in e.values()),
+                                      m["accuracy_vs_fine"]["equal_accuracy"][n]))
 
 
 if __name__ == "__main__":
