@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -91,9 +92,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     if (a == "--reps") {
-      reps = std::atoi(argv[++i]);
+      char* end = nullptr;
+      const long r = std::strtol(argv[++i], &end, 10);
+      reps = (end && *end == '\0' && r >= 1 && r <= 1000) ? static_cast<int>(r) : 0;
       if (reps < 1) {
-        std::fprintf(stderr, "bench_hybrid: --reps must be a positive integer, got %s\n", argv[i]);
+        std::fprintf(stderr, "bench_hybrid: --reps must be an integer in 1..1000, got %s\n", argv[i]);
         return 2;
       }
     } else if (a == "--json") {
@@ -127,6 +130,14 @@ int main(int argc, char** argv) {
     if (f.name.size() > 5 && f.name.compare(f.name.size() - 5, 5, ".json") == 0)
       f.name.resize(f.name.size() - 5);
   }
+  std::ofstream json_file;
+  if (!json_out.empty()) {  // before the runs: an unwritable path is reported at once
+    json_file.open(json_out);
+    if (!json_file) {
+      std::fprintf(stderr, "bench_hybrid: cannot write %s\n", json_out.c_str());
+      return 1;
+    }
+  }
   std::printf("bench_hybrid: step loops on one thread, %d alternating repetitions; first case = reference\n",
               reps);
   try {
@@ -134,6 +145,10 @@ int main(int argc, char** argv) {
       for (auto& f : cases) run_once(f);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_hybrid: %s\n", e.what());
+    if (json_file.is_open()) {  // no empty figures file left behind
+      json_file.close();
+      std::remove(json_out.c_str());
+    }
     return 1;
   }
   const Figures& ref = cases.front();
@@ -168,8 +183,9 @@ int main(int argc, char** argv) {
                             {"speedup_over_reference_median", xmed}};
   }
   if (!json_out.empty()) {
-    std::ofstream o(json_out);
+    std::ofstream& o = json_file;
     o << out.dump(2) << "\n";
+    o.flush();
     if (!o) {
       std::fprintf(stderr, "bench_hybrid: cannot write %s\n", json_out.c_str());
       return 1;
