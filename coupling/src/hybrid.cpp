@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "silentmpm/dashpot.hpp"
 #include "silentmpm/shape.hpp"
 
 namespace smpm {
@@ -341,24 +342,10 @@ void Hybrid::step() {
     const std::uint32_t e = shared_[k][0], n = shared_[k][1];
     if (dash_of_fe_[e] < 0) continue;
     const auto& c = D[dash_of_fe_[e]];
-    const double mi = g.m[n], hh = 0.5 * dt;
-    const double cxx = c.cxx + g.cxx[n], cxy = c.cxy + g.cxy[n], cyy = c.cyy + g.cyy[n];
     const double vx = g.vx[n], vy = g.vy[n];
-    const double rx = mi * vx - hh * (cxx * vx + cxy * vy) + dt * g.fx[n];
-    const double ry = mi * vy - hh * (cxy * vx + cyy * vy) + dt * g.fy[n];
-    const double A = mi + hh * cxx, B = hh * cxy, Dd = mi + hh * cyy;
-    double a = 0, b = 0;
-    switch (g.fix[n] & 3) {
-      case 0: {
-        const double det = A * Dd - B * B;
-        a = (Dd * rx - B * ry) / det;
-        b = (A * ry - B * rx) / det;
-        break;
-      }
-      case 1: b = ry / Dd; break;
-      case 2: a = rx / A; break;
-      default: break;
-    }
+    double a, b;
+    dashpot_velocity(g.m[n], c.cxx + g.cxx[n], c.cxy + g.cxy[n], c.cyy + g.cyy[n], vx, vy, g.fx[n],
+                     g.fy[n], dt, g.fix[n], a, b);
     g.vnx[n] = a;
     g.vny[n] = b;
     const double bx = 0.5 * (vx + a), by = 0.5 * (vy + b);
@@ -399,22 +386,7 @@ void Hybrid::step() {
         vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy * im[i];
       } else {
         const auto& c = D[dof[i]];
-        const double hh = 0.5 * dt;
-        const double rx = mi * vx0 - hh * (c.cxx * vx0 + c.cxy * vy0) + dt * fx;
-        const double ry = mi * vy0 - hh * (c.cxy * vx0 + c.cyy * vy0) + dt * fy;
-        const double A = mi + hh * c.cxx, B = hh * c.cxy, Dd = mi + hh * c.cyy;
-        vx = 0; vy = 0;
-        switch (mask[i] & 3) {
-          case 0: {
-            const double det = A * Dd - B * B;
-            vx = (Dd * rx - B * ry) / det;
-            vy = (A * ry - B * rx) / det;
-            break;
-          }
-          case 1: vy = ry / Dd; break;
-          case 2: vx = rx / A; break;
-          default: break;
-        }
+        dashpot_velocity(mi, c.cxx, c.cxy, c.cyy, vx0, vy0, fx, fy, dt, mask[i], vx, vy);
         const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
         abs2 += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
       }

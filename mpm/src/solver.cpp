@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "silentmpm/dashpot.hpp"
 #include "silentmpm/film.hpp"
 #include "silentmpm/shape.hpp"
 
@@ -425,27 +426,10 @@ void Solver::grid_update() {
     uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * fy[i] / mi;
   }
   if (!has_nodal_dashpot_) return;
-  const double h = 0.5 * dt;
   for (long i : dashpot_nodes_) {
-    const double mi = m[i];
-    if (mi <= floor) continue;
-    const double cxx = grid.cxx[i], cxy = grid.cxy[i], cyy = grid.cyy[i];
-    const double rx = mi * vx[i] - h * (cxx * vx[i] + cxy * vy[i]) + DT * fx[i];
-    const double ry = mi * vy[i] - h * (cxy * vx[i] + cyy * vy[i]) + DT * fy[i];
-    const double A = mi + h * cxx, B = h * cxy, D = mi + h * cyy;
-    double a = 0, b = 0;
-    switch (fix[i] & 3) {
-      case 0: {
-        const double det = A * D - B * B;
-        a = (D * rx - B * ry) / det;
-        b = (A * ry - B * rx) / det;
-        break;
-      }
-      case 1: b = ry / D; break;   // x held: solve for y alone
-      case 2: a = rx / A; break;   // y held
-      default: break;
-    }
-    ux[i] = a; uy[i] = b;
+    if (m[i] <= floor) continue;
+    dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
+                     fix[i], ux[i], uy[i]);
   }
 }
 
