@@ -102,15 +102,19 @@ nlohmann::ordered_json summary_head(const Case& c, const RunResult& r, double dt
 }
 
 nlohmann::ordered_json energy_json(const Energies& e) {
-  const double scale = std::max({std::abs(e.initial) + std::abs(e.external_work), 1e-300});
-  return nlohmann::ordered_json{{"kinetic", e.kinetic},
-                                {"elastic", e.elastic},
-                                {"dissipated", e.dissipated},
-                                {"absorbed", e.absorbed},
-                                {"external_work", e.external_work},
-                                {"initial", e.initial},
-                                {"imbalance", e.imbalance()},
-                                {"relative_imbalance", e.imbalance() / scale}};
+  const double scale = std::abs(e.initial) + std::abs(e.external_work);
+  nlohmann::ordered_json j{{"kinetic", e.kinetic},
+                           {"elastic", e.elastic},
+                           {"dissipated", e.dissipated},
+                           {"absorbed", e.absorbed},
+                           {"external_work", e.external_work},
+                           {"initial", e.initial},
+                           {"imbalance", e.imbalance()}};
+  // Relative to the energy put in (initial + external work); null when nothing was put in (an
+  // unloaded region of a hybrid, whose energy all crossed the interface).
+  if (scale > 0) j["relative_imbalance"] = e.imbalance() / scale;
+  else j["relative_imbalance"] = nullptr;
+  return j;
 }
 
 nlohmann::ordered_json silents_json(const Solver& s) {

@@ -108,6 +108,9 @@ RunResult run_hybrid_case(Case& c, const std::string& out_dir) {
   j["energy"] = energy_json(hy.energy);
   j["energy_mpm"] = energy_json(s.energy);
   j["energy_fem"] = energy_json(fe.energy);
+  j["energy_regions_note"] = "energy_mpm and energy_fem hold each region's own terms; their "
+                             "imbalances are the energy that crossed the MPM-FEM interface and sum "
+                             "to the total imbalance in energy";
   j["silent_boundaries"] = silents_json(s);
   j["loads"] = c.notes;
   j["outputs"] = {{"history", "history.csv"},
