@@ -168,6 +168,12 @@ TEST(HybridCase, ErrorsNameTheKey) {
   c = plate_case("hybrid");
   c["probes"][0]["fields"] = {"div"};  // A is in the particles: no div there
   EXPECT_NE(case_error(c).find("h.json: probes[0].fields"), std::string::npos) << case_error(c);
+  // A probe along a curve is an MPM probe: its errors come from the MPM parser, reported at the
+  // probe's index in the document (probes[2], the first MPM probe after A and the FE probe B).
+  c = plate_case("hybrid");
+  c["probes"].push_back({{"name", "C"}, {"curve", 12}, {"count", 3}});
+  EXPECT_NE(case_error(c).find("h.json: probes[2].curve: needs the top-level key \"geometry\""),
+            std::string::npos) << case_error(c);
   c = plate_case("hybrid");
   c["extra"] = 1;
   EXPECT_NE(case_error(c).find("h.json: extra: unknown key in a hybrid"), std::string::npos)

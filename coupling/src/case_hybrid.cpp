@@ -66,10 +66,10 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
     for (std::size_t i = 0; i < probes->size(); ++i) {
       const ojson& p = (*probes)[i];
       if (!p.is_object()) fail(source, probe_path(i), "expected an object");
-      if (p.contains("curve"))
-        fail(source, probe_path(i) + ".curve",
-             "probes along a curve are not available in hybrid cases; give points with \"at\"");
-      const ojson* at = p.contains("at") ? &p["at"] : nullptr;
+      // A probe along a curve is read from the particles: its curve is a physical curve of the
+      // MPM region's geometry, and every point must lie in one of its bodies (the MPM parser
+      // checks both), hence outside the FE cells.
+      const ojson* at = p.contains("at") && !p.contains("curve") ? &p["at"] : nullptr;
       int idx = -1;
       if (at && at->is_array() && at->size() == 2 && (*at)[0].is_number() && (*at)[1].is_number())
         idx = fe.add_probe((*at)[0].get<double>(), (*at)[1].get<double>());
@@ -105,11 +105,20 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
   static const std::vector<std::string> fem_fields = {"sxx", "syy", "szz", "sxy", "J2",
                                                       "vx",  "vy",  "div", "curl"};
   std::vector<ProbeSpec> all;
+  std::vector<std::size_t> origin;  // document index of each entry of all
   std::size_t next_mpm = 0;
   if (probes)
     for (std::size_t i = 0; i < probes->size(); ++i) {
       if (fem_probe[i] < 0) {
+        // One entry for a point probe; the points of a probe along a curve (named after it in
+        // `along`, consecutive).
         all.push_back(c.probes.at(next_mpm++));
+        origin.push_back(i);
+        const std::string along = all.back().along;
+        while (!along.empty() && next_mpm < c.probes.size() && c.probes[next_mpm].along == along) {
+          all.push_back(c.probes[next_mpm++]);
+          origin.push_back(i);
+        }
         continue;
       }
       const ojson& p = (*probes)[i];
@@ -150,11 +159,12 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
         pr.fields = {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"};
       }
       all.push_back(std::move(pr));
+      origin.push_back(i);
     }
   for (std::size_t i = 0; i < all.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (all[i].name == all[j].name)
-        fail(source, probe_path(i) + ".name", "probe name \"" + all[i].name + "\" is used twice");
+        fail(source, probe_path(origin[i]) + ".name", "probe name \"" + all[i].name + "\" is used twice");
   c.probes = std::move(all);
 
   // Couple.

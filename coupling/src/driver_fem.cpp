@@ -20,6 +20,7 @@ RunResult run_fem_case(Case& c, const std::string& out_dir) {
   std::error_code ec;
 
   const std::vector<std::string> cols = history_columns(c.probes);
+  write_probe_table(dir, c.probes);
   HistoryWriter hist;
   hist.open((dir / "history.csv").string(), cols);
   std::vector<double> row(cols.size());
@@ -74,6 +75,7 @@ RunResult run_fem_case(Case& c, const std::string& out_dir) {
   j["energy"] = energy_json(s.energy);
   j["model"] = c.notes;
   j["outputs"] = {{"history", "history.csv"},
+                  {"probes", "probes.csv"},
                   {"snapshots", s.snapshot_count()},
                   {"xdmf", snap_every ? "fem.xdmf" : ""}};
   write_summary(dir, j);

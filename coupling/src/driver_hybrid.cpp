@@ -32,6 +32,7 @@ RunResult run_hybrid_case(Case& c, const std::string& out_dir) {
     }
   }
   const std::vector<std::string> cols = history_columns(c.probes);
+  write_probe_table(dir, c.probes);
   HistoryWriter hist;
   hist.open((dir / "history.csv").string(), cols);
   std::vector<double> row(cols.size());
@@ -113,7 +114,10 @@ RunResult run_hybrid_case(Case& c, const std::string& out_dir) {
                              "to the total imbalance in energy";
   j["silent_boundaries"] = silents_json(s);
   j["loads"] = c.notes;
+  j["bodies"] = bodies_json(c, s);
+  j["curve_probes"] = curve_probes_json(c.probes);
   j["outputs"] = {{"history", "history.csv"},
+                  {"probes", "probes.csv"},
                   {"snapshots", snap_every ? snap.count() : 0},
                   {"xdmf", snap_every ? "particles.xdmf" : ""},
                   {"fem_snapshots", fe.snapshot_count()},

@@ -27,6 +27,19 @@ def rel_l2(a, b, col, t0=0.0, t1=np.inf):
     return float(np.sqrt(np.sum((a[col][m] - bb) ** 2) / np.sum(bb ** 2)))
 
 
+def interface_l2(a, b, field="syy", t0=0.0, t1=np.inf, n=21):
+    """Relative L2 of the probe along the W-Si interface (I_00 ... I_20), all points together."""
+    t = a["time"]
+    m = (t >= t0) & (t <= t1)
+    num = den = 0.0
+    for k in range(n):
+        c = "I_%02d.%s" % (k, field)
+        bb = np.interp(t[m], b["time"], b[c])
+        num += np.sum((a[c][m] - bb) ** 2)
+        den += np.sum(bb ** 2)
+    return float(np.sqrt(num / den))
+
+
 def repetitions(out, prefix):
     """Numbers k of the files OUTDIR/<prefix>_<k>.txt, sorted."""
     ks = []
@@ -90,6 +103,9 @@ def main(out):
         if n != ref:
             w = m["window"]["film" if n.startswith("film") else "pulse"]
             r["rel_l2"] = {c: rel_l2(H[n], H[ref], c, w[0], w[1]) for c in cols}
+            if "I_00.syy" in H[n] and "I_00.syy" in H[ref]:  # the probe along the W-Si interface
+                r["rel_l2"]["I.syy"] = interface_l2(H[n], H[ref], "syy", w[0], w[1])
+                r["rel_l2"]["I.sxy"] = interface_l2(H[n], H[ref], "sxy", w[0], w[1])
         r["timing"] = timing(out, n)
         s = json.load(open(os.path.join(out, n, "summary.json")))
         r["energy_relative_imbalance"] = s["energy"]["relative_imbalance"]
