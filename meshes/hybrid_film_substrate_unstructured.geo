@@ -10,19 +10,21 @@
 // mesh has them.
 //
 // Parameters: h (the case's fem.size), top (interface height, default 3.5 um: 1.5 um of
-// particles under the film; hybrid_film_substrate_unstructured_1um.geo sets 4 um), grow.
+// particles under the film; hybrid_film_substrate_unstructured_1um.geo sets 4 um), grow, y0
+// (bottom, default -10 um: the 15 um substrate; hybrid_film_substrate_unstructured_30um.geo
+// sets -25 um).
 //
 // Physical groups (project convention; no Physical Points):
 //   surface 1  substrate  (band + graded block)
 //   curve  11  left    x = 0
 //   curve  12  right   x = 10 um
-//   curve  13  bottom  y = -10 um
+//   curve  13  bottom  y = y0 (-10 um)
 //   curve  14  top     y = top    (the interface with the particles)
 DefineConstant[ h = {5e-7, Name "Parameters/h"} ];
 DefineConstant[ top = {3.5e-6, Name "Parameters/top"} ];
 DefineConstant[ grow = {0.1, Name "Parameters/grow"} ];
+DefineConstant[ y0 = {-10e-6, Name "Parameters/bottom"} ];
 L = 10e-6;
-y0 = -10e-6;
 yb = top - 1e-6;
 Point(1) = {0, y0, 0};
 Point(2) = {L, y0, 0};
