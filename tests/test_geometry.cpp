@@ -371,7 +371,7 @@ TEST(GeometryMeshes, ConventionAndAreas) {
         {"inclined_edge.geo", 0.01}, {"ring.geo", 0.002}, {"pulse_plate.geo", 0.005},
         {"pulse_extended.geo", 0.005}, {"hybrid_film_substrate.geo", 5e-7},
         {"hybrid_film_substrate_graded.geo", 5e-7}, {"hybrid_pulse_50.geo", 0.005},
-        {"hybrid_pulse_150.geo", 0.005}};
+        {"hybrid_pulse_150.geo", 0.005}, {"film_30um.geo", 5e-7}, {"film_hybrid_1500nm.geo", 5e-7}};
     const auto cs = coarse.find(name);
     try {
       g = load_geometry(entry.path().string(), cs == coarse.end() ? 0.0 : cs->second);
