@@ -81,7 +81,8 @@ def timing(out, name):
 def main(out):
     film = ["film_extended", "film_silent", "film_hybrid_fixed", "film_hybrid_dashpot",
             "film_hybrid_graded_fixed", "film_hybrid_coarse_fixed", "film_hybrid_unstructured_fixed",
-            "film_hybrid_unstructured_1um_fixed", "film_extended_elastic",
+            "film_hybrid_unstructured_1um_fixed", "film_extended_30um",
+            "film_hybrid_unstructured_30um_fixed", "film_extended_elastic",
             "film_hybrid_fixed_elastic", "film_hybrid_graded_fixed_elastic",
             "film_hybrid_coarse_fixed_elastic"]
     pulse = ["pulse_extended", "pulse_silent", "pulse_hybrid_extended", "pulse_hybrid_dashpot"]
@@ -94,14 +95,17 @@ def main(out):
          # extended substrate (15 um) holds to 3.25 ns, past the end of the runs (3.2 ns).
          "window": {"film": [0.0, 3.2e-9], "pulse": [0.0, 43e-6]},
          "runs": {}}
+    m["reference"]["film_30um"] = "film_extended_30um (all-MPM, 30 um substrate, to 6.4 ns)"
+    m["window"]["film_30um"] = [0.0, 6.4e-9]
     for n in film + pulse:
-        ref = ("film_extended_elastic" if n.endswith("_elastic") else "film_extended") \
+        ref = ("film_extended_elastic" if n.endswith("_elastic") else
+               "film_extended_30um" if n.endswith("30um_fixed") else "film_extended") \
             if n.startswith("film") else "pulse_extended"
         cols = ["E.syy", "F.syy", "E.J2", "F.J2", "E.sxx"] if n.startswith("film") else \
             ["A.sxx", "A.syy"]
         r = {"reference": ref}
         if n != ref:
-            w = m["window"]["film" if n.startswith("film") else "pulse"]
+            w = m["window"]["film_30um" if "30um" in n else "film" if n.startswith("film") else "pulse"]
             r["rel_l2"] = {c: rel_l2(H[n], H[ref], c, w[0], w[1]) for c in cols}
             if "I_00.syy" in H[n] and "I_00.syy" in H[ref]:  # the probe along the W-Si interface
                 r["rel_l2"]["I.syy"] = interface_l2(H[n], H[ref], "syy", w[0], w[1])
@@ -119,11 +123,21 @@ def main(out):
         w = m["window"]["film"]
         cols = ["E.syy", "F.syy", "E.J2", "F.J2", "E.sxx"]
         err = {n: {c: rel_l2(H[n], fine, c, w[0], w[1]) for c in cols}
-               for n in film if not n.endswith("_elastic")}
+               for n in film if not n.endswith("_elastic") and "30um" not in n}
         acc = {"yardstick": "film_extended at 0.05 um cells, dt 1.6 ps (70 000 particles)",
                "error_vs_fine": err, "error_ratio_to_extended": {}, "equal_accuracy": {}}
+        # The 30 um pair over [0, 6.4 ns] against the 30 um run at 0.05 um.
+        fine30_dir = os.path.join(out, "film_extended_30um_fine")
+        refs = {n: "film_extended" for n in err}
+        if os.path.exists(os.path.join(fine30_dir, "history.csv")):
+            fine30 = history(os.path.join(fine30_dir, "history.csv"))
+            w30 = m["window"]["film_30um"]
+            for n in ("film_extended_30um", "film_hybrid_unstructured_30um_fixed"):
+                err[n] = {c: rel_l2(H[n], fine30, c, w30[0], w30[1]) for c in cols}
+                refs[n] = "film_extended_30um"
+            acc["yardstick_30um"] = "film_extended_30um at 0.05 um cells, dt 1.6 ps, over [0, 6.4 ns]"
         for n in err:
-            ratio = {c: err[n][c] / err["film_extended"][c] for c in cols}
+            ratio = {c: err[n][c] / err[refs[n]][c] for c in cols}
             acc["error_ratio_to_extended"][n] = ratio
             acc["equal_accuracy"][n] = bool(all(abs(r - 1) <= 0.05 for r in ratio.values()))
         m["accuracy_vs_fine"] = acc
@@ -131,6 +145,9 @@ def main(out):
     bj = os.path.join(out, "bench_hybrid.json")
     if os.path.exists(bj):
         m["benchmark"] = json.load(open(bj))
+    bj = os.path.join(out, "bench_hybrid_30um.json")
+    if os.path.exists(bj):
+        m["benchmark_30um"] = json.load(open(bj))
     # Process start alone (silentmpm --help: the shared libraries), best of the repetitions.
     starts = [cpu(os.path.join(out, "start_%d.txt" % k)) for k in repetitions(out, "start")]
     start = min(starts) if starts else None
@@ -145,6 +162,7 @@ def main(out):
                      ("film_hybrid_coarse_fixed", "film_extended"),
                      ("film_hybrid_unstructured_fixed", "film_extended"),
                      ("film_hybrid_unstructured_1um_fixed", "film_extended"),
+                     ("film_hybrid_unstructured_30um_fixed", "film_extended_30um"),
                      ("film_hybrid_fixed_elastic", "film_extended_elastic"),
                      ("film_hybrid_graded_fixed_elastic", "film_extended_elastic"),
                      ("film_hybrid_coarse_fixed_elastic", "film_extended_elastic"),
@@ -200,6 +218,19 @@ def main(out):
                 a.set_xlim(left=0); a.set_ylim(0, 1.15 * top)
             ax[0].legend(fontsize=6, loc="lower right")
             fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_cost_accuracy.png"), dpi=120)
+        if "film_hybrid_unstructured_30um_fixed" in H:
+            fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+            curves = [("film_extended_30um", H["film_extended_30um"], "k-"),
+                      ("film_hybrid_unstructured_30um_fixed", H["film_hybrid_unstructured_30um_fixed"], "c-")]
+            if "accuracy_vs_fine" in m and "yardstick_30um" in m["accuracy_vs_fine"]:
+                curves.append(("film_extended_30um at 0.05 um (yardstick)", fine30, "0.6"))
+            for lab, h, st in curves:
+                for a, p in zip(ax, "EF"):
+                    a.plot(h["time"] * 1e9, h[p + ".syy"] / 1e9, st if st != "0.6" else "-",
+                           color=None if st != "0.6" else "0.6", lw=1.0 if st != "0.6" else 0.8, label=lab)
+            for a, p in zip(ax, "EF"):
+                a.set_xlabel("t (ns)"); a.set_ylabel("sigma_yy at %s (GPa)" % p); a.legend(fontsize=7)
+            fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_film_30um.png"), dpi=120)
         fig, ax = plt.subplots(1, 2, figsize=(11, 4))
         for n, st in [("pulse_extended", "k-"), ("pulse_silent", "b--"), ("pulse_hybrid_extended", "r-."),
                       ("pulse_hybrid_dashpot", "g:")]:
@@ -211,9 +242,11 @@ def main(out):
     except ImportError:
         pass
     print(json.dumps(sp, indent=2))
-    if "benchmark" in m:
-        print("benchmark (step loops, one thread, CPU):")
-        for n, b in m["benchmark"]["cases"].items():
+    for key in ("benchmark", "benchmark_30um"):
+        if key not in m:
+            continue
+        print("%s (step loops, one thread, CPU):" % key)
+        for n, b in m[key]["cases"].items():
             print("  %-36s %6.3f s  x %.2f (min)  x %.2f (median)" % (
                 n, b["step_cpu_seconds_min"], b["speedup_over_reference_min"],
                 b["speedup_over_reference_median"]))
