@@ -99,7 +99,7 @@ def main(out):
     m["window"]["film_30um"] = [0.0, 6.4e-9]
     for n in film + pulse:
         ref = ("film_extended_elastic" if n.endswith("_elastic") else
-               "film_extended_30um" if n.endswith("30um_fixed") else "film_extended") \
+               "film_extended_30um" if "30um" in n else "film_extended") \
             if n.startswith("film") else "pulse_extended"
         cols = ["E.syy", "F.syy", "E.J2", "F.J2", "E.sxx"] if n.startswith("film") else \
             ["A.sxx", "A.syy"]
@@ -220,14 +220,13 @@ def main(out):
             fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_cost_accuracy.png"), dpi=120)
         if "film_hybrid_unstructured_30um_fixed" in H:
             fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-            curves = [("film_extended_30um", H["film_extended_30um"], "k-"),
-                      ("film_hybrid_unstructured_30um_fixed", H["film_hybrid_unstructured_30um_fixed"], "c-")]
+            curves = [("film_extended_30um", H["film_extended_30um"], "k", 1.0),
+                      ("film_hybrid_unstructured_30um_fixed", H["film_hybrid_unstructured_30um_fixed"], "c", 1.0)]
             if "accuracy_vs_fine" in m and "yardstick_30um" in m["accuracy_vs_fine"]:
-                curves.append(("film_extended_30um at 0.05 um (yardstick)", fine30, "0.6"))
-            for lab, h, st in curves:
+                curves.append(("film_extended_30um at 0.05 um (yardstick)", fine30, "0.6", 0.8))
+            for lab, h, col, lw in curves:
                 for a, p in zip(ax, "EF"):
-                    a.plot(h["time"] * 1e9, h[p + ".syy"] / 1e9, st if st != "0.6" else "-",
-                           color=None if st != "0.6" else "0.6", lw=1.0 if st != "0.6" else 0.8, label=lab)
+                    a.plot(h["time"] * 1e9, h[p + ".syy"] / 1e9, "-", color=col, lw=lw, label=lab)
             for a, p in zip(ax, "EF"):
                 a.set_xlabel("t (ns)"); a.set_ylabel("sigma_yy at %s (GPa)" % p); a.legend(fontsize=7)
             fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_film_30um.png"), dpi=120)
