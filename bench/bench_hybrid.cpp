@@ -102,7 +102,13 @@ int main(int argc, char** argv) {
     } else if (a == "--json") {
       json_out = argv[++i];
     } else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_hybrid [--reps R] [--json FILE] [CASE.json ...]\n");
+      std::printf(
+          "usage: bench_hybrid [--reps R] [--json FILE] [CASE.json ...]\n"
+          "  Runs each case's whole step loop on one thread without output, the cases alternating\n"
+          "  R times (default 5); prints per case the step-loop CPU time (min, median), wall time,\n"
+          "  particle- and FE dof-updates per second and the speed-up over the first case.\n"
+          "  Default cases: studies/film/cases/extended.json (the reference) and the hybrid film\n"
+          "  cases of studies/hybrid/cases. --json FILE also writes the figures as JSON.\n");
       return 0;
     } else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "bench_hybrid: unknown option %s (see --help)\n", a.c_str());
