@@ -12,10 +12,9 @@
 // particle-updates and FE dof-updates per second, and the step-loop speed-up of each case over
 // the first one (the reference).
 //
-//   build/bench_hybrid [--reps R] [CASE.json ...]
+//   build/bench_hybrid [--reps R] [--json FILE] [CASE.json ...]
 //     default cases: studies/film/cases/extended.json and the hybrid study's hybrid cases
 //     --json FILE    also write the figures as JSON
-#include <omp.h>
 #include <time.h>
 
 #include <algorithm>
@@ -23,7 +22,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -189,10 +187,9 @@ int main(int argc, char** argv) {
                             {"speedup_over_reference_median", xmed}};
   }
   if (!json_out.empty()) {
-    std::ofstream& o = json_file;
-    o << out.dump(2) << "\n";
-    o.flush();
-    if (!o) {
+    json_file << out.dump(2) << "\n";
+    json_file.flush();
+    if (!json_file) {
       std::fprintf(stderr, "bench_hybrid: cannot write %s\n", json_out.c_str());
       return 1;
     }

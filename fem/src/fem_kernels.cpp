@@ -117,23 +117,10 @@ void add_loads(const Solver::Impl& m, double time, double* f) {
 }
 }  // namespace
 
-void Solver::external_force(double time, double* f) const {
-  std::fill(f, f + dofs(), 0.0);
-  add_loads(*impl_, time, f);
-}
-
 void Solver::refresh_external_force(double time, double* f) const {
   for (const auto& l : impl_->loads)
     for (const auto nd : l.nodes) f[2 * nd] = f[2 * nd + 1] = 0.0;
   add_loads(*impl_, time, f);
-}
-
-void Solver::advance_displacement(const double* v, double h) {
-  Impl& m = *impl_;
-  const std::int64_t n = static_cast<std::int64_t>(m.u.size());
-#pragma omp parallel for schedule(static) num_threads(m.threads) if (n >= kParallelMinimum)
-  for (std::int64_t i = 0; i < n; ++i) m.u[i] += h * v[i];
-  m.ku_valid = false;
 }
 
 void Solver::set_dt(double h) {

@@ -153,13 +153,10 @@ class Solver {
   const std::vector<std::uint32_t>& cell_nodes() const;
   // Constraint mask per node: bit 0 = x held, bit 1 = y held.
   const std::vector<std::uint8_t>& constraint_mask() const;
-  // External nodal force f_ext(t) (2 per node) into f (overwrites).
-  void external_force(double time, double* f) const;
-  // The same on the loaded nodes only: f must hold zero on every other node (a vector only ever
-  // written by this call), so that a step costs O(loaded nodes), not O(dofs).
+  // External nodal force f_ext(t) (2 per node) into f, written on the loaded nodes only: f must
+  // hold zero on every other node (start from a zero vector written only by this call), so that
+  // a step costs O(loaded nodes), not O(dofs).
   void refresh_external_force(double time, double* f) const;
-  // Advance u by dt * v for a given velocity field (2 per node).
-  void advance_displacement(const double* v, double dt_);
   // Nodes on the given boundary ids (physical curve tags), sorted.
   std::vector<std::uint32_t> boundary_nodes(const std::vector<int>& curves) const;
 
