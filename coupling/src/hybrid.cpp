@@ -246,7 +246,10 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   energy = Energies();
   energy.initial = mpm_.energy.initial + fe_initial_;
   update_energies();
+  mpm_.attach(this);
 }
+
+Hybrid::~Hybrid() { mpm_.detach(this); }
 
 double Hybrid::critical_dt() const { return std::min(mpm_.critical_dt(), fe_.critical_dt()); }
 
@@ -269,12 +272,8 @@ void Hybrid::check_particles_in_fe_cells(bool at_setup) const {
   if (!at_setup) {
     // The step that moved the particles recorded the rows they occupy, per strip: when none of
     // those rows holds an FE cell (the film: particles above the interface), nothing to check.
-    long lo = std::numeric_limits<long>::max(), hi = std::numeric_limits<long>::min();
-    for (int s = 0; s < mpm_.nstrips_; ++s)
-      if (mpm_.strip_lo_[s] <= mpm_.strip_hi_[s]) {
-        lo = std::min<long>(lo, mpm_.strip_lo_[s]);
-        hi = std::max<long>(hi, mpm_.strip_hi_[s]);
-      }
+    long lo, hi;
+    mpm_.occupied_rows(lo, hi);
     if (lo > hi || hi < fe_row_lo_ || lo > fe_row_hi_) return;
   }
   long first = n;
@@ -296,30 +295,27 @@ void Hybrid::check_particles_in_fe_cells(bool at_setup) const {
   throw HybridError(o.str());
 }
 
-void Hybrid::step() {
-  Solver& S = mpm_;
-  Grid& g = S.grid;
-  const double dt = S.dt;
-  if (fe_.dt != dt) set_dt(dt);
-  if (!S.strips_ok_) S.sort_particles();
+// ---- the hooks of the coupled step ----------------------------------------------------------
+
+void Hybrid::after_momentum(Solver& S) {
   if (S.contact.multi())
     throw HybridError("hybrid: multi-velocity-field contact is not supported with an FEM region");
   if (S.opt.scheme == Scheme::USF)
     throw HybridError("hybrid: the coupled step supports the USL and MUSL schemes, not USF");
+}
 
-  // MPM: masses, momenta, forces, particle-carried loads.
-  S.reset_grid();
-  S.p2g(true, true);
-  S.apply_loads();
-
-  // FE: forces at u^n, then their share at the shared nodes.
+// After the MPM p2g and particle-carried loads: FE forces at u^n, then their share, the FE
+// masses and momenta at the shared nodes.
+void Hybrid::after_forces(Solver& S) {
+  Grid& g = S.grid;
+  if (fe_.dt != S.dt) set_dt(S.dt);
   fe_.internal_force(fe_.displacement().data(), fint_.data());
   fe_.refresh_external_force(S.t, fext_.data());
   const auto& mfe = fe_.mass();
-  std::vector<double>& v = fe_.velocity();
+  const std::vector<double>& v = fe_.velocity();
   for (std::size_t k = 0; k < shared_.size(); ++k) {
     const std::uint32_t e = shared_[k][0], n = shared_[k][1];
-    // The particles' own velocity at the node, for their FLIP increment (below).
+    // The particles' own velocity at the node, for their FLIP increment (before_g2p).
     mpm_v_[2 * k] = g.m[n] > 0 ? g.px[n] / g.m[n] : 0.0;
     mpm_v_[2 * k + 1] = g.m[n] > 0 ? g.py[n] / g.m[n] : 0.0;
     if (has_mpm_mass_[k] && (fext_[2 * e] != 0 || fext_[2 * e + 1] != 0))
@@ -332,10 +328,13 @@ void Hybrid::step() {
     g.fx[n] += fint_[2 * e] + fext_[2 * e];
     g.fy[n] += fint_[2 * e + 1] + fext_[2 * e + 1];
   }
+}
 
-  // One velocity update on the grid (shared nodes included).
-  S.grid_update();
-  // FE dashpot blocks at shared nodes: redo those nodes semi-implicitly with the summed mass.
+// After the one velocity update on the grid (shared nodes included): FE dashpot blocks at shared
+// nodes, those nodes redone semi-implicitly with the summed mass.
+void Hybrid::after_grid_update(Solver& S) {
+  Grid& g = S.grid;
+  const double dt = S.dt;
   const auto& D = fe_.dashpots();
   double absorbed = 0;
   for (std::size_t k = 0; k < shared_.size(); ++k) {
@@ -351,7 +350,17 @@ void Hybrid::step() {
     const double bx = 0.5 * (vx + a), by = 0.5 * (vy + b);
     absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
   }
-  S.boundary_work();
+  step_absorbed_ = absorbed;
+}
+
+// After the MPM boundary work is booked, before the particles take their velocities.
+void Hybrid::before_g2p(Solver& S) {
+  Grid& g = S.grid;
+  const double dt = S.dt;
+  const auto& D = fe_.dashpots();
+  const auto& mfe = fe_.mass();
+  std::vector<double>& v = fe_.velocity();
+  double absorbed = step_absorbed_;
   // FLIP increments of the particles use, at a shared node, the particles' own projected
   // velocity as the old one: Sum_p m_p dv_p + m_FE dv_FE = m v+ - p_MPM - m_FE v_FE = dt f, so the
   // total momentum changes only by the external forces. (The summed velocity (p_MPM + m_FE v_FE)/m
@@ -408,31 +417,29 @@ void Hybrid::step() {
     v[2 * e + 1] = g.vny[n];
   }
   fe_absorbed_ += absorbed;
+}
 
-  // Particles. MUSL strains the particles with the re-mapped velocity q / m; at a shared node the
-  // FE nodes' momentum is part of q, and the FE displacement there advances with the same
-  // re-mapped velocity, so both sides of the interface see one displacement increment (advancing
-  // the FE with v+ instead reflects about twice as much: 1.5 % vs 0.8 % for a 20-cell pulse).
-  if (S.opt.scheme == Scheme::MUSL) {
-    S.g2p_velocity(true, false);
-    for (std::size_t k = 0; k < shared_.size(); ++k) {
-      const std::uint32_t e = shared_[k][0], n = shared_[k][1];
-      g.qx[n] += mfe[e] * v[2 * e];
-      g.qy[n] += mfe[e] * v[2 * e + 1];
-    }
-    S.nodal_velocity(g.qx, g.qy, g.qx, g.qy);
-    S.update_stress_and_position(g.qx, g.qy, true);
-    advance_shared_displacement(g.qx, g.qy);
-  } else {
-    advance_shared_displacement(g.vnx, g.vny);
-    S.g2p_velocity(false, false);
-    S.update_stress_and_position(g.vnx, g.vny, true);
+// MUSL strains the particles with the re-mapped velocity q / m; at a shared node the FE nodes'
+// momentum is part of q, and the FE displacement there advances with the same re-mapped velocity
+// (end_of_step), so both sides of the interface see one displacement increment (advancing the FE
+// with v+ instead reflects about twice as much: 1.5 % vs 0.8 % for a 20-cell pulse).
+void Hybrid::after_remap(Solver& S) {
+  Grid& g = S.grid;
+  const auto& mfe = fe_.mass();
+  const std::vector<double>& v = fe_.velocity();
+  for (std::size_t k = 0; k < shared_.size(); ++k) {
+    const std::uint32_t e = shared_[k][0], n = shared_[k][1];
+    g.qx[n] += mfe[e] * v[2 * e];
+    g.qy[n] += mfe[e] * v[2 * e + 1];
   }
-  S.t += dt;
-  ++S.steps;
+}
+
+void Hybrid::end_of_step(Solver& S) {
+  Grid& g = S.grid;
+  if (S.opt.scheme == Scheme::MUSL) advance_shared_displacement(g.qx, g.qy);
+  else advance_shared_displacement(g.vnx, g.vny);
   fe_.t = S.t;
   ++fe_.steps;
-  S.check_outside();
   check_particles_in_fe_cells(false);
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "silentmpm/dashpot.hpp"
 #include "silentmpm/film.hpp"
@@ -114,7 +115,7 @@ long Solver::first_particle_outside() const {
 
 void Solver::finalize() {
   nthreads_ = opt.threads > 0 ? opt.threads : omp_get_max_threads();
-  if (contact.multi()) contact.setup(*this);  // splits material groups per body
+  if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
   nstrips_ = 2 * nthreads_;
   double mmin = std::numeric_limits<double>::infinity();
   for (double m : p.mass) mmin = std::min(mmin, m);
@@ -185,6 +186,7 @@ void Solver::sort_particles() {
     for (std::size_t k = 0; k < sl.layer.ids.size(); ++k) sl.layer.idx[k] = where_[sl.layer.ids[k]];
   refresh_strip_rows();
   strips_ok_ = !strips_conflict();
+  refresh_fields();
 }
 
 void Solver::refresh_strip_rows() {
@@ -216,36 +218,92 @@ bool Solver::strips_conflict() const {
 }
 
 // ------------------------------------------------------------------------------------------
-// Loop helpers
+// Fields, hooks and loop helpers
 // ------------------------------------------------------------------------------------------
+
+void Solver::attach(StepHooks* h) { hooks_.push_back(h); }
+
+void Solver::detach(StepHooks* h) {
+  hooks_.erase(std::remove(hooks_.begin(), hooks_.end(), h), hooks_.end());
+}
+
+template <class Fn>
+void Solver::call(Fn&& fn) {
+  if (contact.multi()) fn(contact);
+  for (StepHooks* h : hooks_) fn(*h);
+}
+
+void Solver::use_body_fields(const std::vector<NodalField>& fields,
+                             const std::vector<int>& body_of_group) {
+  fields_.assign(fields.size(), VelocityField());
+  for (std::size_t b = 0; b < fields.size(); ++b) {
+    fields_[b].f = fields[b];
+    fields_[b].body = static_cast<int>(b);
+  }
+  body_of_group_ = body_of_group;
+}
+
+// The particle ranges of every field after a re-sort: the grid's own field takes every range, a
+// body's field the ranges of that body's groups (the others emptied).
+void Solver::refresh_fields() {
+  if (body_of_group_.empty()) {
+    fields_.resize(1);
+    VelocityField& F = fields_[0];
+    Grid& g = grid;
+    F.f = NodalField{g.m.data(),  g.px.data(),  g.py.data(),  g.fx.data(), g.fy.data(),
+                     g.vx.data(), g.vy.data(),  g.vnx.data(), g.vny.data(), g.qx.data(),
+                     g.qy.data()};
+    F.box = {0, g.nnx - 1, 0, g.nny - 1};
+    F.body = -1;
+    F.ranges = ranges_;
+    return;
+  }
+  const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
+  for (VelocityField& F : fields_) {
+    F.ranges = ranges_;
+    for (int st = 0; st < nstrips_; ++st)
+      for (int g = 0; g < G; ++g)
+        if (body_of_group_[g] != F.body) F.ranges[st * G + g] = {0, 0};
+  }
+}
+
+void Solver::occupied_rows(long& lo, long& hi) const {
+  lo = std::numeric_limits<long>::max();
+  hi = std::numeric_limits<long>::min();
+  for (int s = 0; s < nstrips_; ++s)
+    if (strip_lo_[s] <= strip_hi_[s]) {
+      lo = std::min<long>(lo, strip_lo_[s]);
+      hi = std::max<long>(hi, strip_hi_[s]);
+    }
+}
 
 // fn(begin, end, group, strip) for every range; no two concurrent ranges write one node.
 template <class Fn>
-void Solver::scatter_over_groups(Fn&& fn) {
+void Solver::scatter(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn) {
   const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
   if (!strips_ok_ || nthreads_ == 1) {
     for (int s = 0; s < nstrips_; ++s)
-      for (int g = 0; g < G; ++g) fn(ranges_[s * G + g][0], ranges_[s * G + g][1], g, s);
+      for (int g = 0; g < G; ++g) fn(ranges[s * G + g][0], ranges[s * G + g][1], g, s);
     return;
   }
   for (int colour = 0; colour < 2; ++colour) {
 #pragma omp parallel for schedule(static, 1) num_threads(nthreads_)
     for (int s = colour; s < nstrips_; s += 2)
-      for (int g = 0; g < G; ++g) fn(ranges_[s * G + g][0], ranges_[s * G + g][1], g, s);
+      for (int g = 0; g < G; ++g) fn(ranges[s * G + g][0], ranges[s * G + g][1], g, s);
   }
 }
 
 // fn(begin, end, group, strip) for every range, strips in parallel (no scatter allowed).
 template <class Fn>
-void Solver::parallel_over_groups(Fn&& fn) {
+void Solver::parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn) {
   const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
 #pragma omp parallel for schedule(static, 1) num_threads(nthreads_)
   for (int s = 0; s < nstrips_; ++s)
-    for (int g = 0; g < G; ++g) fn(ranges_[s * G + g][0], ranges_[s * G + g][1], g, s);
+    for (int g = 0; g < G; ++g) fn(ranges[s * G + g][0], ranges[s * G + g][1], g, s);
 }
 
 // ------------------------------------------------------------------------------------------
-// Kernels
+// Stages
 // ------------------------------------------------------------------------------------------
 
 void Solver::reset_grid() {
@@ -265,41 +323,65 @@ void Solver::reset_grid() {
   }
 }
 
-void Solver::p2g(bool with_momentum, bool with_force) {
-  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h;
-  const int nnx = grid.nnx;
-  double* gm = grid.m.data();
-  double* gpx = grid.px.data();
-  double* gpy = grid.py.data();
-  double* gfx = grid.fx.data();
-  double* gfy = grid.fy.data();
-  const double* X = p.x.data(); const double* Y = p.y.data();
-  const double* VX = p.vx.data(); const double* VY = p.vy.data();
-  const double* M = p.mass.data(); const double* V = p.vol.data();
-  const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
-  scatter_over_groups([&](uint32_t b, uint32_t e, int, int) {
-    Bilinear sf;
-    for (uint32_t k = b; k < e; ++k) {
-      sf.eval(X[k], Y[k], x0, y0, ih);
-      const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
-      const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
-      if (with_momentum) {
-        const double mk = M[k], mvx = mk * VX[k], mvy = mk * VY[k];
-        for (int a = 0; a < 4; ++a) {
-          gm[nodes[a]] += mk * sf.N[a];
-          gpx[nodes[a]] += mvx * sf.N[a];
-          gpy[nodes[a]] += mvy * sf.N[a];
-        }
-      }
-      if (with_force) {
-        const double v = V[k], sxx = SXX[k], syy = SYY[k], sxy = SXY[k];
-        for (int a = 0; a < 4; ++a) {
-          gfx[nodes[a]] -= v * (sxx * sf.dNx[a] + sxy * sf.dNy[a]);
-          gfy[nodes[a]] -= v * (sxy * sf.dNx[a] + syy * sf.dNy[a]);
-        }
-      }
+// p2g over every field. A body's field clears its arrays over last step's box first and finds
+// its new box; with body fields the grid's arrays (cleared by reset_grid) then receive their sum,
+// the centre-of-mass field.
+void Solver::p2g(unsigned what) {
+  const bool momentum = (what & kMomentum) != 0, force = (what & kForce) != 0;
+  const long nnx = grid.nnx;
+  for (VelocityField& F : fields_) {
+    const NodalField& f = F.f;
+    const bool body = F.body >= 0;
+    std::vector<NodeBox> sbox;
+    if (body && momentum) {
+      double* a[10] = {f.m, f.px, f.py, f.gx, f.gy, f.xm, f.ym, f.sm, f.fx, f.fy};
+      kernels::for_box(F.box, nnx, nthreads_, [&](long i) {
+        for (double* v : a) v[i] = 0;
+      });
+      sbox.assign(nstrips_, NodeBox{1 << 30, -1, 1 << 30, -1});
     }
-  });
+    auto run = [&](auto what_c) {
+      constexpr unsigned W = decltype(what_c)::value;
+      scatter(F.ranges, [&](uint32_t b, uint32_t e, int, int s) {
+        kernels::p2g<Bilinear, W>(grid, p, b, e, f, (W & kContact) ? &sbox[s] : nullptr);
+      });
+    };
+    using std::integral_constant;
+    if (body && momentum && force) run(integral_constant<unsigned, kMomentum | kForce | kContact>());
+    else if (body && momentum) run(integral_constant<unsigned, kMomentum | kContact>());
+    else if (momentum && force) run(integral_constant<unsigned, kMomentum | kForce>());
+    else if (momentum) run(integral_constant<unsigned, kMomentum>());
+    else run(integral_constant<unsigned, kForce>());
+    if (body && momentum) {
+      NodeBox u{1 << 30, -1, 1 << 30, -1};
+      for (const NodeBox& q : sbox)
+        u = {std::min(u[0], q[0]), std::max(u[1], q[1]), std::min(u[2], q[2]), std::max(u[3], q[3])};
+      F.box = u;
+    }
+  }
+  if (body_of_group_.empty()) return;
+  Grid& gw = grid;
+  for (const VelocityField& F : fields_) {
+    const NodalField& f = F.f;
+    kernels::for_box(F.box, nnx, nthreads_, [&](long i) {
+      if (momentum) { gw.m[i] += f.m[i]; gw.px[i] += f.px[i]; gw.py[i] += f.py[i]; }
+      if (force) { gw.fx[i] += f.fx[i]; gw.fy[i] += f.fy[i]; }
+    });
+  }
+}
+
+// USF: every field's start-of-step velocity p / m, with the constraints.
+void Solver::start_velocities() {
+  for (const VelocityField& F : fields_)
+    kernels::nodal_velocity(grid, F.box, F.f.m, grid.fix.data(), F.f.px, F.f.py, F.f.vx, F.f.vy,
+                            mass_floor_, nthreads_);
+}
+
+// MUSL: every field's re-mapped momentum q becomes the velocity q / m, with the constraints.
+void Solver::remapped_velocities() {
+  for (const VelocityField& F : fields_)
+    kernels::nodal_velocity(grid, F.box, F.f.m, grid.fix.data(), F.f.qx, F.f.qy, F.f.qx, F.f.qy,
+                            mass_floor_, nthreads_);
 }
 
 // Shape functions of boundary particle q of layer L at its anchor point; fills nodes[4].
@@ -386,31 +468,13 @@ void Solver::apply_loads() {
   dashpot_nodes_.erase(std::unique(dashpot_nodes_.begin(), dashpot_nodes_.end()), dashpot_nodes_.end());
 }
 
-// Nodal velocities v = p / m (void nodes get zero) with the essential conditions applied.
-void Solver::nodal_velocity(std::vector<double>& ax, std::vector<double>& ay,
-                            const std::vector<double>& mx, const std::vector<double>& my) {
-  const long n = static_cast<long>(grid.nodes());
-  const double floor = mass_floor_;
-  const double* m = grid.m.data();
-  const uint8_t* fix = grid.fix.data();
-  double* vx = ax.data(); double* vy = ay.data();
-  const double* qx = mx.data(); const double* qy = my.data();
-#pragma omp parallel for schedule(static) num_threads(nthreads_)
-  for (long i = 0; i < n; ++i) {
-    if (m[i] > floor) {
-      vx[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
-      vy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
-    } else {
-      vx[i] = 0; vy[i] = 0;
-    }
-  }
-}
-
 // v+ = v + dt f / m on every node; then, on the few nodes that carry a dashpot block C,
 // (m + dt/2 C) v+ = (m - dt/2 C) v + dt f  (trapezoidal, unconditionally stable for C).
 // The second loop touches only the boundary nodes, so the silent layer costs O(boundary).
 void Solver::grid_update() {
-  nodal_velocity(grid.vx, grid.vy, grid.px, grid.py);
+  kernels::nodal_velocity(grid, NodeBox{0, grid.nnx - 1, 0, grid.nny - 1}, grid.m.data(),
+                          grid.fix.data(), grid.px.data(), grid.py.data(), grid.vx.data(),
+                          grid.vy.data(), mass_floor_, nthreads_);
   const long n = static_cast<long>(grid.nodes());
   const double floor = mass_floor_, DT = dt;
   const double* m = grid.m.data();
@@ -441,11 +505,11 @@ void Solver::grid_update() {
 // v+ = v + dt f / m is large while the particles it touches receive a bounded impulse, and
 // f (v + v+)/2 would count a spurious f^2 dt / (2 m) of work (film, 0.05 um cells, boundary
 // anchor: external work x13 and a -93 % imbalance; with w, < 0.1 %).
-void Solver::boundary_work(const std::vector<double>* wx, const std::vector<double>* wy) {
+void Solver::boundary_work(bool remapped) {
   Bilinear sf;
   long nodes[4];
-  const std::vector<double>& ux = wx ? *wx : grid.vnx;
-  const std::vector<double>& uy = wy ? *wy : grid.vny;
+  const std::vector<double>& ux = remapped ? grid.qx : grid.vnx;
+  const std::vector<double>& uy = remapped ? grid.qy : grid.vny;
   auto vbar = [&](long i, double& ax, double& ay) {  // the forces' velocity
     ax = 0.5 * (grid.vx[i] + grid.vnx[i]);
     ay = 0.5 * (grid.vy[i] + grid.vny[i]);
@@ -484,159 +548,72 @@ void Solver::boundary_work(const std::vector<double>* wx, const std::vector<doub
   }
 }
 
-// Particle velocities from the grid (FLIP/PIC blend); MUSL re-maps the particle momenta to the
-// grid at the same positions; USF moves the particles here.
-void Solver::g2p_velocity(bool remap, bool move) {
-  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h, DT = dt;
-  const int nnx = grid.nnx;
-  const double flip = opt.flip, pic = 1.0 - opt.flip;
-  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
-  const double* ux = grid.vnx.data(); const double* uy = grid.vny.data();
-  double* qx = grid.qx.data(); double* qy = grid.qy.data();
-  double* X = p.x.data(); double* Y = p.y.data();
-  double* VX = p.vx.data(); double* VY = p.vy.data();
-  const double* M = p.mass.data();
-  const double x1 = grid.x1();
-  auto body = [&](uint32_t b, uint32_t e, int, int s) {
-    Bilinear sf;
-    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min(), out = 0;
-    for (uint32_t k = b; k < e; ++k) {
-      sf.eval(X[k], Y[k], x0, y0, ih);
-      const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
-      const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
-      double dvx = 0, dvy = 0, wx = 0, wy = 0;
-      for (int a = 0; a < 4; ++a) {
-        const long i = nodes[a];
-        wx += sf.N[a] * ux[i];
-        wy += sf.N[a] * uy[i];
-        dvx += sf.N[a] * (ux[i] - vx[i]);
-        dvy += sf.N[a] * (uy[i] - vy[i]);
-      }
-      const double nvx = flip * (VX[k] + dvx) + pic * wx;
-      const double nvy = flip * (VY[k] + dvy) + pic * wy;
-      VX[k] = nvx; VY[k] = nvy;
-      if (remap) {
-        const double mvx = M[k] * nvx, mvy = M[k] * nvy;
-        for (int a = 0; a < 4; ++a) {
-          qx[nodes[a]] += mvx * sf.N[a];
-          qy[nodes[a]] += mvy * sf.N[a];
-        }
-      }
-      if (move) {
-        X[k] += DT * wx;
-        Y[k] += DT * wy;
-        const int r = static_cast<int>(std::floor((Y[k] - y0) * ih));
-        lo = std::min(lo, r); hi = std::max(hi, r);
-        out += !(X[k] >= x0 && X[k] < x1);
-      }
-    }
-    if (move) {
-      strip_out_[s] += out;
-      strip_lo_[s] = std::min(strip_lo_[s], lo);
-      strip_hi_[s] = std::max(strip_hi_[s], hi);
-    }
-  };
-  if (move) {
-    std::fill(strip_lo_.begin(), strip_lo_.end(), std::numeric_limits<int>::max());
-    std::fill(strip_hi_.begin(), strip_hi_.end(), std::numeric_limits<int>::min());
-    std::fill(strip_out_.begin(), strip_out_.end(), 0);
-  }
-  if (remap) scatter_over_groups(body);
-  else parallel_over_groups(body);
+void Solver::begin_moving_pass() {
+  std::fill(strip_lo_.begin(), strip_lo_.end(), std::numeric_limits<int>::max());
+  std::fill(strip_hi_.begin(), strip_hi_.end(), std::numeric_limits<int>::min());
+  std::fill(strip_out_.begin(), strip_out_.end(), 0);
 }
 
-namespace {
-// Stress update of one group with material model M: velocity gradient from the nodal field
-// (gx, gy), Jaumann rotation, strain increment, material update, volume; optionally the
-// particle moves with the updated nodal velocity (ux, uy).
-template <Model MODEL>
-double stress_range(uint32_t b, uint32_t e, const Material& mat, const Grid& grid,
-                    const double* gx, const double* gy, const double* ux, const double* uy,
-                    double dt, bool move, Particles& p, int& lo, int& hi, int& out) {
-  const double x0 = grid.x0, y0 = grid.y0, ih = grid.inv_h, x1 = grid.x1();
-  const int nnx = grid.nnx;
-  double* X = p.x.data(); double* Y = p.y.data();
-  double* V = p.vol.data();
-  double* SXX = p.sxx.data(); double* SYY = p.syy.data();
-  double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
-  double* EP = p.eps_p.data();
-  double diss = 0;
-  Bilinear sf;
-  for (uint32_t k = b; k < e; ++k) {
-    sf.eval(X[k], Y[k], x0, y0, ih);
-    const long n0 = static_cast<long>(sf.cj) * nnx + sf.ci;
-    const long nodes[4] = {n0, n0 + 1, n0 + nnx + 1, n0 + nnx};
-    double lxx = 0, lxy = 0, lyx = 0, lyy = 0, wx = 0, wy = 0;
-    for (int a = 0; a < 4; ++a) {
-      const long i = nodes[a];
-      lxx += gx[i] * sf.dNx[a];
-      lxy += gx[i] * sf.dNy[a];
-      lyx += gy[i] * sf.dNx[a];
-      lyy += gy[i] * sf.dNy[a];
-      wx += sf.N[a] * ux[i];
-      wy += sf.N[a] * uy[i];
-    }
-    double sxx = SXX[k], syy = SYY[k], szz = SZZ[k], sxy = SXY[k];
-    // Jaumann rotation with spin w = (dvx/dy - dvy/dx) / 2.
-    const double w = 0.5 * (lxy - lyx) * dt;
-    const double rxx = 2 * w * sxy, rxy = w * (syy - sxx);
-    sxx += rxx; syy -= rxx; sxy += rxy;
-    double wp;
-    if constexpr (MODEL == Model::J2Film)  // history in extra particle arrays (film.hpp)
-      wp = film_update(mat, p, k, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy, szz, sxy);
-    else
-      wp = stress_update<MODEL>(mat, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy, szz, sxy,
-                                EP[k]);
-    SXX[k] = sxx; SYY[k] = syy; SZZ[k] = szz; SXY[k] = sxy;
-    V[k] *= (1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt;
-    diss += wp * V[k];
-    if (move) {
-      X[k] += dt * wx;
-      Y[k] += dt * wy;
-      const int r = static_cast<int>(std::floor((Y[k] - y0) * ih));
-      lo = std::min(lo, r); hi = std::max(hi, r);
-      out += !(X[k] >= x0 && X[k] < x1);
-    }
-  }
-  return diss;
+void Solver::merge_rows(int s, const RowSpan& r) {
+  strip_out_[s] += r.out;
+  strip_lo_[s] = std::min(strip_lo_[s], r.lo);
+  strip_hi_[s] = std::max(strip_hi_[s], r.hi);
 }
-}  // namespace
 
-void Solver::update_stress_and_position(const std::vector<double>& gx,
-                                        const std::vector<double>& gy, bool move) {
-  std::vector<double> diss(nstrips_, 0.0);
-  if (move) {
-    std::fill(strip_lo_.begin(), strip_lo_.end(), std::numeric_limits<int>::max());
-    std::fill(strip_hi_.begin(), strip_hi_.end(), std::numeric_limits<int>::min());
-    std::fill(strip_out_.begin(), strip_out_.end(), 0);
+// Particle velocities from every field (FLIP/PIC blend); MUSL re-maps the particle momenta to
+// the field at the same positions; USF moves the particles here.
+void Solver::g2p(bool remap, bool move) {
+  if (move) begin_moving_pass();
+  const double flip = opt.flip, DT = dt;
+  for (VelocityField& F : fields_) {
+    const NodalField& f = F.f;
+    if (remap && F.body >= 0) kernels::for_box(F.box, grid.nnx, nthreads_, [&](long i) {
+      f.qx[i] = 0; f.qy[i] = 0;
+    });
+    auto body = [&](uint32_t b, uint32_t e, int, int s) {
+      RowSpan r;
+      if (remap) kernels::g2p<Bilinear, true, false>(grid, p, b, e, f, flip, DT, r);
+      else if (move) kernels::g2p<Bilinear, false, true>(grid, p, b, e, f, flip, DT, r);
+      else kernels::g2p<Bilinear, false, false>(grid, p, b, e, f, flip, DT, r);
+      if (move) merge_rows(s, r);
+    };
+    if (remap) scatter(F.ranges, body);
+    else parallel(F.ranges, body);
   }
-  parallel_over_groups([&](uint32_t b, uint32_t e, int g, int s) {
-    if (b == e) return;
-    int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min(), out = 0;
-    const Material& mat = materials[g];
-    double d = 0;
-    switch (mat.model) {
-      case Model::Elastic:
-        d = stress_range<Model::Elastic>(b, e, mat, grid, gx.data(), gy.data(), grid.vnx.data(),
-                                         grid.vny.data(), dt, move, p, lo, hi, out);
-        break;
-      case Model::VonMises:
-        d = stress_range<Model::VonMises>(b, e, mat, grid, gx.data(), gy.data(),
-                                          grid.vnx.data(), grid.vny.data(), dt, move, p, lo, hi, out);
-        break;
-      case Model::J2Film:
-        d = stress_range<Model::J2Film>(b, e, mat, grid, gx.data(), gy.data(), grid.vnx.data(),
-                                        grid.vny.data(), dt, move, p, lo, hi, out);
-        break;
-    }
-    diss[s] += d;
-    if (move) {
-      strip_out_[s] += out;
-      strip_lo_[s] = std::min(strip_lo_[s], lo);
-      strip_hi_[s] = std::max(strip_hi_[s], hi);
-    }
-  });
-  for (double d : diss) energy.dissipated += d;
+}
+
+// Stress update of every field's particles from the field's start velocity (USF), its re-mapped
+// velocity (MUSL) or its updated velocity (USL); with move, positions advance with the updated
+// nodal velocity. The dissipation is booked field by field.
+void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
+  if (move) begin_moving_pass();
+  for (VelocityField& F : fields_) {
+    const NodalField& f = F.f;
+    const double* gx = start_field ? f.vx : (remapped_field ? f.qx : f.vnx);
+    const double* gy = start_field ? f.vy : (remapped_field ? f.qy : f.vny);
+    std::vector<double> diss(nstrips_, 0.0);
+    parallel(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
+      if (b == e) return;
+      RowSpan r;
+      const Material& mat = materials[g];
+      auto run = [&](auto model_c) {
+        constexpr Model M = decltype(model_c)::value;
+        return move ? kernels::update_stress<Bilinear, M, true>(grid, p, b, e, mat, gx, gy, f.vnx,
+                                                               f.vny, dt, r)
+                    : kernels::update_stress<Bilinear, M, false>(grid, p, b, e, mat, gx, gy,
+                                                                f.vnx, f.vny, dt, r);
+      };
+      double d = 0;
+      switch (mat.model) {
+        case Model::Elastic: d = run(std::integral_constant<Model, Model::Elastic>()); break;
+        case Model::VonMises: d = run(std::integral_constant<Model, Model::VonMises>()); break;
+        case Model::J2Film: d = run(std::integral_constant<Model, Model::J2Film>()); break;
+      }
+      diss[s] += d;
+      if (move) merge_rows(s, r);
+    });
+    for (double d : diss) energy.dissipated += d;
+  }
 }
 
 // The passes that move particles count, per strip, the particles outside the grid's columns and
@@ -660,47 +637,47 @@ void Solver::check_outside() {
   throw std::runtime_error(o.str());
 }
 
+// The time step: see the sequence at the top of solver.hpp.
 void Solver::step() {
   if (!strips_ok_) sort_particles();
-  if (contact.multi()) {  // one velocity field per body: mpm/src/contact.cpp
-    contact.step(*this);
-    t += dt;
-    ++steps;
-    check_outside();
-    return;
-  }
+  if (body_of_group_.empty()) refresh_fields();  // the grid's arrays (pointers only)
+  const Scheme sc = opt.scheme;
   reset_grid();
-  switch (opt.scheme) {
-    case Scheme::USL:
+  p2g(sc == Scheme::USF ? kMomentum : kMomentum | kForce);
+  call([&](StepHooks& h) { h.after_momentum(*this); });
+  if (sc == Scheme::USF) {
+    start_velocities();
+    update_stress(false, true, false);
+    p2g(kForce);
+  }
+  apply_loads();
+  call([&](StepHooks& h) { h.after_forces(*this); });
+  grid_update();
+  call([&](StepHooks& h) { h.after_grid_update(*this); });
+  bool remapped_power = sc == Scheme::MUSL;
+  call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
+  if (!remapped_power) boundary_work(false);
+  call([&](StepHooks& h) { h.before_g2p(*this); });
+  switch (sc) {
     case Scheme::MUSL:
-      p2g(true, true);
-      apply_loads();
-      grid_update();
-      if (opt.scheme == Scheme::MUSL) {
-        g2p_velocity(true, false);
-        nodal_velocity(grid.qx, grid.qy, grid.qx, grid.qy);
-        boundary_work(&grid.qx, &grid.qy);
-        update_stress_and_position(grid.qx, grid.qy, true);
-      } else {
-        boundary_work();
-        g2p_velocity(false, false);
-        update_stress_and_position(grid.vnx, grid.vny, true);
-      }
+      g2p(true, false);
+      call([&](StepHooks& h) { h.after_remap(*this); });
+      remapped_velocities();
+      if (remapped_power) boundary_work(true);
+      update_stress(true, false, true);
+      break;
+    case Scheme::USL:
+      g2p(false, false);
+      update_stress(false, false, true);
       break;
     case Scheme::USF:
-      p2g(true, false);
-      nodal_velocity(grid.vx, grid.vy, grid.px, grid.py);
-      update_stress_and_position(grid.vx, grid.vy, false);
-      p2g(false, true);
-      apply_loads();
-      grid_update();
-      boundary_work();
-      g2p_velocity(false, true);
+      g2p(false, true);
       break;
   }
   t += dt;
   ++steps;
   check_outside();
+  call([&](StepHooks& h) { h.end_of_step(*this); });
 }
 
 // ------------------------------------------------------------------------------------------

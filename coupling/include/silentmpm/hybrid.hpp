@@ -1,5 +1,5 @@
 #pragma once
-// MPM-FEM coupling through shared nodes (REFERENCE.md section 7).
+// MPM-FEM coupling through shared nodes (docs/physics.md section 7).
 //
 // With bilinear grid shape functions MPM is a Q1 Galerkin method whose quadrature points are the
 // particles. A Q1 far-field whose interface nodes coincide with grid nodes forms one
@@ -48,11 +48,16 @@ struct HybridError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-class Hybrid {
+// A hook set on the MPM solver's step (step_hooks.hpp): constructing a Hybrid attaches it, so
+// that every mpm.step() (or hybrid.step()) is the coupled step above; destroying it detaches it.
+class Hybrid : public StepHooks {
  public:
   // Both solvers fully built (mpm.finalize() called). Finds and checks the interface; throws
   // HybridError with a complete message on any guard. dt must then be set with set_dt.
   Hybrid(Solver& mpm, fem::Solver& fe);
+  ~Hybrid() override;
+  Hybrid(const Hybrid&) = delete;
+  Hybrid& operator=(const Hybrid&) = delete;
 
   // Sets the common time step on both regions (throws HybridError if it exceeds the FE element
   // bound or the MPM limit h / c_d).
@@ -63,7 +68,18 @@ class Hybrid {
   // Largest stable step of the coupled system: min of both regions' limits.
   double critical_dt() const;
 
-  void step();
+  // One coupled step: the MPM solver's step with this set's hooks.
+  void step() { mpm_.step(); }
+
+  // The hooks (see the sequence at the top of this file).
+  void after_momentum(Solver& s) override;     // guards: scheme, contact
+  void after_forces(Solver& s) override;       // FE forces, masses and momenta on shared nodes
+  void after_grid_update(Solver& s) override;  // FE dashpot blocks at shared nodes
+  void before_g2p(Solver& s) override;         // FE-only nodes advance; the particles' own v
+  void after_remap(Solver& s) override;        // MUSL: FE momentum at shared nodes in q
+  void end_of_step(Solver& s) override;        // shared displacements, FE clock, particle check
+  // The loads' power is taken with v+ (the coupled MUSL step books it before the re-map).
+  bool remapped_power() const override { return false; }
 
   // Energies of both regions summed (kinetic, elastic; dissipated, absorbed and external work
   // accumulate in step()); also refreshes mpm.energy and fe.energy.
@@ -97,6 +113,7 @@ class Hybrid {
   std::vector<double> fint_, fext_;        // FE per-dof work arrays
   std::vector<double> inv_mfe_;            // 1 / lumped mass per FE node
   std::vector<double> mpm_v_, sum_v_;      // per shared node: p_MPM / m_MPM, (p_MPM + m_FE v_FE) / m
+  double step_absorbed_ = 0;               // FE dashpot energy of this step at shared nodes
   double fe_kinetic_ = 0, fe_elastic_ = 0;
   double fe_absorbed_ = 0, fe_work_ = 0;
   double fe_initial_ = 0;

@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "silentmpm/material.hpp"
-#include "silentmpm/solver.hpp"  // Energies
+#include "silentmpm/energies.hpp"
 #include "silentmpm/time_function.hpp"
 
 namespace smpm::fem {
@@ -135,7 +135,7 @@ class Solver {
   void write_snapshot(const std::string& dir, const std::string& base);
   int snapshot_count() const;
 
-  // --- access for coupling (issue 7) and tests ---------------------------------------------
+  // --- access for the MPM-FEM coupling and tests ---------------------------------------------
   const std::vector<double>& node_x() const;
   const std::vector<double>& node_y() const;
   const std::vector<double>& mass() const;          // lumped nodal mass (per component)

@@ -1,5 +1,5 @@
 #pragma once
-// Discontinuous bifurcation (REFERENCE.md §5): the acoustic tensor Q_jk(n) = n_i C_ijkl n_l of a
+// Discontinuous bifurcation (docs/physics.md §5): the acoustic tensor Q_jk(n) = n_i C_ijkl n_l of a
 // continuum tangent, its determinant swept over the normal angle, and the closed-form J2 criterion
 // used as the sweep's test oracle.
 //
@@ -80,7 +80,7 @@ double acoustic_sampled_bound(const AcousticFourier& F, double threshold = 1e300
 BifurcationResult bifurcation_check(const double C[16], const BifurcationParams& P, double scale,
                                     int* stage = nullptr);
 
-// Closed-form J2 criterion (REFERENCE.md §5): bifurcation on the plane of normal n iff
+// Closed-form J2 criterion (docs/physics.md §5): bifurcation on the plane of normal n iff
 // H <= H_cr(n) = 6G(|a|^2 - (a.n)^2) + (6G^2/M)(a.n)^2 - 3G, a = N n (in-plane block of s/|s|).
 double hcr_j2(double sxx, double syy, double szz, double sxy, double mu, double M, double theta_rad);
 // max over the normal angle of hcr_j2 (fine sweep and refinement); theta_deg gets the argmax.

@@ -60,14 +60,17 @@
 #include <cstdint>
 #include <vector>
 
-namespace smpm {
+#include "silentmpm/step_hooks.hpp"
 
-class Solver;
+namespace smpm {
 
 enum class ContactType { Single, Multi };
 const char* contact_type_name(ContactType t);
 
-class Contact {
+// In the multi mode a hook set on the solver's step: the step maps each body to its own field
+// (the arrays below) and their sum to the grid; the hooks find the contact nodes after the
+// momentum p2g and split and correct the bodies' updated velocities after the grid update.
+class Contact : public StepHooks {
  public:
   ContactType type = ContactType::Single;
   double friction = 0.0;  // Coulomb coefficient mu >= 0 (multi only)
@@ -81,11 +84,15 @@ class Contact {
   long active_nodes = 0;               // of those, nodes where bodies approached (corrected)
 
   // Called by Solver::finalize (multi only): splits material groups so that every group holds
-  // particles of one body (a body's particles then form contiguous ranges), sizes the fields.
+  // particles of one body (a body's particles then form contiguous ranges), sizes the fields and
+  // hands them to the solver (Solver::use_body_fields).
   void setup(Solver& s);
-  // One time step in the multi mode (replaces the stages of Solver::step between the re-sort
-  // and the clock advance).
-  void step(Solver& s);
+
+  // The hooks of the multi mode.
+  void after_momentum(Solver& s) override;     // contact nodes
+  void after_grid_update(Solver& s) override;  // bodies' velocities, contact correction
+  // The power of the loads is taken with v+: there is no single re-mapped field.
+  bool remapped_power() const override { return false; }
 
  private:
   int nb_ = 0;                    // bodies
@@ -94,20 +101,11 @@ class Contact {
   Field m_, px_, py_, fx_, fy_, gx_, gy_, vx_, vy_, vnx_, vny_, qx_, qy_;
   Field xm_, ym_, sm_;  // sum m_p N x_p, sum m_p N y_p, sum m_p N sqrt(V_p): nodal centroid, size
   std::vector<uint32_t> cnodes_;  // nodes with two or more bodies this step
-  // Per body: node range {i0, i1, j0, j1} (inclusive) its particles touched in the last p2g.
-  // Outside it the body's mass, momentum, gradient and force arrays are zero, and no per-body
-  // node loop needs to look there (a small flyer costs its own box, not the whole grid).
-  std::vector<std::array<int, 4>> box_;
-  std::vector<std::vector<std::array<uint32_t, 2>>> ranges_;  // per body: solver ranges, others empty
 
-  void body_ranges(Solver& s);
-  void p2g(Solver& s, bool momentum, bool force);
   void find_contact_nodes(Solver& s);
-  void split_start(Solver& s, Field& vx, Field& vy, const Field& px, const Field& py);
+  void split_start(Solver& s);
   void split_updated(Solver& s);
   void correct(Solver& s, Field& vx, Field& vy, bool count);
-  void swap_in(Solver& s, int b);
-  template <class Fn> void per_body_moving(Solver& s, Fn&& fn);
 };
 
 }  // namespace smpm

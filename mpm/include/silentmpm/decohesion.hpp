@@ -1,5 +1,5 @@
 #pragma once
-// Decohesion after discontinuous bifurcation (REFERENCE.md §5; Chen, Shen, Mai & Shen 2004,
+// Decohesion after discontinuous bifurcation (docs/physics.md §5; Chen, Shen, Mai & Shen 2004,
 // Schreyer-Sulsky-Zhou). From the step a particle bifurcates on, its continuum is elastic (the
 // plastic strain is frozen) and a displacement jump u = u_n n + u_t t, t = (-n_y, n_x), on the
 // critical plane, smeared over the length L, takes the inelastic strain:

@@ -1,6 +1,6 @@
 #pragma once
 // The tungsten-film material (Model::J2Film): one particle's stress update through the state
-// machine  elastic -> plastic -> decohesion -> separated  (REFERENCE.md §5).
+// machine  elastic -> plastic -> decohesion -> separated  (docs/physics.md §5).
 //
 //   elastic / plastic  J2 with hardening then softening (j2soft.hpp). After every plastic
 //                      loading step the acoustic tensor of the continuum tangent is checked

@@ -1,6 +1,6 @@
 #pragma once
 // J2 (von Mises) plasticity with linear hardening up to a peak, then linear softening
-// (REFERENCE.md §5, the tungsten film of paper §5).
+// (docs/physics.md §5, the tungsten film of paper §5).
 //
 //   yield function   f = q - sigma_bar(e),  q = sqrt(3/2) |s|
 //   flow stress      sigma_bar = sigma_y + H_h e                 for e <= e_pk
@@ -11,7 +11,7 @@
 //   tangent          C_ep = C - 6G^2 / (3G + H) N (x) N,  N = s / |s|
 //
 // The moduli E_h, E_s of the paper can be read two ways (an input):
-//   Plastic  H_h = E_h, H_s = -E_s (default; REFERENCE.md's assumption)
+//   Plastic  H_h = E_h, H_s = -E_s (default; docs/physics.md's assumption)
 //   Tangent  E_h, E_s are slopes of the uniaxial stress-strain curve, H = E E_t / (E - E_t)
 //            with E_t = E_h (hardening) and E_t = -E_s (softening).
 // Stresses are four components (xx, yy, zz, xy), plane strain.

@@ -1,5 +1,5 @@
 #pragma once
-// Exact plane-wave reflection at a Lysmer-Kuhlemeyer boundary (2D P-SV), REFERENCE.md §4.1.
+// Exact plane-wave reflection at a Lysmer-Kuhlemeyer boundary (2D P-SV), docs/physics.md §4.1.
 //
 // Boundary z = 0 with outward normal +z; angles measured from the normal. The boundary condition
 // is sigma_zz = -a rho c_d dot(u_z), sigma_xz = -b rho c_s dot(u_x); a = b = 0 is a free surface,

@@ -1,15 +1,23 @@
 #pragma once
-// The explicit MPM solver: one region of particles on a background grid.
-//
-// The time step (MUSL shown; USF and USL differ only in where the stress update sits):
+// The explicit MPM solver: one region of particles on a background grid, and the one time step
+// every MPM run takes (Solver::step in solver.cpp):
 //
 //   reset grid
-//   p2g          masses, momenta, internal forces  (Eq. 15, 18)
-//   loads        tractions and silent-layer dashpots carried by boundary particles (Eq. 16, 20-21)
-//   grid update  v+ = v + dt f / m  (semi-implicit where a nodal dashpot block is present)
-//   constraints  fixed / roller components
-//   g2p          particle velocity (FLIP/PIC blend); MUSL re-maps the momentum
-//   stress       velocity gradient -> strain increment -> material update; positions advance
+//   p2g            masses, momenta (USL, MUSL: and internal forces)         -> after_momentum
+//   [USF: nodal velocities, stress update, p2g of the internal forces]
+//   loads          tractions and silent-layer dashpots of boundary particles -> after_forces
+//   grid update    v+ = v + dt f / m (semi-implicit on nodes with a dashpot block), constraints
+//                                                                           -> after_grid_update
+//   boundary work  work of tractions, energy absorbed by dashpots           -> before_g2p
+//   g2p            particle velocities (FLIP/PIC); MUSL re-maps the momenta -> after_remap
+//   stress         velocity gradient -> strain increment -> material update; positions advance
+//   clock          t += dt; particles still on the grid?                   -> end_of_step
+//
+// Velocity fields: the kernels (kernels.hpp) run over the particles of one field into that
+// field's nodal arrays. The ordinary step has one field, the grid's own arrays. Multi-field
+// contact (contact.hpp) gives one field per body; the grid's arrays then hold the centre-of-mass
+// field, the sum of the bodies' masses, momenta and forces, which takes the loads and the grid
+// update. Hook sets (StepHooks: contact, the MPM-FEM hybrid) add their work at the named points.
 //
 // Particle loops run over contiguous ranges of one material group, so the material model is a
 // template argument of the inner loop. Scatters to the grid run in parallel over horizontal
@@ -21,10 +29,13 @@
 
 #include "silentmpm/boundary.hpp"
 #include "silentmpm/contact.hpp"
+#include "silentmpm/energies.hpp"
 #include "silentmpm/grid.hpp"
+#include "silentmpm/kernels.hpp"
 #include "silentmpm/material.hpp"
 #include "silentmpm/particles.hpp"
 #include "silentmpm/shape.hpp"
+#include "silentmpm/step_hooks.hpp"
 
 namespace smpm {
 
@@ -38,25 +49,23 @@ struct SolverOptions {
   int threads = 0;            // 0 = OpenMP default
 };
 
-struct Energies {
-  double kinetic = 0, elastic = 0;
-  double dissipated = 0;      // plastic (+ decohesion) dissipation, accumulated
-  double absorbed = 0;        // energy taken out by silent-layer dashpots, accumulated
-  double external_work = 0;   // work of tractions, accumulated
-  double initial = 0;         // kinetic + elastic at t = 0
-  // (kinetic + elastic + dissipated + absorbed) - (initial + external_work)
-  double imbalance() const { return kinetic + elastic + dissipated + absorbed - initial - external_work; }
-};
-
 struct ProbeSample {
   double sxx = 0, syy = 0, szz = 0, sxy = 0, j2 = 0, vx = 0, vy = 0;
   bool valid = false;  // false when no particle is near the point
 };
 
-class Solver {
-  friend class Contact;  // the multi-field step runs the stages below per body
-  friend class Hybrid;   // the MPM-FEM coupled step (coupling/src/hybrid.cpp) runs them too
+// One velocity field: its nodal arrays, the particle ranges mapped to it ([strip * G + group]),
+// and the node box its particles touched in the last momentum p2g (the whole grid for the
+// grid's own field). A field of one body (body >= 0) has its arrays cleared over its last box
+// at each momentum p2g; the grid's own arrays are cleared by the grid reset.
+struct VelocityField {
+  NodalField f;
+  NodeBox box{0, -1, 0, -1};
+  int body = -1;
+  std::vector<std::array<uint32_t, 2>> ranges;
+};
 
+class Solver {
  public:
   Grid grid;
   Particles p;
@@ -86,7 +95,15 @@ class Solver {
   double critical_dt() const;  // h / max c_d over materials present
 
   // --- run ---------------------------------------------------------------------------------
+  // One time step (the sequence at the top of this file).
   void step();
+  // Hook sets: attach before the first step; a set must outlive its attachment.
+  void attach(StepHooks* h);
+  void detach(StepHooks* h);
+  // One field per body (multi-field contact; called from finalize): the bodies' nodal arrays,
+  // and the body of every material group (groups must not mix bodies).
+  void use_body_fields(const std::vector<NodalField>& fields, const std::vector<int>& body_of_group);
+  const std::vector<VelocityField>& fields() const { return fields_; }
   // Recompute kinetic and elastic energies (a pass over the particles).
   void update_energies();
   // Mass-weighted projection of particle fields to the nodes of the cell holding (x, y), then
@@ -98,6 +115,13 @@ class Solver {
   std::vector<ProbeSample> sample(const std::vector<std::array<double, 2>>& points,
                                   const std::vector<int>& bodies) const;
   int thread_count() const { return nthreads_; }
+  // Nodes lighter than this are void (opt.mass_tolerance times the lightest particle).
+  double mass_floor() const { return mass_floor_; }
+  // Cell rows the particles occupied after the last step that moved them (lo > hi: none).
+  void occupied_rows(long& lo, long& hi) const;
+  // Shape functions of boundary particle q of layer L at its anchor point; fills nodes[4].
+  void layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, Bilinear& sf,
+                   long nodes[4]) const;
   // Check every particle is inside the grid; returns the index of the first outside, or -1.
   long first_particle_outside() const;
 
@@ -113,24 +137,28 @@ class Solver {
   std::vector<int> strip_lo_, strip_hi_;  // cell-row range each strip touches
   std::vector<int> strip_out_;            // particles of each strip outside the grid columns
   std::vector<uint32_t> where_;           // permanent id -> current index
+  std::vector<VelocityField> fields_;     // empty: the grid's own field (set up by the step)
+  std::vector<int> body_of_group_;        // with body fields: the body of each material group
+  std::vector<StepHooks*> hooks_;
 
   void sort_particles();
   void refresh_strip_rows();
+  void refresh_fields();
   bool strips_conflict() const;
   void reset_grid();
-  template <class Fn> void scatter_over_groups(Fn&& fn);
-  template <class Fn> void parallel_over_groups(Fn&& fn);
-  void p2g(bool with_momentum, bool with_force);
+  template <class Fn> void scatter(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
+  template <class Fn> void parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
+  template <class Fn> void call(Fn&& fn);
+  void p2g(unsigned what);
+  void start_velocities();
   void apply_loads();
-  void layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, Bilinear& sf,
-                   long nodes[4]) const;
   void grid_update();
-  void boundary_work(const std::vector<double>* wx = nullptr, const std::vector<double>* wy = nullptr);
-  void g2p_velocity(bool remap, bool move);
-  void update_stress_and_position(const std::vector<double>& gx, const std::vector<double>& gy,
-                                  bool move);
-  void nodal_velocity(std::vector<double>& ax, std::vector<double>& ay,
-                      const std::vector<double>& mx, const std::vector<double>& my);
+  void boundary_work(bool remapped);
+  void g2p(bool remap, bool move);
+  void remapped_velocities();
+  void update_stress(bool remapped_field, bool start_field, bool move);
+  void begin_moving_pass();
+  void merge_rows(int strip, const RowSpan& r);
   void check_outside();
   long outside_ = -1;  // index of a particle that left the grid in the last pass
 };

@@ -4,7 +4,7 @@
 // studies/oblique (studies/oblique/oblique.hpp), at nu = 0.25 and a Gaussian pulse 24 cells wide (FWHM).
 #include <gtest/gtest.h>
 
-#include "../studies/oblique/oblique.hpp"
+#include "../../studies/oblique/oblique.hpp"
 
 using namespace smpm;
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "../studies/geometry/inclined.hpp"
+#include "../../studies/geometry/inclined.hpp"
 
 #ifndef SMPM_SOURCE_DIR
 #define SMPM_SOURCE_DIR "."

@@ -16,40 +16,12 @@
 #include <memory>
 
 #include "silentmpm/solver.hpp"
+#include "test_contact_common.hpp"
 
 using namespace smpm;
+using namespace smpm::contact_testing;
 
 namespace {
-
-Material aluminium(Model model = Model::Elastic) {
-  Material m;
-  m.name = "aluminium"; m.model = model;
-  m.E = 70e9; m.nu = 0.33; m.rho = 2700; m.sigma_y = 200e6;
-  m.derive();
-  return m;
-}
-
-Material steel(Model model = Model::Elastic) {
-  Material m;
-  m.name = "steel"; m.model = model;
-  m.E = 200e9; m.nu = 0.30; m.rho = 7800; m.sigma_y = 400e6;
-  m.derive();
-  return m;
-}
-
-struct Impact {
-  int flyer_cells = 50;    // d1 / h
-  int target_cells = 160;  // d2 / h: its back-face echo returns after 2 d2 / c2 > t_end
-  int height = 2;          // cells across, rollers on top and bottom
-  int ppc_side = 1;
-  double h = 1e-3;
-  double v0 = 10.0;
-  double cfl = 0.3;
-  ContactType type = ContactType::Multi;
-  double friction = 0;
-  Scheme scheme = Scheme::MUSL;
-  int threads = 1;
-};
 
 // Flyer [-d1, 0] x [0, H] (body 0) moving at v0 onto the target [0, d2] x [0, H] (body 1).
 std::unique_ptr<Solver> make_impact(const Impact& c) {
@@ -126,23 +98,6 @@ double mean_over(const std::vector<double>& t, const std::vector<double>& v, dou
   return n ? s / n : std::numeric_limits<double>::quiet_NaN();
 }
 
-struct Oracle {
-  double z1, z2, sigma, tc, rebound, c1, c2;
-};
-
-Oracle oracle(const Impact& c) {
-  const Material a = aluminium(), b = steel();
-  Oracle o;
-  o.z1 = a.impedance_p();
-  o.z2 = b.impedance_p();
-  o.c1 = a.cd;
-  o.c2 = b.cd;
-  o.sigma = c.v0 * o.z1 * o.z2 / (o.z1 + o.z2);
-  o.tc = 2 * c.flyer_cells * c.h / a.cd;
-  o.rebound = c.v0 * (o.z1 - o.z2) / (o.z1 + o.z2);
-  return o;
-}
-
 // First and last time a history is above half its plateau value: the contact duration as the
 // width at half height of the stress pulse.
 std::pair<double, double> half_width(const std::vector<double>& t, const std::vector<double>& v,
@@ -157,16 +112,6 @@ std::pair<double, double> half_width(const std::vector<double>& t, const std::ve
 }
 
 }  // namespace
-
-// The oracle itself: 12.26 MPa per m/s from the P-wave impedances (REFERENCE.md §4).
-TEST(ContactOracle, ImpedancesFromConstants) {
-  Impact c;
-  c.v0 = 1.0;
-  const Oracle o = oracle(c);
-  EXPECT_NEAR(o.z1, 1.673e7, 0.001e7);
-  EXPECT_NEAR(o.z2, 4.583e7, 0.001e7);
-  EXPECT_NEAR(o.sigma, 12.26e6, 0.01e6);
-}
 
 // Multi-velocity-field contact: contact stress (from the contact force and from the stress in
 // both plates), duration, rebound, momentum, no interpenetration.

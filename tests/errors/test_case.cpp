@@ -1,5 +1,6 @@
-// Case files: a valid case builds the solver it describes; malformed cases fail with a message
-// naming the key path, both through load_case() and through the CLI (`silentmpm check`).
+// Case files: a missing file and malformed cases fail with a message naming the key path, both
+// through load_case() and through the CLI (`silentmpm check`); the valid case through the CLI.
+// Valid cases through load_case() are in tests/unit/test_case_load.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,190 +17,17 @@
 #include <nlohmann/json.hpp>
 
 #include "silentmpm/case.hpp"
+#include "test_case_common.hpp"
 
 #ifndef SMPM_CLI
 #define SMPM_CLI ""
-#endif
-#ifndef SMPM_SOURCE_DIR
-#define SMPM_SOURCE_DIR "."
 #endif
 
 namespace {
 
 namespace fs = std::filesystem;
 using ojson = nlohmann::ordered_json;
-
-// A per-process scratch directory, removed at exit.
-struct Scratch {
-  fs::path dir = fs::temp_directory_path() /
-                 ("smpm_test_case_" + std::to_string(static_cast<long>(::getpid())));
-  Scratch() { fs::create_directories(dir); }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-};
-
-fs::path scratch() {
-  static const Scratch s;
-  return s.dir;
-}
-
-fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p;
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-// 10 x 10 cells of 1 mm; a 10 mm x 5 mm tungsten plate (4 particles per cell) on the bottom half;
-// rollers under it, the left grid side fixed, a pulse on its top, a silent layer at its bottom.
-const char* kValid = R"({
-  "title": "small valid case",
-  "grid": { "origin": [0, 0], "size": [0.01, 0.01], "cell": 0.001 },
-  "time": { "end": 1e-6, "cfl": 0.5 },
-  "scheme": { "update": "MUSL", "flip": 1.0, "threads": 1 },
-  "materials": {
-    "tungsten": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 },
-    "soft": { "model": "von_mises", "young": 70e9, "poisson": 0.3, "density": 2700,
-              "yield_stress": 300e6 }
-  },
-  "bodies": [
-    { "name": "plate", "material": "tungsten", "box": [0, 0, 0.01, 0.005],
-      "particles_per_cell": 4 }
-  ],
-  "boundaries": [
-    { "type": "roller", "component": "y", "body": "plate", "side": "bottom" },
-    { "type": "traction", "name": "load", "body": "plate", "side": "top", "width": 0.0005,
-      "normal": -1e8, "time": { "shape": "sin2", "start": 0, "duration": 2e-7, "ramp": 5e-8 } },
-    { "type": "silent", "body": "plate", "side": "bottom", "form": "particle" },
-    { "type": "fixed", "grid_side": "left" }
-  ],
-  "probes": [ { "name": "A", "at": [0.005, 0.0025], "fields": ["sxx", "vy"] } ],
-  "output": { "history_every": 2, "snapshots": 0, "progress": false }
-})";
-
-TEST(CaseLoad, ValidCaseBuilds) {
-  const fs::path file = write_file("valid.json", kValid);
-  const smpm::Case c = smpm::load_case(file.string());
-  ASSERT_TRUE(c.solver);
-  const smpm::Solver& s = *c.solver;
-  EXPECT_EQ(c.title, "small valid case");
-  EXPECT_DOUBLE_EQ(c.t_end, 1e-6);
-  EXPECT_EQ(s.grid.nx, 10);
-  EXPECT_EQ(s.grid.ny, 10);
-  EXPECT_DOUBLE_EQ(s.grid.h, 0.001);
-
-  // Materials in file order; wave speed of tungsten from E, nu, rho.
-  ASSERT_EQ(s.materials.size(), 2u);
-  EXPECT_EQ(s.materials[0].name, "tungsten");
-  EXPECT_EQ(s.materials[1].model, smpm::Model::VonMises);
-  EXPECT_DOUBLE_EQ(s.materials[1].sigma_y, 300e6);
-  EXPECT_NEAR(s.materials[0].cd, 5918.5, 0.1);
-
-  // 10 x 5 cells x 4 particles per cell.
-  EXPECT_EQ(s.p.size(), 200u);
-
-  // dt = cfl * h / c_d (only tungsten is seeded, but the limit covers every material listed).
-  EXPECT_NEAR(s.dt, 0.5 * s.critical_dt(), 1e-12 * s.dt);
-  EXPECT_LE(s.dt, 0.5 * s.grid.h / s.materials[0].cd * (1 + 1e-12));
-
-  // Boundaries: two particle rows per cell; width 0.5 mm holds the top row, the default width
-  // (one cell) the two bottom rows. 11 nodes on a grid line.
-  ASSERT_EQ(s.tractions.size(), 1u);
-  EXPECT_EQ(s.tractions[0].layer.ids.size(), 20u);
-  EXPECT_DOUBLE_EQ(s.tractions[0].normal, -1e8);
-  EXPECT_EQ(s.tractions[0].fn.kind, smpm::TimeFunction::Kind::Sin2Pulse);
-  EXPECT_DOUBLE_EQ(s.tractions[0].fn.ramp, 5e-8);
-  ASSERT_EQ(s.silents.size(), 1u);
-  EXPECT_EQ(s.silents[0].layer.ids.size(), 40u);
-  EXPECT_EQ(s.silents[0].form, smpm::SilentForm::Particle);
-  ASSERT_EQ(s.silents[0].zn.size(), 40u);
-  EXPECT_NEAR(s.silents[0].zn[0], 15000 * s.materials[0].cd, 1e-6 * s.silents[0].zn[0]);
-  for (double ny : s.silents[0].layer.ny) EXPECT_EQ(ny, -1.0);
-  ASSERT_EQ(s.constraints.size(), 2u);
-  EXPECT_EQ(s.constraints[0].name, "roller0");
-  EXPECT_EQ(s.constraints[0].mask, 2);
-  EXPECT_EQ(s.constraints[0].nodes.size(), 11u);
-  EXPECT_EQ(s.constraints[1].name, "fixed3");
-  EXPECT_EQ(s.constraints[1].mask, 3);
-  EXPECT_EQ(s.constraints[1].nodes.size(), 11u);
-
-  EXPECT_EQ(s.opt.scheme, smpm::Scheme::MUSL);
-  EXPECT_EQ(s.opt.threads, 1);
-  ASSERT_EQ(c.probes.size(), 1u);
-  EXPECT_EQ(c.probes[0].name, "A");
-  EXPECT_EQ(c.probes[0].fields, (std::vector<std::string>{"sxx", "vy"}));
-  EXPECT_EQ(c.output.history_every, 2);
-  EXPECT_EQ(c.output.snapshots, 0);
-  EXPECT_FALSE(c.output.progress);
-  ASSERT_EQ(c.notes.size(), 1u);
-  EXPECT_NE(c.notes[0].find("sin^2"), std::string::npos) << c.notes[0];
-}
-
-TEST(CaseLoad, DefaultsAndOverrides) {
-  const fs::path file = write_file("valid_ovr.json", kValid);
-  const smpm::Case c = smpm::load_case(
-      file.string(), {"bodies.0.particles_per_cell=1", "title=renamed", "time.cfl=0.25",
-                      "probes.0.fields=[\"J2\"]", "scheme.update=USL", "boundaries.1.width=0.001"});
-  const smpm::Solver& s = *c.solver;
-  EXPECT_EQ(c.title, "renamed");        // not valid JSON -> taken as a string
-  EXPECT_EQ(s.p.size(), 50u);
-  EXPECT_NEAR(s.dt, 0.25 * s.critical_dt(), 1e-12 * s.dt);
-  EXPECT_EQ(c.probes[0].fields, std::vector<std::string>{"J2"});
-  EXPECT_EQ(s.opt.scheme, smpm::Scheme::USL);
-  EXPECT_EQ(s.tractions[0].layer.ids.size(), 10u);
-}
-
-TEST(CaseLoad, MinimalCaseUsesDefaults) {
-  nlohmann::json j = {
-      {"grid", {{"size", {0.004, 0.002}}, {"cell", 0.001}}},
-      {"time", {{"end", 1e-6}, {"dt", 1e-8}}},
-      {"materials", {{"m", {{"model", "elastic"}, {"young", 1e9}, {"poisson", 0.25},
-                            {"density", 1000}}}}},
-      {"bodies", {{{"name", "b"}, {"material", "m"}, {"box", {0, 0, 0.004, 0.002}}}}}};
-  const smpm::Case c = smpm::build_case(j, "inline");
-  EXPECT_EQ(c.source, "inline");
-  EXPECT_EQ(c.title, "");
-  EXPECT_EQ(c.solver->p.size(), 8u);
-  EXPECT_DOUBLE_EQ(c.solver->dt, 1e-8);
-  EXPECT_EQ(c.solver->opt.scheme, smpm::Scheme::MUSL);
-  EXPECT_DOUBLE_EQ(c.solver->opt.flip, 1.0);
-  EXPECT_EQ(c.output.history_every, 1);
-  EXPECT_EQ(c.output.snapshots, 10);
-  EXPECT_TRUE(c.output.progress);
-  EXPECT_TRUE(c.probes.empty());
-  EXPECT_TRUE(c.solver->constraints.empty());
-}
-
-// The complete example of docs/case-reference.md is a valid case (the reference stays honest).
-TEST(CaseLoad, ReferenceExampleBuilds) {
-  const std::string doc = read_file(fs::path(SMPM_SOURCE_DIR) / "docs" / "case-reference.md");
-  const std::size_t section = doc.find("## Complete example");
-  ASSERT_NE(section, std::string::npos);
-  const std::size_t begin = doc.find("```json\n", section);
-  ASSERT_NE(begin, std::string::npos);
-  const std::size_t end = doc.find("\n```", begin + 8);
-  ASSERT_NE(end, std::string::npos);
-  const fs::path file = write_file("reference_example.json", doc.substr(begin + 8, end - begin - 8));
-  const smpm::Case c = smpm::load_case(file.string());
-  const smpm::Solver& s = *c.solver;
-  EXPECT_EQ(s.p.size(), 50u * 200u);
-  EXPECT_DOUBLE_EQ(s.dt, 4e-8);
-  EXPECT_NEAR(s.dt / s.critical_dt(), 0.237, 0.001);  // REFERENCE.md: CFL 0.237
-  ASSERT_EQ(s.tractions.size(), 1u);
-  EXPECT_EQ(s.tractions[0].layer.ids.size(), 200u);
-  ASSERT_EQ(s.silents.size(), 1u);
-  EXPECT_EQ(s.silents[0].layer.ids.size(), 200u);
-  ASSERT_EQ(c.probes.size(), 1u);
-  EXPECT_EQ(c.notes.size(), 1u);
-}
+using namespace smpm::case_testing;
 
 TEST(CaseLoad, MissingFile) {
   try {

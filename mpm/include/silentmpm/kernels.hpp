@@ -1,0 +1,267 @@
+#pragma once
+// The MPM kernels as free functions over one range of particles and one set of nodal arrays,
+// templated on the shape function (shape.hpp) and, for the stress update, on the material model.
+//
+// The solver's step (solver.cpp) calls them for every range of the strip colouring and for every
+// velocity field: the grid's own arrays in the ordinary single-field step, one set of arrays per
+// body in the multi-field contact (contact.hpp). A kernel never owns or swaps arrays; what it
+// reads and writes is the NodalField it is handed.
+//
+// Each kernel keeps the arithmetic of the formulas it implements in a fixed order (node a = 0 ..
+// Shape::kNodes - 1, particle by particle), so that a run is reproducible bit for bit for a given
+// thread count.
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "silentmpm/film.hpp"
+#include "silentmpm/grid.hpp"
+#include "silentmpm/material.hpp"
+#include "silentmpm/particles.hpp"
+#include "silentmpm/shape.hpp"
+
+namespace smpm {
+
+// One velocity field on the grid: nodal arrays (all nodes, n = j * nnx + i). Pointers a kernel
+// does not use may be null.
+struct NodalField {
+  double* m = nullptr;              // lumped mass
+  double* px = nullptr;             // momentum at the start of the step
+  double* py = nullptr;
+  double* fx = nullptr;             // internal (+ external) force
+  double* fy = nullptr;
+  double* vx = nullptr;             // velocity at the start of the step
+  double* vy = nullptr;
+  double* vnx = nullptr;            // updated velocity
+  double* vny = nullptr;
+  double* qx = nullptr;             // MUSL: re-mapped momentum, then velocity
+  double* qy = nullptr;
+  // Multi-field contact only: mass gradient sum m_p grad N, and sum m_p N x_p, m_p N y_p,
+  // m_p N sqrt(V_p) (nodal centroid and size of the body's particles).
+  double* gx = nullptr;
+  double* gy = nullptr;
+  double* xm = nullptr;
+  double* ym = nullptr;
+  double* sm = nullptr;
+};
+
+// A range of node indices i0..i1, j0..j1 (inclusive); empty when i0 > i1 or j0 > j1.
+using NodeBox = std::array<int, 4>;
+inline bool box_empty(const NodeBox& b) { return b[0] > b[1] || b[2] > b[3]; }
+
+// What a p2g pass maps.
+enum Transfer : unsigned {
+  kMomentum = 1,  // mass and momentum
+  kForce = 2,     // internal force -V sigma grad N
+  kContact = 4    // with kMomentum: the contact fields (mass gradient, centroid, size)
+};
+
+// Cell rows a moving pass found its particles in, and how many left the grid's columns.
+struct RowSpan {
+  int lo = std::numeric_limits<int>::max();
+  int hi = std::numeric_limits<int>::min();
+  int out = 0;
+  void add(int r, bool outside) {
+    lo = r < lo ? r : lo;
+    hi = r > hi ? r : hi;
+    out += outside;
+  }
+};
+
+namespace kernels {
+
+// Particle to grid over [b, e) (paper Eq. 15, 18): mass and momentum, and/or the internal force.
+// With kContact the node box the particles touch is grown in `box`.
+template <class Shape, unsigned WHAT>
+inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
+                NodeBox* box = nullptr) {
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h;
+  const long nnx = g.nnx;
+  const double* X = p.x.data(); const double* Y = p.y.data();
+  const double* VX = p.vx.data(); const double* VY = p.vy.data();
+  const double* M = p.mass.data(); const double* V = p.vol.data();
+  const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
+  Shape sf;
+  long nodes[Shape::kNodes];
+  for (uint32_t k = b; k < e; ++k) {
+    sf.eval(X[k], Y[k], x0, y0, ih);
+    sf.node_indices(nnx, nodes);
+    if constexpr ((WHAT & kMomentum) != 0) {
+      const double mk = M[k], mvx = mk * VX[k], mvy = mk * VY[k];
+      if constexpr ((WHAT & kContact) != 0) {
+        sf.grow_box(*box);
+        const double sv = std::sqrt(V[k]);
+        for (int a = 0; a < Shape::kNodes; ++a) {
+          f.m[nodes[a]] += mk * sf.N[a];
+          f.px[nodes[a]] += mvx * sf.N[a];
+          f.py[nodes[a]] += mvy * sf.N[a];
+          f.gx[nodes[a]] += mk * sf.dNx[a];
+          f.gy[nodes[a]] += mk * sf.dNy[a];
+          f.xm[nodes[a]] += mk * sf.N[a] * X[k];
+          f.ym[nodes[a]] += mk * sf.N[a] * Y[k];
+          f.sm[nodes[a]] += mk * sf.N[a] * sv;
+        }
+      } else {
+        for (int a = 0; a < Shape::kNodes; ++a) {
+          f.m[nodes[a]] += mk * sf.N[a];
+          f.px[nodes[a]] += mvx * sf.N[a];
+          f.py[nodes[a]] += mvy * sf.N[a];
+        }
+      }
+    }
+    if constexpr ((WHAT & kForce) != 0) {
+      const double v = V[k], sxx = SXX[k], syy = SYY[k], sxy = SXY[k];
+      for (int a = 0; a < Shape::kNodes; ++a) {
+        f.fx[nodes[a]] -= v * (sxx * sf.dNx[a] + sxy * sf.dNy[a]);
+        f.fy[nodes[a]] -= v * (sxy * sf.dNx[a] + syy * sf.dNy[a]);
+      }
+    }
+  }
+}
+
+// Grid to particle over [b, e): velocities from the field's start (vx, vy) and updated (vnx, vny)
+// nodal velocities with the FLIP/PIC blend (flip = 1: FLIP). REMAP: MUSL's re-map of the new
+// particle momenta into (qx, qy). MOVE: USF's position update with the updated nodal velocity.
+template <class Shape, bool REMAP, bool MOVE>
+inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const NodalField& f,
+                double flip, double dt, RowSpan& rows) {
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
+  const long nnx = g.nnx;
+  const double pic = 1.0 - flip;
+  const double* vx = f.vx; const double* vy = f.vy;
+  const double* ux = f.vnx; const double* uy = f.vny;
+  double* X = p.x.data(); double* Y = p.y.data();
+  double* VX = p.vx.data(); double* VY = p.vy.data();
+  const double* M = p.mass.data();
+  Shape sf;
+  long nodes[Shape::kNodes];
+  for (uint32_t k = b; k < e; ++k) {
+    sf.eval(X[k], Y[k], x0, y0, ih);
+    sf.node_indices(nnx, nodes);
+    double dvx = 0, dvy = 0, wx = 0, wy = 0;
+    for (int a = 0; a < Shape::kNodes; ++a) {
+      const long i = nodes[a];
+      wx += sf.N[a] * ux[i];
+      wy += sf.N[a] * uy[i];
+      dvx += sf.N[a] * (ux[i] - vx[i]);
+      dvy += sf.N[a] * (uy[i] - vy[i]);
+    }
+    const double nvx = flip * (VX[k] + dvx) + pic * wx;
+    const double nvy = flip * (VY[k] + dvy) + pic * wy;
+    VX[k] = nvx; VY[k] = nvy;
+    if constexpr (REMAP) {
+      const double mvx = M[k] * nvx, mvy = M[k] * nvy;
+      for (int a = 0; a < Shape::kNodes; ++a) {
+        f.qx[nodes[a]] += mvx * sf.N[a];
+        f.qy[nodes[a]] += mvy * sf.N[a];
+      }
+    }
+    if constexpr (MOVE) {
+      X[k] += dt * wx;
+      Y[k] += dt * wy;
+      rows.add(static_cast<int>(std::floor((Y[k] - y0) * ih)), !(X[k] >= x0 && X[k] < x1));
+    }
+  }
+}
+
+// Stress update over [b, e) for one material group with model MODEL: velocity gradient from the
+// nodal velocity (gx, gy), Jaumann rotation, strain increment, material update, volume. MOVE:
+// the particle advances with the updated nodal velocity (ux, uy). Returns the energy dissipated.
+template <class Shape, Model MODEL, bool MOVE>
+inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
+                            const Material& mat, const double* gx, const double* gy,
+                            const double* ux, const double* uy, double dt, RowSpan& rows) {
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
+  const long nnx = g.nnx;
+  double* X = p.x.data(); double* Y = p.y.data();
+  double* V = p.vol.data();
+  double* SXX = p.sxx.data(); double* SYY = p.syy.data();
+  double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
+  double* EP = p.eps_p.data();
+  double diss = 0;
+  Shape sf;
+  long nodes[Shape::kNodes];
+  for (uint32_t k = b; k < e; ++k) {
+    sf.eval(X[k], Y[k], x0, y0, ih);
+    sf.node_indices(nnx, nodes);
+    double lxx = 0, lxy = 0, lyx = 0, lyy = 0, wx = 0, wy = 0;
+    for (int a = 0; a < Shape::kNodes; ++a) {
+      const long i = nodes[a];
+      lxx += gx[i] * sf.dNx[a];
+      lxy += gx[i] * sf.dNy[a];
+      lyx += gy[i] * sf.dNx[a];
+      lyy += gy[i] * sf.dNy[a];
+      if constexpr (MOVE) {
+        wx += sf.N[a] * ux[i];
+        wy += sf.N[a] * uy[i];
+      }
+    }
+    double sxx = SXX[k], syy = SYY[k], szz = SZZ[k], sxy = SXY[k];
+    // Jaumann rotation with spin w = (dvx/dy - dvy/dx) / 2.
+    const double w = 0.5 * (lxy - lyx) * dt;
+    const double rxx = 2 * w * sxy, rxy = w * (syy - sxx);
+    sxx += rxx; syy -= rxx; sxy += rxy;
+    double wp;
+    if constexpr (MODEL == Model::J2Film)  // history in the film arrays of the particles
+      wp = film_update(mat, p, k, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy, szz, sxy);
+    else
+      wp = stress_update<MODEL>(mat, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy, szz, sxy,
+                                EP[k]);
+    SXX[k] = sxx; SYY[k] = syy; SZZ[k] = szz; SXY[k] = sxy;
+    V[k] *= (1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt;
+    diss += wp * V[k];
+    if constexpr (MOVE) {
+      X[k] += dt * wx;
+      Y[k] += dt * wy;
+      rows.add(static_cast<int>(std::floor((Y[k] - y0) * ih)), !(X[k] >= x0 && X[k] < x1));
+    }
+  }
+  return diss;
+}
+
+// fn(node index) over the nodes of a box, rows in parallel.
+template <class Fn>
+inline void for_box(const NodeBox& bx, long nnx, int threads, Fn&& fn) {
+  if (box_empty(bx)) return;
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int j = bx[2]; j <= bx[3]; ++j) {
+    const long r = static_cast<long>(j) * nnx;
+    for (int i = bx[0]; i <= bx[1]; ++i) fn(r + i);
+  }
+}
+
+// Nodal velocity v = p / m over the nodes of `box` (nodes lighter than `floor` get zero), with
+// the essential conditions `fix` (bit 0: x held, bit 1: y held). v and p may alias.
+inline void nodal_velocity(const Grid& g, const NodeBox& box, const double* m, const uint8_t* fix,
+                           const double* qx, const double* qy, double* vx, double* vy,
+                           double floor, int threads) {
+  if (box_empty(box)) return;
+  const long nnx = g.nnx;
+  if (box[0] == 0 && box[1] == g.nnx - 1) {  // whole rows: one flat loop
+    const long i0 = box[2] * nnx, i1 = (box[3] + 1) * nnx;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long i = i0; i < i1; ++i) {
+      if (m[i] > floor) {
+        vx[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
+        vy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
+      } else {
+        vx[i] = 0; vy[i] = 0;
+      }
+    }
+    return;
+  }
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int j = box[2]; j <= box[3]; ++j)
+    for (long i = j * nnx + box[0]; i <= j * nnx + box[1]; ++i) {
+      if (m[i] > floor) {
+        vx[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
+        vy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
+      } else {
+        vx[i] = 0; vy[i] = 0;
+      }
+    }
+}
+
+}  // namespace kernels
+}  // namespace smpm

@@ -1,0 +1,24 @@
+#pragma once
+// The named points of the MPM time step (silentmpm/solver.hpp) where a coupled model adds its work.
+namespace smpm {
+
+class Solver;
+
+// Work a coupled model adds to the MPM step at its named points. A hook set is attached to one
+// solver (Solver::attach); the step calls the solver's multi-field contact first, when it is on,
+// then the attached sets in order of attachment.
+class StepHooks {
+ public:
+  virtual ~StepHooks() = default;
+  virtual void after_momentum(Solver&) {}     // p2g done (nodal mass and momentum on every field)
+  virtual void after_forces(Solver&) {}       // internal forces and loads on the grid
+  virtual void after_grid_update(Solver&) {}  // v+ on the grid, before its boundary work is booked
+  virtual void before_g2p(Solver&) {}         // boundary work booked; particles not yet updated
+  virtual void after_remap(Solver&) {}        // MUSL: re-mapped momenta, not yet divided by mass
+  virtual void end_of_step(Solver&) {}        // clock advanced, particles checked
+  // MUSL books the boundary work with the re-mapped velocity only when the grid's arrays hold
+  // the one re-mapped field the particles carry; a hook set that changes that answers false.
+  virtual bool remapped_power() const { return true; }
+};
+
+}  // namespace smpm
