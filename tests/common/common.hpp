@@ -1,5 +1,5 @@
 #pragma once
-// Helpers shared by the physics tests: materials of REFERENCE.md §2 and the 1D column.
+// Helpers shared by the physics tests: materials of docs/physics.md §2 and the 1D column.
 #include <memory>
 
 #include "silentmpm/solver.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 // Helpers shared by the contact tests: the two elastic materials of the 1D plate impact
-// (aluminium flyer, steel target), the impact set-up, and its closed forms (REFERENCE.md §4)
+// (aluminium flyer, steel target), the impact set-up, and its closed forms (docs/physics.md §4)
 // (tests/physics/test_contact.cpp, tests/unit/test_contact_oracle.cpp); the same impact as a
 // case document (tests/physics/test_contact_case.cpp, tests/errors/test_contact_case_errors.cpp).
 #include <nlohmann/json.hpp>

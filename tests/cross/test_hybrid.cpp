@@ -1,5 +1,6 @@
-// MPM-FEM hybrid (REFERENCE.md section 7): a plane P wave crossing the interface, energy balance,
-// momentum, the uniaxial-strain patch across the interface.
+// MPM-FEM hybrid (docs/physics.md section 7): a plane P wave crossing the interface, and the
+// reflection of a wide pulse there. Energy balance, momentum and the uniform-strain patches are in
+// test_hybrid_conservation.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -42,7 +43,7 @@ std::vector<double> record(HybRun& m, const Strip& c, double x, double y, double
 // elements on [60h, 200h]. The wave reflected by the interface is the difference, at a probe in
 // the MPM part, between the hybrid and an all-MPM column of the same length; in the window where
 // only that reflection can reach the probe it must stay below 2 % of the pulse amplitude
-// (REFERENCE.md: ~0.5 % in a 1D prototype). With one particle per cell at the cell centre and u
+// (docs/physics.md: ~0.5 % in a 1D prototype). With one particle per cell at the cell centre and u
 // a function of x only, MPM and lumped Q1 coincide, so the reflection is the MPM noise floor.
 // Measured (MUSL, 1 ppc): 0.86 % for this 20-cell pulse; 0.24 % for 40 cells; USL 0.15 %.
 TEST(Hybrid, PlanePWaveCrossesTheInterface) {
@@ -74,7 +75,7 @@ TEST(Hybrid, PlanePWaveCrossesTheInterface) {
   EXPECT_LT(diff / c.amplitude, 0.02);
 }
 
-// REFERENCE.md section 7 acceptance: a pulse >= 40 cells wide reflects <= 1 %. Particles on
+// docs/physics.md section 7 acceptance: a pulse >= 40 cells wide reflects <= 1 %. Particles on
 // [0, 100h], elements on [100h, 300h]; probe 50 cells from the interface. Measured 0.24 % (MUSL,
 // 1 particle per cell).
 TEST(Hybrid, WidePulseReflectsUnderOnePercent) {

@@ -2,7 +2,7 @@
 // the film and 1.5 um of silicon as particles (meshes/film_hybrid_1500nm.geo) on an unstructured
 // Q1 far field growing with depth (meshes/hybrid_film_substrate_unstructured.geo), with the same
 // probes as the all-MPM extended film run (E, F, and I along the W-Si interface curve), against it
-// (studies/film/cases/extended.json, 15 um of silicon particles). This is the pair issue 7's speed
+// (studies/film/cases/extended.json, 15 um of silicon particles). This is the pair the hybrid's speed
 // benchmark (build/bench_hybrid) compares, so the test holds the accuracy that benchmark claims:
 // over the extended run's reflection-free window [0, 3.2 ns], sigma_yy at E and F within 2 %
 // relative L2 (measured 1.21 % and 1.68 %), J2 within 1 % (0.65 %, 0.68 %), sigma_xx at E within

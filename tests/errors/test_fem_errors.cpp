@@ -177,7 +177,7 @@ TEST(FemErrors, BadInputs) {
   EXPECT_ERROR(error_of(c), "fem.meshes", "unknown key");
 
   c = good_case();
-  c["bodies"] = json::array();  // bodies + fem: a hybrid case (issue 7), which needs a grid
+  c["bodies"] = json::array();  // bodies + fem: a hybrid case, which needs a grid
   EXPECT_ERROR(error_of(c), "case.json: grid", "MPM-FEM hybrid");
 
   c = good_case();

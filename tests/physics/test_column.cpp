@@ -1,4 +1,4 @@
-// The 1D column with rollers (REFERENCE.md §4): arrival time, plateau, and what the right end
+// The 1D column with rollers (docs/physics.md §4): arrival time, plateau, and what the right end
 // reflects (free, LK silent layer in both its forms).
 #include <gtest/gtest.h>
 
@@ -74,7 +74,7 @@ void check_arrival_and_plateau(bool shear) {
 TEST(Column, ArrivalAndPlateauP) { check_arrival_and_plateau(false); }
 TEST(Column, ArrivalAndPlateauS) { check_arrival_and_plateau(true); }
 
-// Energy reflected by the right end, by extended-domain differencing (REFERENCE.md §4.1): run A
+// Energy reflected by the right end, by extended-domain differencing (docs/physics.md §4.1): run A
 // has the boundary under test at x = L; run B is the same column three times as long (same
 // particles, same dt), so nothing comes back from its end in the window. At a time when the
 // incident pulse has left A and its reflection is inside, the energy of the field A - B on the
@@ -166,7 +166,7 @@ INSTANTIATE_TEST_SUITE_P(
       return s;
     });
 
-// Stability of the dashpot forms (REFERENCE.md §1). A pulse runs into the silent end of a short
+// Stability of the dashpot forms (docs/physics.md §1). A pulse runs into the silent end of a short
 // column for 20 pulse lengths; a stable absorbing end leaves < 5 % of the input energy. The
 // column starts inside its first cell (offset) so the boundary cells are partly filled.
 //  * the paper's form (lagged particle velocity, mapped at the particle) is stable up to the

@@ -1,5 +1,5 @@
-// Contact of bodies (issue 5): 1D plate impact, aluminium flyer on a steel target, rollers on the
-// long sides (uniaxial strain), elastic. Closed forms (REFERENCE.md §4, P-wave impedances
+// Contact of bodies: 1D plate impact, aluminium flyer on a steel target, rollers on the
+// long sides (uniaxial strain), elastic. Closed forms (docs/physics.md §4, P-wave impedances
 // Z = rho c_d computed from E, nu, rho):
 //   contact stress     sigma = v0 Z1 Z2 / (Z1 + Z2)        (12.26 MPa per m/s)
 //   contact duration   T_c = 2 d1 / c_d1                     (flyer thickness d1)

@@ -1,4 +1,4 @@
-// FEM far-field on the 1D column with rollers (REFERENCE.md §4): arrival and plateau of a step
+// FEM far-field on the 1D column with rollers (docs/physics.md §4): arrival and plateau of a step
 // load, energy reflected by the LK dashpot end (extended-domain differencing), energy balance.
 #include <gtest/gtest.h>
 
@@ -205,10 +205,10 @@ Reflected fem_reflected(Column c, int fwhm_cells) {
           A->energy.absorbed / A->energy.external_work};
 }
 
-// REFERENCE.md §4: FE Q1 lumped reflects 9.8e-6 of the energy at a pulse width of 8 cells; the
+// docs/physics.md §4: FE Q1 lumped reflects 9.8e-6 of the energy at a pulse width of 8 cells; the
 // acceptance bound is 1e-4. A free end reflects everything (>= 0.99). The reflection depends on
 // dt: at 8 cells FWHM it is 3.3e-5, 2.3e-5 and 4.8e-6 at 0.1, 0.5 and 0.95 of the element bound
-// (4 cells: 6.1e-4, 4.4e-4, 1.2e-4; 16 cells: 2.0e-6, 1.35e-6, 2.7e-7), so REFERENCE.md's
+// (4 cells: 6.1e-4, 4.4e-4, 1.2e-4; 16 cells: 2.0e-6, 1.35e-6, 2.7e-7), so docs/physics.md's
 // 1.6e-4 / 9.8e-6 / 5.9e-7 correspond to dt near 0.8 of the bound: the lumped-mass spatial
 // dispersion and the central-difference temporal dispersion cancel towards the stability limit.
 // These tests run at 0.5.

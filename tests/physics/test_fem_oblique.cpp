@@ -1,4 +1,4 @@
-// Oblique incidence on the FEM LK dashpot boundary (REFERENCE.md §4.1): a plane P pulse at 15 and
+// Oblique incidence on the FEM LK dashpot boundary (docs/physics.md §4.1): a plane P pulse at 15 and
 // 30 degrees, reflected P and SV amplitudes measured by extended-domain differencing (same mesh,
 // identical dt), against the closed form: within 10 % or 2e-3 absolute. The set-up is the one of
 // studies/oblique (studies/oblique/oblique.hpp), at nu = 0.25 and a Gaussian pulse 24 cells wide (FWHM).

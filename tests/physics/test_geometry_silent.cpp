@@ -1,7 +1,7 @@
 // The silent layer on an inclined gmsh edge (studies/geometry/inclined.hpp has the method): a
 // plane P pulse meets the right edge of meshes/inclined_edge.geo at 30 degrees from its normal;
 // the reflected field is measured by extended-domain differencing and split into P and SV by
-// div and curl (REFERENCE.md §4.1), then compared with the closed form smpm::lk_reflection.
+// div and curl (docs/physics.md §4.1), then compared with the closed form smpm::lk_reflection.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -47,7 +47,7 @@ InclinedSpec ci_spec() {
 // The measurement on a free edge (a = b = 0) against the closed form (|R_PP| = 0.754,
 // |R_PS| = 0.876 for nu = 0.33 at 30 degrees), then the silent edge (closed form |R_PP| = 0.0122,
 // |R_PS| = 0.0284) within the 20 %, and the grid-aligned silent edge (closed form 0).
-// R are displacement-amplitude ratios (div u, curl u; REFERENCE.md §4.1). Measured on velocities
+// R are displacement-amplitude ratios (div u, curl u; docs/physics.md §4.1). Measured on velocities
 // the same runs give 0.04-0.3: the particle staircase of the inclined edge scatters a short-wave
 // near field that the time derivative weights one order more and that decays with the distance
 // from the edge (studies/geometry/README.md).

@@ -166,11 +166,11 @@ TEST(FastBifurcation, MinimiserAgreesWithSweep) {
 }
 
 // Tied minima keep the sweep's tie rule: plate tension at bifurcation (two planes at +-44.7 deg,
-// REFERENCE.md §5) and pure shear at H = 0 (n along x or y).
+// docs/physics.md §5) and pure shear at H = 0 (n along x or y).
 TEST(FastBifurcation, TieRuleOnSymmetricStates) {
   const Material m = tungsten();
   const double scale = m.mu * m.M;
-  // Plate-tension state at bifurcation (REFERENCE.md §5): sxx 1.7837, syy 0, szz 0.8309 GPa,
+  // Plate-tension state at bifurcation (docs/physics.md §5): sxx 1.7837, syy 0, szz 0.8309 GPa,
   // with the critical modulus of that state (det min = 0 at two mirror planes).
   const double sxx = 1.7837e9, szz = 0.8309e9;
   double th_cf;
@@ -204,7 +204,7 @@ TEST(FastBifurcation, TieRuleOnSymmetricStates) {
 
 // The check gives the sweep's verdict, and at bifurcation the sweep's plane bit for bit, on
 // random J2 states around the critical modulus; with hardening (H > 0) no state bifurcates
-// (associated J2: H_cr <= 0 for every stress, REFERENCE.md §5), and the closed-form bound alone
+// (associated J2: H_cr <= 0 for every stress, docs/physics.md §5), and the closed-form bound alone
 // settles it (stage 1) for the tungsten hardening modulus.
 TEST(FastBifurcation, CheckGivesTheSweepVerdictAndPlane) {
   const Material m = tungsten();
@@ -285,7 +285,7 @@ TEST(FastBifurcation, ClosedFormCriticalModulus) {
   }
   EXPECT_GT(excluded, 500);
   EXPECT_LT(excluded, 1500);
-  // Pure shear in plane: 0 (REFERENCE.md §5); uniaxial strain: about -0.64 G.
+  // Pure shear in plane: 0 (docs/physics.md §5); uniaxial strain: about -0.64 G.
   EXPECT_NEAR(hcr_j2_max_closed(1e9, -1e9, 0, 0, m.mu, m.M), 0.0, 1e-12 * m.mu);
   const double lat = m.lambda / m.M * -1.6e9;
   EXPECT_NEAR(hcr_j2_max_closed(-1.6e9, lat, lat, 0, m.mu, m.M),

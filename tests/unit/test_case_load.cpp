@@ -128,7 +128,7 @@ TEST(CaseLoad, ReferenceExampleBuilds) {
   const smpm::Solver& s = *c.solver;
   EXPECT_EQ(s.p.size(), 50u * 200u);
   EXPECT_DOUBLE_EQ(s.dt, 4e-8);
-  EXPECT_NEAR(s.dt / s.critical_dt(), 0.237, 0.001);  // REFERENCE.md: CFL 0.237
+  EXPECT_NEAR(s.dt / s.critical_dt(), 0.237, 0.001);  // docs/physics.md: CFL 0.237
   ASSERT_EQ(s.tractions.size(), 1u);
   EXPECT_EQ(s.tractions[0].layer.ids.size(), 200u);
   ASSERT_EQ(s.silents.size(), 1u);

@@ -1,5 +1,5 @@
 // The closed forms of the contact tests (tests/physics/test_contact.cpp): the 1D plate impact's
-// contact stress from the P-wave impedances Z = rho c_d computed from E, nu, rho (REFERENCE.md §4).
+// contact stress from the P-wave impedances Z = rho c_d computed from E, nu, rho (docs/physics.md §4).
 #include <gtest/gtest.h>
 
 #include "test_contact_common.hpp"
@@ -7,7 +7,7 @@
 using namespace smpm;
 using namespace smpm::contact_testing;
 
-// The oracle itself: 12.26 MPa per m/s from the P-wave impedances (REFERENCE.md §4).
+// The oracle itself: 12.26 MPa per m/s from the P-wave impedances (docs/physics.md §4).
 TEST(ContactOracle, ImpedancesFromConstants) {
   Impact c;
   c.v0 = 1.0;

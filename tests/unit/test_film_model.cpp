@@ -1,4 +1,4 @@
-// Tungsten film constitutive pieces (REFERENCE.md §5): J2 with hardening/softening, the
+// Tungsten film constitutive pieces (docs/physics.md §5): J2 with hardening/softening, the
 // acoustic-tensor bifurcation sweep against the closed-form J2 criterion, and decohesion.
 #include <gtest/gtest.h>
 
@@ -102,7 +102,7 @@ TEST(FilmJ2, PlateTensionYieldPeakBifurcation) {
               "%.5g, e %.5g, sxx %.5g, szz %.5g, theta %.3f (%d minima), tn %.4g, tt %.4g\n",
               r.yield.sxx, r.yield.exx, r.peak.sxx, r.peak.exx, r.bif.exx, r.bif.e, r.bif.sxx,
               r.bif.szz, r.b.theta, r.b.minima, r.tn, r.tt);
-  // REFERENCE.md §5, plastic-modulus reading, 1 %.
+  // docs/physics.md §5, plastic-modulus reading, 1 %.
   EXPECT_REL(r.yield.sxx, 1.6789e9, 0.01);
   EXPECT_REL(r.yield.exx, 3.77e-3, 0.01);
   EXPECT_REL(r.peak.sxx, 1.7527e9, 0.01);
@@ -132,7 +132,7 @@ TEST(FilmJ2, TangentModulusReadingChangesBifurcationStrainLittle) {
   const Material mt = film_tungsten(ModuliReading::Tangent);
   EXPECT_REL(mt.j2.H_h, 411.0 * 64 / (411 - 64) * 1e9, 1e-12);
   EXPECT_REL(mt.j2.H_s, -411.0 * 0.64 / (411 + 0.64) * 1e9, 1e-12);
-  // The bifurcation strain moves by well under 1 % (REFERENCE.md: < 0.1 %; the peak moves more).
+  // The bifurcation strain moves by well under 1 % (docs/physics.md: < 0.1 %; the peak moves more).
   EXPECT_LT(std::fabs(b.bif.exx / a.bif.exx - 1), 2e-3);
 }
 
@@ -223,7 +223,7 @@ TEST(FilmBifurcation, SweepMatchesBruteForceMinimum) {
 
 TEST(FilmBifurcation, UniaxialStrainNeverBifurcatesPureShearAtZeroModulus) {
   const Material m = film_tungsten();
-  // Uniaxial strain: sigma_yy = sigma_zz = lambda/M sigma_xx; H_cr ~ -0.64 G (REFERENCE.md).
+  // Uniaxial strain: sigma_yy = sigma_zz = lambda/M sigma_xx; H_cr ~ -0.64 G (docs/physics.md).
   const double s = -1.6e9, lat = m.lambda / m.M * s;
   const double h1 = hcr_j2_max(s, lat, lat, 0, m.mu, m.M);
   EXPECT_LT(h1, -0.5 * m.mu);

@@ -1,4 +1,4 @@
-// Closed-form LK reflection coefficients (REFERENCE.md §4.1): the nu = 0.25 table to 1e-4, and
+// Closed-form LK reflection coefficients (docs/physics.md §4.1): the nu = 0.25 table to 1e-4, and
 // energy conservation on a free surface.
 #include <gtest/gtest.h>
 
