@@ -1,4 +1,4 @@
-// bench_hybrid: issue 7's speed benchmark, the MPM-FEM hybrid film case against the all-MPM
+// bench_hybrid: the hybrid's speed benchmark, the MPM-FEM hybrid film case against the all-MPM
 // extended film case (studies/hybrid/README.md).
 //
 // Every case is the tungsten film of studies/film (2 500 j2_softening particles, 0.1 um cells,

@@ -1,4 +1,4 @@
-// Convergence plates (Shen & Chen 2005, §4, Figs. 11-13; REFERENCE.md §3.3): geometrically
+// Convergence plates (Shen & Chen 2005, §4, Figs. 11-13; docs/physics.md §3.3): geometrically
 // identical aluminium and steel plates side by side; the aluminium plate impacts at 10 m/s, the
 // steel plate's right edge is silent, point D at the steel plate's centre. Plate size (not in the
 // paper): 0.1 m x 0.1 m each, as in studies/convergence.

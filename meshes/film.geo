@@ -1,4 +1,4 @@
-// Tungsten film on a silicon substrate (Shen & Chen 2005, §5, Figs. 14-24; REFERENCE.md §3.4):
+// Tungsten film on a silicon substrate (Shen & Chen 2005, §5, Figs. 14-24; docs/physics.md §3.4):
 // film L = 10 um long, ht = 2.5 um thick, on a substrate as wide as the film (assumption) and
 // hs thick; the W-Si interface at y = 5 um, as in studies/film. film_5um.geo and film_15um.geo
 // set hs.

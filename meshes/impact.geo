@@ -1,4 +1,4 @@
-// Oblique impact (Shen & Chen 2005, §4, Figs. 8-10; REFERENCE.md §3.2): a smaller aluminium
+// Oblique impact (Shen & Chen 2005, §4, Figs. 8-10; docs/physics.md §3.2): a smaller aluminium
 // plate (the flyer) strikes the left edge of a steel plate (the target) off-centre, so that the
 // waves reach the target's right side obliquely. The geometry of studies/impact/cases:
 //

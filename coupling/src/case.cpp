@@ -461,7 +461,7 @@ GridSpec parse_grid(Obj g) {
   return s;
 }
 
-// Keys of model "j2_softening" (the tungsten film of REFERENCE.md §5; docs/case-reference.md).
+// Keys of model "j2_softening" (the tungsten film of docs/physics.md §5; docs/case-reference.md).
 const std::vector<std::string> kFilmKeys = {"yield_stress", "peak_stress", "hardening_modulus",
                                             "softening_modulus", "moduli", "bifurcation",
                                             "decohesion"};
@@ -767,7 +767,7 @@ class Builder {
   std::vector<Material> materials_;
   std::map<std::string, int> material_index_;
   std::vector<BodySpec> bodies_;
-  std::unique_ptr<Geometry> geo_;  // the "geometry" key (case_geometry.cpp)
+  std::unique_ptr<Geometry> geo_;  // the "geometry" key (silentmpm/geometry.hpp)
   bool use_cfl_ = false;
   double dt_or_cfl_ = 0;
 
@@ -1033,7 +1033,7 @@ class Builder {
     const double tol = 1e-6 * grid_.h;
     double x0, y0, x1, y1;
     std::string what;
-    if (o.has("curve")) return curve_nodes(o);  // a gmsh physical curve (case_geometry.cpp)
+    if (o.has("curve")) return curve_nodes(o);  // a gmsh physical curve (silentmpm/geometry.hpp)
     if (o.has("grid_side")) {
       const std::string side = o.choice("grid_side", kSides);
       x0 = side == "right" ? grid_.x1() : grid_.x0;

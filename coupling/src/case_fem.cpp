@@ -3,7 +3,7 @@
 // is a CaseError "<source>: <key path>: <what>", as for the MPM sections.
 //
 // Layout of an FEM-only case: title, time, scheme (threads only), materials, fem, probes, output.
-// A case with both MPM bodies and an FEM region (the coupled hybrid) is not supported yet.
+// A case with both MPM bodies and an FEM region is the coupled hybrid (case_hybrid.cpp).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

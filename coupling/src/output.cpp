@@ -1,4 +1,4 @@
-// History CSV and HDF5/XDMF particle snapshots (contracts in DESIGN.md and output.hpp).
+// History CSV and HDF5/XDMF particle snapshots (the contract in output.hpp).
 //
 // Snapshot layout, one file DIR/<base>.h5:
 //   /step_000000123            group, attributes "time" (double) and "step" (int64)

@@ -2,7 +2,7 @@
 // differencing (inclined.hpp) against the closed form, for a free edge and for the silent edge.
 //   geometry_inclined SOURCE_DIR OUT.csv [widths|depths|variants]
 //     widths    (default) free edge, grid-aligned edge, silent edge at FWHM 8/12/16/24 cells,
-//               measured on displacements (REFERENCE.md §4.1) and, for comparison, on velocities
+//               measured on displacements (docs/physics.md §4.1) and, for comparison, on velocities
 //     depths    FWHM 16: receivers from 3-6 to 16-22 cells inside the edge
 //     variants  FWHM 16: the silent layer's form and anchor; LK coefficients a = b = 0.5 and 2
 #include <cstdio>

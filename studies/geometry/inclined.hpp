@@ -1,6 +1,6 @@
 #pragma once
 // Extended-domain differencing for a plane P pulse meeting an inclined edge (studies/geometry,
-// tests/test_geometry_silent.cpp). Shared by the test and the study program.
+// tests/physics/test_geometry_silent.cpp). Shared by the test and the study program.
 //
 // Run A: the aluminium plate of meshes/inclined_edge.geo (right edge with outward normal at
 // theta from +x: silent, or free with a = b = 0), loaded on its left edge by a sin^2 pulse of
@@ -12,7 +12,7 @@
 // lattice (spacing h/n), sampled every step at the receivers: particles between depth0 and
 // depth1 cells inside the edge, within half_span cells of its mid-height point along it.
 //   |R_PP| = max|div D| / max|div u_B|,   |R_PS| = (c_s / c_d) max|curl D| / max|div u_B|
-// (REFERENCE.md §4.1), the maxima over the receivers and the window. The window ends before any
+// (docs/physics.md §4.1), the maxima over the receivers and the window. The window ends before any
 // signal from the plate's corners can reach the receivers (checked; an error otherwise).
 #include <algorithm>
 #include <chrono>
@@ -45,7 +45,7 @@ struct InclinedSpec {
   double a = 1, b = 1;      // LK coefficients (0, 0: a free edge)
   std::string form, anchor; // silent layer options (empty: the defaults)
   double width = 0;         // silent layer depth, cells (0: the default, one cell)
-  // Measure div/curl of the displacement (REFERENCE.md §4.1: R are displacement-amplitude
+  // Measure div/curl of the displacement (docs/physics.md §4.1: R are displacement-amplitude
   // ratios) or, if false, of the velocity (weights the high frequencies one order more).
   bool displacement = true;
 };

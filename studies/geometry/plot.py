@@ -1,7 +1,7 @@
 """Figures and metrics.json of the geometry study (called by studies/geometry/run).
 
   inclined_reflection.png  |R_PP| and |R_PS| of the 30-degree silent edge against the pulse width,
-                           with the closed form (REFERENCE.md §4.1) and the free-edge check
+                           with the closed form (docs/physics.md §4.1) and the free-edge check
   ring_history.png         radial stress at P (30 mm from the centre of the ring) for the free,
                            silent and extended outer circle
   ring_energy.png          energy left in the ring / absorbed by the silent ring over time
@@ -57,7 +57,7 @@ def main():
                      "particles": int(f(r, "particles_a")) + int(f(r, "particles_b")),
                      "wall_seconds": f(r, "wall_seconds")}
     inc = {"method": "extended-domain differencing, div/curl of the particle-displacement difference on "
-                     "the particle lattice (R are displacement-amplitude ratios, REFERENCE.md §4.1), "
+                     "the particle lattice (R are displacement-amplitude ratios, docs/physics.md §4.1), "
                      "receivers 8-12 cells inside the edge unless stated, 4 ppc, aluminium (nu = 0.33), "
                      "sin^2 pulse",
            "closed_form_30deg": {"rpp": f(silent[0], "rpp_exact"), "rps": f(silent[0], "rps_exact")},

@@ -141,7 +141,7 @@ def main(out):
             acc["error_ratio_to_extended"][n] = ratio
             acc["equal_accuracy"][n] = bool(all(abs(r - 1) <= 0.05 for r in ratio.values()))
         m["accuracy_vs_fine"] = acc
-    # Issue 7's benchmark (build/bench_hybrid): step loops in one process, process CPU clock.
+    # The hybrid benchmark (build/bench_hybrid): step loops in one process, process CPU clock.
     bj = os.path.join(out, "bench_hybrid.json")
     if os.path.exists(bj):
         m["benchmark"] = json.load(open(bj))

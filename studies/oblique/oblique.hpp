@@ -1,7 +1,7 @@
 #pragma once
 // Reflection of plane P and SV pulses at an LK dashpot boundary, measured in the FEM far-field by
-// extended-domain differencing (REFERENCE.md §4.1), against the closed form (lk_reflection).
-// Used by studies/oblique (all angles) and tests/test_fem_oblique.cpp (15 and 30 degrees).
+// extended-domain differencing (docs/physics.md §4.1), against the closed form (lk_reflection).
+// Used by studies/oblique (all angles) and tests/physics/test_fem_oblique.cpp (15 and 30 degrees).
 //
 // Geometry, in cells of size h (the boundary under test is the right side x = Lx, outward normal
 // +x; angles are measured from that normal):

@@ -3,7 +3,7 @@
 // MPM bodies (1 particle per cell, MUSL, the default semi-implicit nodal silent layer on the
 // right side of run A), with the particles of A and B on the same lattice and the identical dt
 // (CFL 0.3 of h / c_d). The initial condition sets the particles' velocity and stress from the
-// plane pulse. P and S are separated with div u and curl u at R (REFERENCE.md §4.1: R are
+// plane pulse. P and S are separated with div u and curl u at R (docs/physics.md §4.1: R are
 // displacement-amplitude ratios): central differences of the solver's probe sampling of the
 // velocity at R +- h, integrated over the steps from the exact initial values. (Taken on the
 // velocity instead, the ratios are the same for a plane wave, but numerical short-wave content

@@ -4,7 +4,7 @@
 
 Reads OUTDIR/metrics.json (written by the `oblique` program) and, when present,
 OUTDIR/metrics_mpm.json (`oblique --method mpm`), adds the closed-form curves
-(REFERENCE.md §4.1, a = b = 1) and writes OUTDIR/reflection_vs_angle.png.
+(docs/physics.md §4.1, a = b = 1) and writes OUTDIR/reflection_vs_angle.png.
 """
 import cmath
 import json
@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 
 
 def lk(nu, angle, a=1.0, b=1.0):
-    """|R_PP|, |R_PS|, |R_SS|, |R_SP| of REFERENCE.md §4.1 (same formulas as lk_reflection)."""
+    """|R_PP|, |R_PS|, |R_SS|, |R_SP| of docs/physics.md §4.1 (same formulas as lk_reflection)."""
     k = math.sqrt((1 - 2 * nu) / (2 * (1 - nu)))
     out = []
     # incident P at `angle`

@@ -1,5 +1,5 @@
 #pragma once
-// Output files of a run (the contract in DESIGN.md):
+// Output files of a run:
 //   DIR/history.csv    first column `time`, then `<probe>.<field>` and `energy.<term>` columns
 //   DIR/summary.json   steps, dt, t_end, wall_seconds, particles, particle_updates_per_second,
 //                      energy {kinetic, elastic, dissipated, absorbed, external_work, ...}
@@ -30,7 +30,9 @@ class HistoryWriter {
 
 // Particle snapshots: one HDF5 file with a group per snapshot ("/step_000123") holding datasets
 // of length N (double unless noted): x, y (as a N x 3 "xyz" dataset for XDMF), vx, vy, sxx, syy,
-// szz, sxy, J2, eps_p, mass, volume, body (int32). The XDMF sidecar (temporal collection of
+// szz, sxy, J2, eps_p, mass, volume, body (int32), id (uint32), and the film model's state
+// (int32: 0 elastic, 1 plastic, 2 decohesion, 3 separated), normal_x, normal_y, jump_n, jump_t,
+// ubar. The XDMF sidecar (temporal collection of
 // Polyvertex grids) is rewritten after every snapshot so a partial run still opens.
 class SnapshotWriter {
  public:

@@ -28,7 +28,7 @@
 //    its gradient is the better resolved one; in particular where a small body sits on a larger
 //    one, the larger body's face stays flat under the small body's corners. The symmetric
 //    alternative, the difference g_1 - g_2, tilts the normal at such corners and the contact then
-//    "ploughs": a block sliding frictionless on a base (tests/test_contact.cpp) received 7 % less
+//    "ploughs": a block sliding frictionless on a base (tests/physics/test_contact.cpp) received 7 % less
 //    than its tangential impulse with it, 0.1 % with the heavier-body normal. Where the heavier
 //    body's gradient is weak (shorter than 1/4 of |g_h - g_others|: a node inside body h) the
 //    difference is used. Where a velocity component is held by a constraint, that component of

@@ -91,7 +91,8 @@ inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
       const double mk = M[k], mvx = mk * VX[k], mvy = mk * VY[k];
       if constexpr ((WHAT & kContact) != 0) {
         sf.grow_box(*box);
-        const double sv = std::sqrt(V[k]);
+        // sqrt(V_p) per node, not hoisted: hoisted, the compiler fuses the gradient sums into
+        // FMAs differently and multi-field histories move at 1e-16 from earlier versions'.
         for (int a = 0; a < Shape::kNodes; ++a) {
           f.m[nodes[a]] += mk * sf.N[a];
           f.px[nodes[a]] += mvx * sf.N[a];
@@ -100,7 +101,7 @@ inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
           f.gy[nodes[a]] += mk * sf.dNy[a];
           f.xm[nodes[a]] += mk * sf.N[a] * X[k];
           f.ym[nodes[a]] += mk * sf.N[a] * Y[k];
-          f.sm[nodes[a]] += mk * sf.N[a] * sv;
+          f.sm[nodes[a]] += mk * sf.N[a] * std::sqrt(V[k]);
         }
       } else {
         for (int a = 0; a < Shape::kNodes; ++a) {
