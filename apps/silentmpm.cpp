@@ -95,8 +95,9 @@ int main(int argc, char** argv) {
       std::printf("  particles %zu, grid %d x %d cells of %g m, dt %g s (CFL %.3f), %ld steps\n",
                   s.p.size(), s.grid.nx, s.grid.ny, s.grid.h, s.dt, s.dt / s.critical_dt(),
                   static_cast<long>(std::ceil(c.t_end / s.dt - 1e-9)));
-      std::printf("  scheme %s, flip %g; %zu traction(s), %zu silent layer(s), %zu constraint(s), "
-                  "%zu probe(s)\n", smpm::scheme_name(s.opt.scheme), s.opt.flip, s.tractions.size(),
+      std::printf("  scheme %s, shape %s, flip %g; %zu traction(s), %zu silent layer(s), "
+                  "%zu constraint(s), %zu probe(s)\n", smpm::scheme_name(s.opt.scheme),
+                  smpm::shape_name(s.opt.shape), s.opt.flip, s.tractions.size(),
                   s.silents.size(), s.constraints.size(), c.probes.size());
       for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
       return 0;

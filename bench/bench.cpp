@@ -2,7 +2,9 @@
 // MUSL, 1 particle per cell), refined to about 1e5 and 1e6 particles, on one thread and on all
 // threads, with a free and with a silent right boundary; and bytes per particle.
 //
-//   build/bench [--quick]      (--quick: only the 1e5 size, fewer steps)
+//   build/bench [--quick] [--shape bilinear|gimp|bspline|all]
+//     --quick: only the 1e5 size, fewer steps; --shape: the grid shape functions (default
+//     bilinear; all: the three, alternating per size and thread count)
 #include <omp.h>
 
 #include <chrono>
@@ -10,6 +12,8 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "silentmpm/solver.hpp"
 
@@ -17,7 +21,8 @@ using namespace smpm;
 
 namespace {
 
-std::unique_ptr<Solver> pulse_plate(double h, bool silent, int threads) {
+std::unique_ptr<Solver> pulse_plate(double h, bool silent, int threads,
+                                    ShapeKind shape = ShapeKind::Bilinear) {
   auto s = std::make_unique<Solver>();
   Material w;
   w.name = "tungsten"; w.model = Model::Elastic; w.E = 411e9; w.nu = 0.28; w.rho = 15000;
@@ -39,13 +44,14 @@ std::unique_ptr<Solver> pulse_plate(double h, bool silent, int threads) {
     s->silents.push_back(sb);
   }
   s->opt.threads = threads;
+  s->opt.shape = shape;
   s->dt = 0.237 * h / w.cd;
   s->finalize();
   return s;
 }
 
-double rate(double h, bool silent, int threads, int steps) {
-  auto s = pulse_plate(h, silent, threads);
+double rate(double h, bool silent, int threads, int steps, ShapeKind shape) {
+  auto s = pulse_plate(h, silent, threads, shape);
   for (int i = 0; i < 3; ++i) s->step();  // warm-up
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < steps; ++i) s->step();
@@ -56,11 +62,33 @@ double rate(double h, bool silent, int threads, int steps) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  bool quick = false;
+  std::vector<ShapeKind> shapes = {ShapeKind::Bilinear};
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0) {
+      quick = true;
+    } else if (std::strcmp(argv[i], "--shape") == 0 && i + 1 < argc) {
+      const std::string v = argv[++i];
+      if (v == "bilinear") shapes = {ShapeKind::Bilinear};
+      else if (v == "gimp") shapes = {ShapeKind::UGimp};
+      else if (v == "bspline") shapes = {ShapeKind::BSpline2};
+      else if (v == "all") shapes = {ShapeKind::Bilinear, ShapeKind::UGimp, ShapeKind::BSpline2};
+      else {
+        std::fprintf(stderr, "bench: --shape: must be bilinear, gimp, bspline or all, got \"%s\"\n",
+                     v.c_str());
+        return 1;
+      }
+    } else {
+      std::fprintf(stderr, "bench: unknown argument \"%s\"; usage: bench [--quick] "
+                           "[--shape bilinear|gimp|bspline|all]\n", argv[i]);
+      return 1;
+    }
+  }
   const int all = omp_get_max_threads();
   std::printf("silentmpm bench: pulse plate 50 x 200 mm, tungsten, elastic, MUSL, 1 ppc\n");
   std::printf("bytes per particle (particle arrays): %zu\n", Particles::bytes_per_particle());
-  std::printf("%10s %9s %8s %8s %14s\n", "particles", "boundary", "threads", "steps", "updates/s");
+  std::printf("%10s %9s %8s %8s %14s %9s\n", "particles", "boundary", "threads", "steps",
+              "updates/s", "shape");
   for (double h : {1e-4 * std::sqrt(10.0), 1e-4}) {
     if (quick && h < 2e-4) continue;
     auto probe = pulse_plate(h, false, 1);
@@ -71,11 +99,13 @@ int main(int argc, char** argv) {
     probe.reset();
     const int steps = quick ? 20 : (n > 500000 ? 30 : 200);
     for (int th : {1, all}) {
-      for (bool silent : {false, true}) {
-        const double r = rate(h, silent, th, steps);
-        std::printf("%10zu %9s %8d %8d %14.3e\n", n, silent ? "silent" : "free", th, steps, r);
-        std::fflush(stdout);
-      }
+      for (bool silent : {false, true})
+        for (ShapeKind shape : shapes) {
+          const double r = rate(h, silent, th, steps, shape);
+          std::printf("%10zu %9s %8d %8d %14.3e %9s\n", n, silent ? "silent" : "free", th, steps, r,
+                      shape_name(shape));
+          std::fflush(stdout);
+        }
       if (all == 1) break;
     }
   }

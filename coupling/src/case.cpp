@@ -809,9 +809,15 @@ class Builder {
   }
 
   void parse_scheme(Obj s) {
-    s.allow({"update", "flip", "threads"});
+    s.allow({"update", "flip", "threads", "shape"});
     const std::string u = s.choice("update", {"USF", "USL", "MUSL"}, "MUSL");
     s_->opt.scheme = u == "USF" ? Scheme::USF : u == "USL" ? Scheme::USL : Scheme::MUSL;
+    const std::string sh = s.choice("shape", {"bilinear", "gimp", "bspline"}, "bilinear");
+    s_->opt.shape = sh == "gimp" ? ShapeKind::UGimp
+                    : sh == "bspline" ? ShapeKind::BSpline2 : ShapeKind::Bilinear;
+    if (s_->opt.shape != ShapeKind::Bilinear && (grid_.nx < 2 || grid_.ny < 2))
+      s.fail("shape", "\"" + sh + "\" needs a grid of at least 2 x 2 cells, got " +
+                          std::to_string(grid_.nx) + " x " + std::to_string(grid_.ny));
     s_->opt.flip = s.num("flip", 1.0);
     s.ge("flip", s_->opt.flip, 0);
     s.le("flip", s_->opt.flip, 1);

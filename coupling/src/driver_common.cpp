@@ -139,6 +139,7 @@ nlohmann::ordered_json fem_json(const fem::Solver& s) {
 
 void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {
   j["scheme"] = scheme_name(s.opt.scheme);
+  j["shape"] = shape_name(s.opt.shape);
   j["flip"] = s.opt.flip;
   j["grid"] = {{"origin", {s.grid.x0, s.grid.y0}}, {"cells", {s.grid.nx, s.grid.ny}}, {"cell", s.grid.h}};
 }

@@ -41,6 +41,10 @@ bool inside_quad(const double* qx, const double* qy, double x, double y, double 
 Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   const Grid& g = mpm_.grid;
   const double h = g.h, tol = 1e-6 * h;
+  if (mpm_.opt.shape != ShapeKind::Bilinear)
+    throw HybridError(std::string("hybrid: the MPM region must use scheme.shape \"bilinear\" (its "
+                                  "grid shares nodes with Q1 elements), got \"") +
+                      shape_name(mpm_.opt.shape) + "\"");
   if (fe_.degree() != 1)
     throw HybridError("hybrid: the FEM region must use fem.degree 1 (Q1, like the MPM grid), got " +
                       std::to_string(fe_.degree()));

@@ -24,6 +24,15 @@ const char* scheme_name(Scheme s) {
   return "?";
 }
 
+const char* shape_name(ShapeKind s) {
+  switch (s) {
+    case ShapeKind::Bilinear: return "bilinear";
+    case ShapeKind::UGimp: return "gimp";
+    case ShapeKind::BSpline2: return "bspline";
+  }
+  return "?";
+}
+
 const char* model_name(Model m) {
   switch (m) {
     case Model::Elastic: return "elastic";
@@ -117,6 +126,8 @@ void Solver::finalize() {
   nthreads_ = opt.threads > 0 ? opt.threads : omp_get_max_threads();
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
   nstrips_ = 2 * nthreads_;
+  stencil_rows_ = opt.shape == ShapeKind::Bilinear ? Bilinear::kRowsBelow + Bilinear::kRowsAbove
+                                                   : BSpline2::kRowsBelow + BSpline2::kRowsAbove;
   double mmin = std::numeric_limits<double>::infinity();
   for (double m : p.mass) mmin = std::min(mmin, m);
   mass_floor_ = p.size() ? opt.mass_tolerance * mmin : 0.0;
@@ -204,14 +215,16 @@ void Solver::refresh_strip_rows() {
 }
 
 // Two strips of one colour must not write a common node row: a strip touching cell rows
-// [lo, hi] writes node rows [lo, hi + 1].
+// [lo, hi] writes node rows [lo - below, hi + above] (bilinear: [lo, hi + 1]; 3 x 3 shapes:
+// [lo - 1, hi + 2]), so two strips conflict when they are less than below + above rows apart.
 bool Solver::strips_conflict() const {
   if (nthreads_ == 1) return false;
+  const int d = stencil_rows_;
   for (int a = 0; a < nstrips_; ++a) {
     if (strip_lo_[a] > strip_hi_[a]) continue;
     for (int b = a + 2; b < nstrips_; b += 2) {
       if (strip_lo_[b] > strip_hi_[b]) continue;
-      if (strip_lo_[a] <= strip_hi_[b] + 1 && strip_lo_[b] <= strip_hi_[a] + 1) return true;
+      if (strip_lo_[a] <= strip_hi_[b] + d && strip_lo_[b] <= strip_hi_[a] + d) return true;
     }
   }
   return false;
@@ -225,6 +238,10 @@ void Solver::attach(StepHooks* h) { hooks_.push_back(h); }
 
 void Solver::detach(StepHooks* h) {
   hooks_.erase(std::remove(hooks_.begin(), hooks_.end(), h), hooks_.end());
+}
+
+double Solver::inv_rho(int g) const {
+  return g < static_cast<int>(materials.size()) ? 1.0 / materials[g].rho : 0.0;
 }
 
 template <class Fn>
@@ -326,6 +343,7 @@ void Solver::reset_grid() {
 // p2g over every field. A body's field clears its arrays over last step's box first and finds
 // its new box; with body fields the grid's arrays (cleared by reset_grid) then receive their sum,
 // the centre-of-mass field.
+template <class S>
 void Solver::p2g(unsigned what) {
   const bool momentum = (what & kMomentum) != 0, force = (what & kForce) != 0;
   const long nnx = grid.nnx;
@@ -342,8 +360,9 @@ void Solver::p2g(unsigned what) {
     }
     auto run = [&](auto what_c) {
       constexpr unsigned W = decltype(what_c)::value;
-      scatter(F.ranges, [&](uint32_t b, uint32_t e, int, int s) {
-        kernels::p2g<Bilinear, W>(grid, p, b, e, f, (W & kContact) ? &sbox[s] : nullptr);
+      scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
+        kernels::p2g<S, W>(grid, p, b, e, f, inv_rho(g),
+                           (W & kContact) ? &sbox[s] : nullptr);
       });
     };
     using std::integral_constant;
@@ -384,18 +403,41 @@ void Solver::remapped_velocities() {
                             mass_floor_, nthreads_);
 }
 
-// Shape functions of boundary particle q of layer L at its anchor point; fills nodes[4].
-void Solver::layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, Bilinear& sf,
-                         long nodes[4]) const {
+// Shape functions of boundary particle q of layer L at its anchor point; fills nodes[].
+template <class S>
+void Solver::layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, S& sf,
+                         long* nodes) const {
   const uint32_t k = L.idx[q];
   double x = p.x[k], y = p.y[k];
   if (anchor == Anchor::Boundary) {
     x += L.d[q] * L.nx[q];
     y += L.d[q] * L.ny[q];
   }
-  sf.eval_clamped(x, y, grid.x0, grid.y0, grid.inv_h, grid.nx, grid.ny);
-  const long n0 = static_cast<long>(sf.cj) * grid.nnx + sf.ci;
-  nodes[0] = n0; nodes[1] = n0 + 1; nodes[2] = n0 + grid.nnx + 1; nodes[3] = n0 + grid.nnx;
+  if constexpr (S::kSized) sf.size(p.mass[k], 1.0 / materials[p.group[k]].rho, grid.inv_h);
+  sf.eval_clamped(grid, x, y);
+  sf.node_indices(grid.nnx, nodes);
+}
+template void Solver::layer_shape<Bilinear>(const BoundaryLayer&, std::size_t, Anchor, Bilinear&,
+                                            long*) const;
+
+// The weights a load of boundary particle q puts on the nodes. With the 3 x 3 shapes the support
+// of a point on the body's edge reaches a node row outside the body (the quadratic B-spline
+// gives it 1/8 at a node-aligned edge, uGIMP lp/(4h)); that node has no mass, its share of a
+// traction or dashpot would never act (a silent end that loses 1/8 of its impedance reflects
+// 6.7 % of the amplitude). Such shares go to the particle's other nodes in proportion to their
+// weights, so the load still sums to t w_q and acts where the body is. Bilinear weights on a
+// void node are zero already and are left as they are.
+template <class S>
+void Solver::load_weights(const BoundaryLayer& L, std::size_t q, Anchor anchor, S& sf,
+                          long* nodes) const {
+  layer_shape(L, q, anchor, sf, nodes);
+  if constexpr (S::kNodes > 4) {
+    double kept = 0, lost = 0;
+    for (int a = 0; a < S::kNodes; ++a)
+      (grid.m[nodes[a]] > mass_floor_ ? kept : lost) += sf.N[a];
+    if (lost == 0 || kept <= 0) return;
+    for (int a = 0; a < S::kNodes; ++a) sf.N[a] = grid.m[nodes[a]] > mass_floor_ ? sf.N[a] / kept : 0.0;
+  }
 }
 
 // Traction vector of load tl on particle q of its layer at the current time.
@@ -416,17 +458,18 @@ static inline void dashpot_of(const SilentBoundary& sl, std::size_t q, double ux
 }
 
 // Tractions and silent-layer dashpots carried by boundary particles (Eq. 16, 20, 21).
+template <class S>
 void Solver::apply_loads() {
-  Bilinear sf;
-  long nodes[4];
+  S sf;
+  long nodes[S::kNodes];
   for (const auto& tl : tractions) {
     const double f = tl.fn(t);
     if (f == 0.0) continue;
     for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
       double tx, ty;
       traction_of(tl, q, f, tx, ty);
-      layer_shape(tl.layer, q, tl.anchor, sf, nodes);
-      for (int a = 0; a < 4; ++a) {
+      load_weights(tl.layer, q, tl.anchor, sf, nodes);
+      for (int a = 0; a < S::kNodes; ++a) {
         grid.fx[nodes[a]] += tx * tl.layer.w[q] * sf.N[a];
         grid.fy[nodes[a]] += ty * tl.layer.w[q] * sf.N[a];
       }
@@ -440,11 +483,11 @@ void Solver::apply_loads() {
   for (const auto& sl : silents) {
     const auto& L = sl.layer;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
-      layer_shape(L, q, sl.anchor, sf, nodes);
+      load_weights(L, q, sl.anchor, sf, nodes);
       if (sl.form == SilentForm::Particle) {  // lagged: the particle velocity of the last step
         double tx, ty;
         dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
-        for (int a = 0; a < 4; ++a) {
+        for (int a = 0; a < S::kNodes; ++a) {
           grid.fx[nodes[a]] += tx * L.w[q] * sf.N[a];
           grid.fy[nodes[a]] += ty * L.w[q] * sf.N[a];
         }
@@ -455,7 +498,7 @@ void Solver::apply_loads() {
       const double bxx = zn * nx * nx + zt * (1 - nx * nx);
       const double bxy = (zn - zt) * nx * ny;
       const double byy = zn * ny * ny + zt * (1 - ny * ny);
-      for (int a = 0; a < 4; ++a) {
+      for (int a = 0; a < S::kNodes; ++a) {
         const double wn = L.w[q] * sf.N[a];
         grid.cxx[nodes[a]] += wn * bxx;
         grid.cxy[nodes[a]] += wn * bxy;
@@ -505,9 +548,10 @@ void Solver::grid_update() {
 // v+ = v + dt f / m is large while the particles it touches receive a bounded impulse, and
 // f (v + v+)/2 would count a spurious f^2 dt / (2 m) of work (film, 0.05 um cells, boundary
 // anchor: external work x13 and a -93 % imbalance; with w, < 0.1 %).
+template <class S>
 void Solver::boundary_work(bool remapped) {
-  Bilinear sf;
-  long nodes[4];
+  S sf;
+  long nodes[S::kNodes];
   const std::vector<double>& ux = remapped ? grid.qx : grid.vnx;
   const std::vector<double>& uy = remapped ? grid.qy : grid.vny;
   auto vbar = [&](long i, double& ax, double& ay) {  // the forces' velocity
@@ -524,8 +568,8 @@ void Solver::boundary_work(bool remapped) {
     for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
       double tx, ty, ax, ay;
       traction_of(tl, q, f, tx, ty);
-      layer_shape(tl.layer, q, tl.anchor, sf, nodes);
-      for (int a = 0; a < 4; ++a) {
+      load_weights(tl.layer, q, tl.anchor, sf, nodes);
+      for (int a = 0; a < S::kNodes; ++a) {
         wbar(nodes[a], ax, ay);
         energy.external_work += dt * tl.layer.w[q] * sf.N[a] * (tx * ax + ty * ay);
       }
@@ -534,8 +578,8 @@ void Solver::boundary_work(bool remapped) {
   for (const auto& sl : silents) {
     const auto& L = sl.layer;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
-      layer_shape(L, q, sl.anchor, sf, nodes);
-      for (int a = 0; a < 4; ++a) {
+      load_weights(L, q, sl.anchor, sf, nodes);
+      for (int a = 0; a < S::kNodes; ++a) {
         double ax, ay, tx, ty, bx, by;
         vbar(nodes[a], ax, ay);
         wbar(nodes[a], bx, by);
@@ -562,6 +606,7 @@ void Solver::merge_rows(int s, const RowSpan& r) {
 
 // Particle velocities from every field (FLIP/PIC blend); MUSL re-maps the particle momenta to
 // the field at the same positions; USF moves the particles here.
+template <class S>
 void Solver::g2p(bool remap, bool move) {
   if (move) begin_moving_pass();
   const double flip = opt.flip, DT = dt;
@@ -570,11 +615,12 @@ void Solver::g2p(bool remap, bool move) {
     if (remap && F.body >= 0) kernels::for_box(F.box, grid.nnx, nthreads_, [&](long i) {
       f.qx[i] = 0; f.qy[i] = 0;
     });
-    auto body = [&](uint32_t b, uint32_t e, int, int s) {
+    auto body = [&](uint32_t b, uint32_t e, int g, int s) {
       RowSpan r;
-      if (remap) kernels::g2p<Bilinear, true, false>(grid, p, b, e, f, flip, DT, r);
-      else if (move) kernels::g2p<Bilinear, false, true>(grid, p, b, e, f, flip, DT, r);
-      else kernels::g2p<Bilinear, false, false>(grid, p, b, e, f, flip, DT, r);
+      const double ir = inv_rho(g);
+      if (remap) kernels::g2p<S, true, false>(grid, p, b, e, f, ir, flip, DT, r);
+      else if (move) kernels::g2p<S, false, true>(grid, p, b, e, f, ir, flip, DT, r);
+      else kernels::g2p<S, false, false>(grid, p, b, e, f, ir, flip, DT, r);
       if (move) merge_rows(s, r);
     };
     if (remap) scatter(F.ranges, body);
@@ -585,6 +631,7 @@ void Solver::g2p(bool remap, bool move) {
 // Stress update of every field's particles from the field's start velocity (USF), its re-mapped
 // velocity (MUSL) or its updated velocity (USL); with move, positions advance with the updated
 // nodal velocity. The dissipation is booked field by field.
+template <class S>
 void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
   if (move) begin_moving_pass();
   for (VelocityField& F : fields_) {
@@ -598,10 +645,10 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
       const Material& mat = materials[g];
       auto run = [&](auto model_c) {
         constexpr Model M = decltype(model_c)::value;
-        return move ? kernels::update_stress<Bilinear, M, true>(grid, p, b, e, mat, gx, gy, f.vnx,
-                                                               f.vny, dt, r)
-                    : kernels::update_stress<Bilinear, M, false>(grid, p, b, e, mat, gx, gy,
-                                                                f.vnx, f.vny, dt, r);
+        return move ? kernels::update_stress<S, M, true>(grid, p, b, e, mat, gx, gy, f.vnx,
+                                                        f.vny, dt, r)
+                    : kernels::update_stress<S, M, false>(grid, p, b, e, mat, gx, gy, f.vnx,
+                                                         f.vny, dt, r);
       };
       double d = 0;
       switch (mat.model) {
@@ -639,39 +686,48 @@ void Solver::check_outside() {
 
 // The time step: see the sequence at the top of solver.hpp.
 void Solver::step() {
+  switch (opt.shape) {
+    case ShapeKind::Bilinear: return step_with<Bilinear>();
+    case ShapeKind::UGimp: return step_with<UGimp>();
+    case ShapeKind::BSpline2: return step_with<BSpline2>();
+  }
+}
+
+template <class S>
+void Solver::step_with() {
   if (!strips_ok_) sort_particles();
   if (body_of_group_.empty()) refresh_fields();  // the grid's arrays (pointers only)
   const Scheme sc = opt.scheme;
   reset_grid();
-  p2g(sc == Scheme::USF ? kMomentum : kMomentum | kForce);
+  p2g<S>(sc == Scheme::USF ? kMomentum : kMomentum | kForce);
   call([&](StepHooks& h) { h.after_momentum(*this); });
   if (sc == Scheme::USF) {
     start_velocities();
-    update_stress(false, true, false);
-    p2g(kForce);
+    update_stress<S>(false, true, false);
+    p2g<S>(kForce);
   }
-  apply_loads();
+  apply_loads<S>();
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
   bool remapped_power = sc == Scheme::MUSL;
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
-  if (!remapped_power) boundary_work(false);
+  if (!remapped_power) boundary_work<S>(false);
   call([&](StepHooks& h) { h.before_g2p(*this); });
   switch (sc) {
     case Scheme::MUSL:
-      g2p(true, false);
+      g2p<S>(true, false);
       call([&](StepHooks& h) { h.after_remap(*this); });
       remapped_velocities();
-      if (remapped_power) boundary_work(true);
-      update_stress(true, false, true);
+      if (remapped_power) boundary_work<S>(true);
+      update_stress<S>(true, false, true);
       break;
     case Scheme::USL:
-      g2p(false, false);
-      update_stress(false, false, true);
+      g2p<S>(false, false);
+      update_stress<S>(false, false, true);
       break;
     case Scheme::USF:
-      g2p(false, true);
+      g2p<S>(false, true);
       break;
   }
   t += dt;

@@ -2,7 +2,7 @@
 // extended-domain differencing (see oblique.hpp), written as OUT/metrics.json and the receiver
 // traces OUT/trace_<P|SV>_<angle>.csv.
 //
-//   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N]
+//   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N] [--shape bilinear|gimp|bspline]
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -17,7 +17,7 @@ using namespace smpm;
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
-                         "[--degree 1] [--threads N]\n");
+                         "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -46,6 +46,15 @@ int main(int argc, char** argv) {
       base.taper = std::atoi(argv[i + 1]);
     } else if (a == "--threads") {
       base.threads = std::atoi(argv[i + 1]);
+    } else if (a == "--shape") {
+      const std::string v = argv[i + 1];
+      if (v == "bilinear") base.shape = ShapeKind::Bilinear;
+      else if (v == "gimp") base.shape = ShapeKind::UGimp;
+      else if (v == "bspline") base.shape = ShapeKind::BSpline2;
+      else {
+        std::fprintf(stderr, "oblique: --shape must be bilinear, gimp or bspline\n");
+        return 1;
+      }
     } else {
       std::fprintf(stderr, "oblique: unknown option %s\n", a.c_str());
       return 1;
@@ -60,6 +69,7 @@ int main(int argc, char** argv) {
                             "differencing"
                       : std::string("MPM, 1 particle per cell, MUSL, nodal semi-implicit silent layer "
                                     "a = b = 1, CFL 0.3; extended-domain differencing (div u, curl u: the sampled velocity's div and curl integrated over the steps)");
+    if (method == "mpm") j["shape"] = shape_name(base.shape);
     j["nu"] = base.nu;
     j["pulse_fwhm_cells"] = base.fwhm;
     j["results"] = nlohmann::ordered_json::array();

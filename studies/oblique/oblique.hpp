@@ -30,6 +30,7 @@
 
 #include "silentmpm/geo_box.hpp"
 #include "silentmpm/fem.hpp"
+#include "silentmpm/shape.hpp"
 #include "silentmpm/lk_reflection.hpp"
 
 namespace smpm::oblique {
@@ -44,6 +45,7 @@ struct Setup {
   int threads = 0;
   int flat = 200;          // half width of the beam's flat top (cells)
   int taper = 60;          // cos^2 taper beyond it (cells)
+  smpm::ShapeKind shape = smpm::ShapeKind::Bilinear;  // MPM grid shape functions
 };
 
 struct Result {

@@ -36,6 +36,7 @@ inline Result measure_mpm(const Setup& su) {
       s->silents.push_back(sb);
     }
     s->opt.threads = su.threads;
+    s->opt.shape = su.shape;
     s->dt = dt;
     s->finalize();
     Particles& p = s->p;

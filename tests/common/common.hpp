@@ -32,6 +32,8 @@ struct ColumnSpec {
   double offset = 0;        // shift of the column start inside its first cell (partly filled cells)
   int threads = 1;
   Anchor anchor = Anchor::Boundary;
+  ShapeKind shape = ShapeKind::Bilinear;
+  int cells_beyond = 4;     // grid cells beyond the column's right end
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -39,7 +41,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
   auto s = std::make_unique<Solver>();
   s->materials.push_back(tungsten());
   const double L = c.cells * c.h;
-  s->grid.init(-2 * c.h, 0.0, c.h, c.cells + 6, c.height);
+  s->grid.init(-2 * c.h, 0.0, c.h, c.cells + 2 + c.cells_beyond, c.height);
   s->seed_rectangle(c.offset, 0, c.offset + L, c.height * c.h, c.ppc_side, 0, 0, 0, 0);
   const double top = c.height * c.h;
   const uint8_t mask = c.shear ? 1 : 2;
@@ -62,6 +64,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
     s->constraints.push_back({"right", s->nodes_in_box(xr - 1e-9, 0, xr + 1e-9, top), 3});
   }
   s->opt.scheme = c.scheme;
+  s->opt.shape = c.shape;
   s->opt.threads = c.threads;
   s->dt = c.cfl * c.h / s->materials[0].cd;
   s->finalize();

@@ -133,6 +133,8 @@ std::vector<Bad> bad_cases() {
        "boundaries[2].body: no body named \"plat\" (did you mean \"plate\"?)"},
       {"negative_threads", [](ojson& j) { j["scheme"]["threads"] = -2; },
        "scheme.threads: must be >= 0"},
+      {"unknown_shape", [](ojson& j) { j["scheme"]["shape"] = "bsplines"; },
+       "scheme.shape: must be one of \"bilinear\", \"gimp\", \"bspline\", got \"bsplines\""},
       {"override_missing_path", nullptr, "bodies[3]: does not exist", "",
        {"bodies.3.particles_per_cell=4"}},
       {"override_bad_value", nullptr,

@@ -126,6 +126,8 @@ struct ReflectCase {
   int ppc_side;
   double bound;  // reflected / incident <= bound (silent) or >= bound (free)
   const char* label;
+  ShapeKind shape = ShapeKind::Bilinear;
+  int cells_beyond = 4;  // grid cells beyond the silent end
 };
 
 class ColumnReflection : public ::testing::TestWithParam<ReflectCase> {};
@@ -139,6 +141,8 @@ TEST_P(ColumnReflection, ReflectedEnergy) {
   c.form = rc.form;
   c.anchor = rc.anchor;
   c.ppc_side = rc.ppc_side;
+  c.shape = rc.shape;
+  c.cells_beyond = rc.cells_beyond;
   const double ratio = reflected_energy_ratio(c, 8);
   std::printf("  [%s] reflected energy / incident = %.3e\n", rc.label, ratio);
   if (rc.end == End::Free) EXPECT_GE(ratio, rc.bound);
@@ -159,7 +163,24 @@ INSTANTIATE_TEST_SUITE_P(
         ReflectCase{false, End::Silent, SilentForm::Particle, Anchor::Particle, 1, 3e-3, "P paper form"},
         ReflectCase{true, End::Silent, SilentForm::Particle, Anchor::Particle, 1, 3e-3, "S paper form"},
         ReflectCase{false, End::Free, SilentForm::Nodal, Anchor::Boundary, 1, 0.95, "P free end"},
-        ReflectCase{true, End::Free, SilentForm::Nodal, Anchor::Boundary, 1, 0.95, "S free end"}),
+        ReflectCase{true, End::Free, SilentForm::Nodal, Anchor::Boundary, 1, 0.95, "S free end"},
+        // The wider shapes (docs/physics.md section 8) with the default silent layer, the column
+        // ending 4 cells inside the grid (measured: B-spline P 4.9e-3 / 4.7e-3 at 1 / 4 ppc,
+        // S 1.2e-3; uGIMP P 9.4e-4 / 3.8e-4 at 4 / 9 ppc, S 2.1e-4) and on the grid's edge, where
+        // the folded basis interpolates (B-spline P 1.8e-3 / 1.3e-3, uGIMP P 3.1e-4 at 4 ppc);
+        // the paper's form with B-splines 1.5e-3.
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 1, 6e-3, "P bspline 1ppc", ShapeKind::BSpline2},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 2, 6e-3, "P bspline 4ppc", ShapeKind::BSpline2},
+        ReflectCase{true, End::Silent, SilentForm::Nodal, Anchor::Boundary, 1, 1.6e-3, "S bspline 1ppc", ShapeKind::BSpline2},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 2, 1.2e-3, "P gimp 4ppc", ShapeKind::UGimp},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 3, 5e-4, "P gimp 9ppc", ShapeKind::UGimp},
+        ReflectCase{true, End::Silent, SilentForm::Nodal, Anchor::Boundary, 2, 3e-4, "S gimp 4ppc", ShapeKind::UGimp},
+        ReflectCase{false, End::Free, SilentForm::Nodal, Anchor::Boundary, 1, 0.95, "P bspline free end", ShapeKind::BSpline2},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 1, 2.3e-3, "P bspline 1ppc edge", ShapeKind::BSpline2, 0},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 2, 1.7e-3, "P bspline 4ppc edge", ShapeKind::BSpline2, 0},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 2, 4e-4, "P gimp 4ppc edge", ShapeKind::UGimp, 0},
+        ReflectCase{false, End::Silent, SilentForm::Nodal, Anchor::Boundary, 1, 1.2e-3, "P bilinear 1ppc edge", ShapeKind::Bilinear, 0},
+        ReflectCase{false, End::Silent, SilentForm::Particle, Anchor::Particle, 1, 2e-3, "P bspline paper form", ShapeKind::BSpline2}),
     [](const auto& info) {
       std::string s = info.param.label;
       for (char& ch : s) if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';

@@ -73,10 +73,11 @@ namespace kernels {
 
 // Particle to grid over [b, e) (paper Eq. 15, 18): mass and momentum, and/or the internal force.
 // With kContact the node box the particles touch is grown in `box`.
+// inv_rho: 1 / density of the range's material (shapes that need the particle size).
 template <class Shape, unsigned WHAT>
 inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
-                NodeBox* box = nullptr) {
-  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h;
+                double inv_rho, NodeBox* box = nullptr) {
+  const double ih = g.inv_h;
   const long nnx = g.nnx;
   const double* X = p.x.data(); const double* Y = p.y.data();
   const double* VX = p.vx.data(); const double* VY = p.vy.data();
@@ -85,7 +86,8 @@ inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
   Shape sf;
   long nodes[Shape::kNodes];
   for (uint32_t k = b; k < e; ++k) {
-    sf.eval(X[k], Y[k], x0, y0, ih);
+    if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
+    sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
     if constexpr ((WHAT & kMomentum) != 0) {
       const double mk = M[k], mvx = mk * VX[k], mvy = mk * VY[k];
@@ -126,7 +128,7 @@ inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
 // particle momenta into (qx, qy). MOVE: USF's position update with the updated nodal velocity.
 template <class Shape, bool REMAP, bool MOVE>
 inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const NodalField& f,
-                double flip, double dt, RowSpan& rows) {
+                double inv_rho, double flip, double dt, RowSpan& rows) {
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
   const long nnx = g.nnx;
   const double pic = 1.0 - flip;
@@ -138,7 +140,8 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   Shape sf;
   long nodes[Shape::kNodes];
   for (uint32_t k = b; k < e; ++k) {
-    sf.eval(X[k], Y[k], x0, y0, ih);
+    if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
+    sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
     double dvx = 0, dvy = 0, wx = 0, wy = 0;
     for (int a = 0; a < Shape::kNodes; ++a) {
@@ -180,11 +183,14 @@ inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
   double* SXX = p.sxx.data(); double* SYY = p.syy.data();
   double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
   double* EP = p.eps_p.data();
+  [[maybe_unused]] const double* M = p.mass.data();
+  [[maybe_unused]] const double inv_rho = 1.0 / mat.rho;
   double diss = 0;
   Shape sf;
   long nodes[Shape::kNodes];
   for (uint32_t k = b; k < e; ++k) {
-    sf.eval(X[k], Y[k], x0, y0, ih);
+    if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
+    sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
     double lxx = 0, lxy = 0, lyx = 0, lyy = 0, wx = 0, wy = 0;
     for (int a = 0; a < Shape::kNodes; ++a) {

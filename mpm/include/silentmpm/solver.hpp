@@ -44,6 +44,7 @@ const char* scheme_name(Scheme s);
 
 struct SolverOptions {
   Scheme scheme = Scheme::MUSL;
+  ShapeKind shape = ShapeKind::Bilinear;  // grid shape functions of every kernel (shape.hpp)
   double flip = 1.0;          // 1 = FLIP, 0 = PIC
   double mass_tolerance = 1e-12;  // nodes lighter than this fraction of the smallest particle mass are void
   int threads = 0;            // 0 = OpenMP default
@@ -119,9 +120,10 @@ class Solver {
   double mass_floor() const { return mass_floor_; }
   // Cell rows the particles occupied after the last step that moved them (lo > hi: none).
   void occupied_rows(long& lo, long& hi) const;
-  // Shape functions of boundary particle q of layer L at its anchor point; fills nodes[4].
-  void layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, Bilinear& sf,
-                   long nodes[4]) const;
+  // Shape functions (S: Bilinear, UGimp, BSpline2) of boundary particle q of layer L at its
+  // anchor point; fills nodes[S::kNodes].
+  template <class S>
+  void layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, S& sf, long* nodes) const;
   // Check every particle is inside the grid; returns the index of the first outside, or -1.
   long first_particle_outside() const;
 
@@ -129,6 +131,7 @@ class Solver {
   int nthreads_ = 1;
   int nstrips_ = 2;
   bool strips_ok_ = false;
+  int stencil_rows_ = 1;  // a particle in cell row r writes node rows [r - b, r + stencil_rows_ - b]
   bool has_nodal_dashpot_ = false;
   std::vector<long> dashpot_nodes_;  // nodes holding a dashpot block this step
   double mass_floor_ = 0;
@@ -149,14 +152,19 @@ class Solver {
   template <class Fn> void scatter(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void call(Fn&& fn);
-  void p2g(unsigned what);
+  double inv_rho(int group) const;  // 1 / density of a group's material (0 if none)
+  // The step and its stages, on the shape S of opt.shape.
+  template <class S> void step_with();
+  template <class S>
+  void load_weights(const BoundaryLayer& L, std::size_t q, Anchor anchor, S& sf, long* nodes) const;
+  template <class S> void p2g(unsigned what);
   void start_velocities();
-  void apply_loads();
+  template <class S> void apply_loads();
   void grid_update();
-  void boundary_work(bool remapped);
-  void g2p(bool remap, bool move);
+  template <class S> void boundary_work(bool remapped);
+  template <class S> void g2p(bool remap, bool move);
   void remapped_velocities();
-  void update_stress(bool remapped_field, bool start_field, bool move);
+  template <class S> void update_stress(bool remapped_field, bool start_field, bool move);
   void begin_moving_pass();
   void merge_rows(int strip, const RowSpan& r);
   void check_outside();
