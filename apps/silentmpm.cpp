@@ -1,5 +1,6 @@
 // silentmpm: command-line entry point. A thin shell over the driver.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <fstream>
@@ -29,6 +30,9 @@ int main(int argc, char** argv) {
   run->add_option("--set", overrides, "Override a case key, e.g. --set grid.cell=0.002 "
                                       "(repeatable; value parsed as JSON)");
   run->add_option("--threads", threads, "OpenMP threads (default: the case's scheme.threads)");
+  std::string shape;
+  run->add_option("--shape", shape, "Grid shape functions: bilinear, gimp or bspline (default: "
+                                    "the case's scheme.shape)");
   run->add_flag("--quiet,-q", quiet, "No progress line");
 
   auto* check = app.add_subcommand("check", "Validate a case file without running it and "
@@ -56,20 +60,25 @@ int main(int argc, char** argv) {
     }
     // The command line's own settings: a section the case leaves out is created with the key
     // (overrides given with --set must name existing sections, so typos are caught).
+    std::vector<std::string> cli;  // in order; prepended to the --set overrides below
+    std::vector<std::string> made;  // sections the command line creates
     auto setting = [&](const std::string& section, const std::string& key, const std::string& value) {
-      bool has = false;
+      bool has = std::find(made.begin(), made.end(), section) != made.end();
       try {
         std::ifstream in(case_path);
         const auto doc = nlohmann::json::parse(in, nullptr, false, true);
-        has = doc.is_object() && doc.contains(section);
+        has = has || (doc.is_object() && doc.contains(section));
       } catch (const std::exception&) {
         // unreadable or malformed: load_case reports it
       }
-      overrides.insert(overrides.begin(), has ? section + "." + key + "=" + value
-                                              : section + "={\"" + key + "\":" + value + "}");
+      cli.push_back(has ? section + "." + key + "=" + value
+                        : section + "={\"" + key + "\":" + value + "}");
+      made.push_back(section);
     };
     if (*run && threads >= 0) setting("scheme", "threads", std::to_string(threads));
+    if (*run && !shape.empty()) setting("scheme", "shape", nlohmann::json(shape).dump());
     if (*run && quiet) setting("output", "progress", "false");
+    overrides.insert(overrides.begin(), cli.begin(), cli.end());
     smpm::Case c = smpm::load_case(case_path, overrides);
     if (!c.solver && c.fem) {  // FEM-only case
       const smpm::fem::Solver& f = *c.fem;

@@ -2,6 +2,7 @@
 // through load_case() and through the CLI (`silentmpm check`); the valid case through the CLI.
 // Valid cases through load_case() are in tests/unit/test_case_load.cpp.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -236,6 +237,22 @@ TEST(CaseCliValid, RunThreadsWithoutSchemeOrOutputSection) {
   const std::string summary = read_file(out / "summary.json");
   EXPECT_NE(summary.find("\"threads\": 1"), std::string::npos) << summary;
   EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  // --shape together with --threads on the same missing section: both are set.
+  const fs::path out2 = scratch() / "no_scheme_cli_shape_out";
+  const CliResult r2 = run_cli("run \"" + file.string() + "\" --out \"" + out2.string() +
+                                   "\" --threads 1 --shape bspline --quiet",
+                               "no_scheme_shape");
+  ASSERT_EQ(r2.status, 0) << "stderr:\n" << r2.err;
+  const std::string summary2 = read_file(out2 / "summary.json");
+  EXPECT_NE(summary2.find("\"threads\": 1"), std::string::npos) << summary2;
+  EXPECT_NE(summary2.find("\"shape\": \"bspline\""), std::string::npos) << summary2;
+  // A wrong shape is one error naming the key.
+  const CliResult r3 = run_cli("run \"" + file.string() + "\" --out \"" + out2.string() +
+                                   "\" --shape quadratic --quiet",
+                               "no_scheme_bad_shape");
+  EXPECT_EQ(WEXITSTATUS(r3.status), 1);
+  EXPECT_NE(r3.err.find("scheme.shape: must be one of \"bilinear\", \"gimp\", \"bspline\""),
+            std::string::npos) << r3.err;
 }
 
 }  // namespace
