@@ -1,6 +1,6 @@
 #pragma once
-// Internal: the pieces the three run drivers (driver.cpp: MPM, driver_fem.cpp: FEM,
-// driver_hybrid.cpp: MPM + FEM) share — output folder, history.csv columns and energy terms,
+// Internal: the pieces the run loop (driver.cpp) and its three regions (region_mpm.cpp,
+// region_fem.cpp, region_hybrid.cpp) share — output folder, history.csv columns and energy terms,
 // probe fields, the progress line, and the blocks and writing of summary.json.
 #include <chrono>
 #include <cmath>
@@ -51,7 +51,7 @@ class Progress {
 };
 
 // summary.json blocks. The head: "title", "case", "steps", "dt", "t_end", "cfl", "wall_seconds",
-// "step_seconds" (each driver adds its own keys after these).
+// "step_seconds" (each region adds its own keys after these).
 nlohmann::ordered_json summary_head(const Case& c, const RunResult& r, double dt, double t_end,
                                     double cfl, double step_seconds);
 nlohmann::ordered_json energy_json(const Energies& e);       // "energy"

@@ -1,11 +1,10 @@
 #pragma once
-// Internal: the FEM side of case files (case_fem.cpp) and of the run driver (driver_fem.cpp),
-// and the section parsers case.cpp shares with them.
+// Internal: the FEM and hybrid sides of case files (case_fem.cpp, case_hybrid.cpp) and the
+// section parsers case.cpp shares with them.
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "silentmpm/case.hpp"
-#include "silentmpm/driver.hpp"
 
 namespace smpm::detail {
 
@@ -18,12 +17,8 @@ TimeFunction parse_time_function_at(const std::string& source, const nlohmann::o
 // Defined in case_fem.cpp: builds a case whose top level has "fem" (an FEM region).
 Case build_fem_case(const std::string& source, const nlohmann::ordered_json& doc);
 
-// Defined in driver_fem.cpp: runs a case that has an FEM region and no MPM bodies.
-RunResult run_fem_case(Case& c, const std::string& out_dir);
-
-// Hybrid cases (both "bodies" and "fem"): case_hybrid.cpp and driver_hybrid.cpp.
+// Hybrid cases (both "bodies" and "fem"): case_hybrid.cpp.
 Case build_mpm_case(const std::string& source, const nlohmann::ordered_json& doc);  // case.cpp
 Case build_hybrid_case(const std::string& source, const nlohmann::ordered_json& doc);
-RunResult run_hybrid_case(Case& c, const std::string& out_dir);
 
 }  // namespace smpm::detail

@@ -1,0 +1,75 @@
+// The FEM region of the run loop (a case with an FEM region and no MPM bodies): probes sampled
+// from the FE field, HDF5 + XDMF snapshots through deal.II's DataOut (fem_NNNNN.h5 + fem.xdmf).
+#include <algorithm>
+#include <filesystem>
+#include <stdexcept>
+
+#include "driver_common.hpp"
+#include "run_loop.hpp"
+
+namespace smpm::detail {
+
+namespace {
+
+class FemRegion final : public Region {
+ public:
+  explicit FemRegion(Case& c) : c_(c), s_(*c.fem) {}
+
+  double dt() const override { return s_.dt; }
+  double time() const override { return s_.t; }
+  double cfl() const override { return s_.dt / s_.critical_dt(); }
+  bool progress_eta() const override { return false; }
+  void prepare(const std::string& out_dir) override {
+    std::error_code ec;
+    std::filesystem::remove(std::filesystem::path(out_dir) / "fem.xdmf", ec);
+  }
+
+  void step() override { s_.step(); }
+
+  void record(std::vector<double>& row) override {
+    const auto samples = s_.sample();
+    s_.update_energies();
+    std::size_t k = 0;
+    for (std::size_t q = 0; q < c_.probes.size(); ++q)
+      for (const auto& f : c_.probes[q].fields) row[k++] = probe_field(samples[q], f);
+    put_energies(s_.energy, row, k);
+    if (!energies_finite(s_.energy))
+      throw std::runtime_error("the FEM run diverged at step " + std::to_string(s_.steps) +
+                               ": energy is not finite");
+  }
+
+  void open_snapshots(const std::string&) override {}
+  void write_snapshot(const std::string& out_dir) override { s_.write_snapshot(out_dir, "fem"); }
+  void finish() override { s_.update_energies(); }
+
+  void rates(RunResult& r, double step_seconds) const override {
+    r.dofs = s_.dofs();
+    r.dof_updates_per_second =
+        static_cast<double>(s_.dofs()) * r.steps / std::max(step_seconds, 1e-12);
+  }
+
+  void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const override {
+    j["particles"] = 0;
+    j["particle_updates_per_second"] = 0;
+    j["dofs"] = r.dofs;
+    j["dof_updates_per_second"] = r.dof_updates_per_second;
+    j["threads"] = s_.thread_count();
+    j["fem"] = fem_json(s_);
+    j["energy"] = energy_json(s_.energy);
+    j["model"] = c_.notes;
+    j["outputs"] = {{"history", "history.csv"},
+                    {"probes", "probes.csv"},
+                    {"snapshots", s_.snapshot_count()},
+                    {"xdmf", snapshots ? "fem.xdmf" : ""}};
+  }
+
+ private:
+  Case& c_;
+  fem::Solver& s_;
+};
+
+}  // namespace
+
+std::unique_ptr<Region> fem_region(Case& c) { return std::make_unique<FemRegion>(c); }
+
+}  // namespace smpm::detail

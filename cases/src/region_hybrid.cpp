@@ -1,0 +1,118 @@
+// The hybrid region of the run loop (MPM + FEM coupled): each probe read from the region holding
+// its point, the energy terms of both regions summed, particle snapshots (particles.h5/.xdmf) and
+// FEM snapshots (fem_NNNNN.h5 + fem.xdmf), both regions' blocks in summary.json.
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <stdexcept>
+
+#include "driver_common.hpp"
+#include "run_loop.hpp"
+#include "silentmpm/output.hpp"
+
+namespace smpm::detail {
+
+namespace {
+
+class HybridRegion final : public Region {
+ public:
+  explicit HybridRegion(Case& c) : c_(c), hy_(*c.hybrid), s_(*c.solver), fe_(*c.fem) {
+    for (const auto& pr : c.probes) {
+      if (pr.fem_index < 0) {
+        pts_.push_back({pr.x, pr.y});
+        bodies_.push_back(pr.body);
+      }
+    }
+  }
+
+  double dt() const override { return hy_.dt(); }
+  double time() const override { return s_.t; }
+  double cfl() const override { return hy_.dt() / hy_.critical_dt(); }
+  bool progress_eta() const override { return false; }
+  void prepare(const std::string& out_dir) override {
+    std::error_code ec;
+    std::filesystem::remove(std::filesystem::path(out_dir) / "fem.xdmf", ec);
+  }
+
+  void step() override { hy_.step(); }
+
+  void record(std::vector<double>& row) override {
+    const auto ms = s_.sample(pts_, bodies_);
+    const auto fs = fe_.sample();
+    hy_.update_energies();
+    std::size_t k = 0, q_mpm = 0;
+    for (const auto& pr : c_.probes) {
+      if (pr.fem_index < 0) {
+        const ProbeSample& sm = ms[q_mpm++];
+        for (const auto& f : pr.fields) row[k++] = probe_field(sm, f);
+      } else {
+        for (const auto& f : pr.fields) row[k++] = probe_field(fs[pr.fem_index], f);
+      }
+    }
+    put_energies(hy_.energy, row, k);
+    if (!energies_finite(hy_.energy))
+      throw std::runtime_error("the hybrid run diverged at step " + std::to_string(s_.steps) +
+                               " (t = " + std::to_string(s_.t) + " s): energy is not finite");
+  }
+
+  void open_snapshots(const std::string& out_dir) override { snap_.open(out_dir, "particles"); }
+  void write_snapshot(const std::string& out_dir) override {
+    snap_.write(s_.p, s_.steps, s_.t);
+    fe_.write_snapshot(out_dir, "fem");
+  }
+  void finish() override {
+    snap_.close();
+    hy_.update_energies();
+  }
+
+  void rates(RunResult& r, double step_seconds) const override {
+    r.particle_updates_per_second =
+        static_cast<double>(s_.p.size()) * r.steps / std::max(step_seconds, 1e-12);
+    r.dofs = fe_.dofs();
+    r.dof_updates_per_second =
+        static_cast<double>(fe_.dofs()) * r.steps / std::max(step_seconds, 1e-12);
+  }
+
+  void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const override {
+    j["particles"] = s_.p.size();
+    j["particle_updates_per_second"] = r.particle_updates_per_second;
+    j["dofs"] = r.dofs;
+    j["dof_updates_per_second"] = r.dof_updates_per_second;
+    j["threads"] = s_.thread_count();
+    put_mpm_scheme(j, s_);
+    j["fem"] = fem_json(fe_);
+    j["hybrid"] = {{"shared_nodes", hy_.shared().size()},
+                   {"interface_nodes", hy_.interface_nodes()}};
+    j["energy"] = energy_json(hy_.energy);
+    j["energy_mpm"] = energy_json(s_.energy);
+    j["energy_fem"] = energy_json(fe_.energy);
+    j["energy_regions_note"] = "energy_mpm and energy_fem hold each region's own terms; their "
+                               "imbalances are the energy that crossed the MPM-FEM interface and "
+                               "sum to the total imbalance in energy";
+    j["silent_boundaries"] = silents_json(s_);
+    j["loads"] = c_.notes;
+    j["bodies"] = bodies_json(c_, s_);
+    j["curve_probes"] = curve_probes_json(c_.probes);
+    j["outputs"] = {{"history", "history.csv"},
+                    {"probes", "probes.csv"},
+                    {"snapshots", snapshots ? snap_.count() : 0},
+                    {"xdmf", snapshots ? "particles.xdmf" : ""},
+                    {"fem_snapshots", fe_.snapshot_count()},
+                    {"fem_xdmf", snapshots ? "fem.xdmf" : ""}};
+  }
+
+ private:
+  Case& c_;
+  Hybrid& hy_;
+  Solver& s_;
+  fem::Solver& fe_;
+  std::vector<std::array<double, 2>> pts_;
+  std::vector<int> bodies_;
+  SnapshotWriter snap_;
+};
+
+}  // namespace
+
+std::unique_ptr<Region> hybrid_region(Case& c) { return std::make_unique<HybridRegion>(c); }
+
+}  // namespace smpm::detail

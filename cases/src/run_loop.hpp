@@ -1,0 +1,50 @@
+#pragma once
+// Internal: the run loop of every case (driver.cpp) and the regions it steps. A region is what a
+// case advances in time: the MPM bodies (region_mpm.cpp), the FEM far field (region_fem.cpp) or
+// both coupled (region_hybrid.cpp). The loop owns the output folder, history.csv, probes.csv, the
+// step loop with its progress line and summary.json; a region samples its probes and energies,
+// writes its own snapshots and adds its blocks to summary.json.
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "silentmpm/case.hpp"
+#include "silentmpm/driver.hpp"
+
+namespace smpm::detail {
+
+class Region {
+ public:
+  virtual ~Region() = default;
+
+  virtual double dt() const = 0;
+  virtual double time() const = 0;  // the time of a history row
+  // dt over the region's stability limit (summary.json "cfl").
+  virtual double cfl() const = 0;
+  // The progress line's form (Progress: eta).
+  virtual bool progress_eta() const = 0;
+  // Called once the output folder exists (removes stale files of the region's own outputs).
+  virtual void prepare(const std::string& /*out_dir*/) {}
+
+  virtual void step() = 0;
+  // One history row: the probe columns in the order of Case::probes, then the energy terms.
+  // Throws std::runtime_error when the energy is not finite (the run diverged).
+  virtual void record(std::vector<double>& row) = 0;
+  // Snapshots (only when the case asks for them): opened before the first one is written.
+  virtual void open_snapshots(const std::string& out_dir) = 0;
+  virtual void write_snapshot(const std::string& out_dir) = 0;
+  // After the last step: closes the snapshots and brings the energies up to date.
+  virtual void finish() = 0;
+
+  // RunResult's rates from the time spent in step().
+  virtual void rates(RunResult& r, double step_seconds) const = 0;
+  // summary.json after the common head; `snapshots`: whether the run wrote snapshots.
+  virtual void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const = 0;
+};
+
+std::unique_ptr<Region> mpm_region(Case& c);     // region_mpm.cpp
+std::unique_ptr<Region> fem_region(Case& c);     // region_fem.cpp
+std::unique_ptr<Region> hybrid_region(Case& c);  // region_hybrid.cpp
+
+}  // namespace smpm::detail
