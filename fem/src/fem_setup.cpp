@@ -28,6 +28,7 @@
 #include <sstream>
 
 #include "fem_impl.hpp"
+#include "silentmpm/dashpot.hpp"
 
 namespace smpm::fem {
 
@@ -383,9 +384,11 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
               if (fe.system_to_component_index(i).first != 0) continue;
               if (std::fabs(fl.shape_value(i, q) - 1.0) > 1e-8) continue;
               auto& c = cblocks[static_cast<std::uint32_t>(ld[i] / 2)];
-              c[0] += ca * n[0] * n[0] + cb * (1 - n[0] * n[0]);
-              c[1] += (ca - cb) * n[0] * n[1];
-              c[2] += ca * n[1] * n[1] + cb * (1 - n[1] * n[1]);
+              double bxx, bxy, byy;
+              lk_block(ca, cb, n[0], n[1], bxx, bxy, byy);
+              c[0] += bxx;
+              c[1] += bxy;
+              c[2] += byy;
             }
           }
         }

@@ -13,17 +13,28 @@ void apply(std::vector<T>& v, const std::vector<uint32_t>& perm) {
 
 void Particles::resize(std::size_t n) {
   for (auto* v : {&x, &y, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p}) v->resize(n, 0.0);
-  for (auto* v : {&dnx, &dny, &dL, &dtnf, &dttf, &jump_n, &jump_t, &ubar}) v->resize(n, 0.0);
-  state.resize(n, 0);
+  if (film_) {
+    for (auto* v : {&dnx, &dny, &dL, &dtnf, &dttf, &jump_n, &jump_t, &ubar}) v->resize(n, 0.0);
+    state.resize(n, 0);
+  }
   id.resize(n, 0);
   body.resize(n, 0);
   group.resize(n, 0);
 }
 
+void Particles::enable_film() {
+  film_ = true;
+  const std::size_t n = size();
+  for (auto* v : {&dnx, &dny, &dL, &dtnf, &dttf, &jump_n, &jump_t, &ubar}) v->resize(n, 0.0);
+  state.resize(n, 0);
+}
+
 void Particles::permute(const std::vector<uint32_t>& perm) {
   for (auto* v : {&x, &y, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p}) apply(*v, perm);
-  for (auto* v : {&dnx, &dny, &dL, &dtnf, &dttf, &jump_n, &jump_t, &ubar}) apply(*v, perm);
-  apply(state, perm);
+  if (film_) {
+    for (auto* v : {&dnx, &dny, &dL, &dtnf, &dttf, &jump_n, &jump_t, &ubar}) apply(*v, perm);
+    apply(state, perm);
+  }
   apply(id, perm);
   apply(body, perm);
   apply(group, perm);

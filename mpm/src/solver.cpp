@@ -125,6 +125,8 @@ long Solver::first_particle_outside() const {
 void Solver::finalize() {
   nthreads_ = opt.threads > 0 ? opt.threads : omp_get_max_threads();
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
+  for (const Material& m : materials)
+    if (m.model == Model::J2Film && !p.has_film()) p.enable_film();
   nstrips_ = 2 * nthreads_;
   stencil_rows_ = opt.shape == ShapeKind::Bilinear ? Bilinear::kRowsBelow + Bilinear::kRowsAbove
                                                    : BSpline2::kRowsBelow + BSpline2::kRowsAbove;
@@ -494,10 +496,8 @@ void Solver::apply_loads() {
         continue;
       }
       has_nodal_dashpot_ = true;
-      const double nx = L.nx[q], ny = L.ny[q], zn = sl.zn[q], zt = sl.zt[q];
-      const double bxx = zn * nx * nx + zt * (1 - nx * nx);
-      const double bxy = (zn - zt) * nx * ny;
-      const double byy = zn * ny * ny + zt * (1 - ny * ny);
+      double bxx, bxy, byy;
+      lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], bxx, bxy, byy);
       for (int a = 0; a < S::kNodes; ++a) {
         const double wn = L.w[q] * sf.N[a];
         grid.cxx[nodes[a]] += wn * bxx;

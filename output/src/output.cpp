@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -213,10 +214,10 @@ void SnapshotWriter::write(const Particles& p, long step, double time) {
                                  p.sxy.size(), p.eps_p.size(), p.id.size(), p.body.size(),
                                  p.state.size(), p.dnx.size(), p.dny.size(), p.jump_n.size(),
                                  p.jump_t.size(), p.ubar.size()};
-    for (std::size_t s : sizes)
-      if (s != n)
+    for (std::size_t k = 0; k < std::size(sizes); ++k)
+      if (sizes[k] != n && !(k >= 12 && !p.has_film()))  // the film block may be off
         throw std::runtime_error("SnapshotWriter: particle arrays have inconsistent sizes (" +
-                                 std::to_string(s) + " vs " + std::to_string(n) + ")");
+                                 std::to_string(sizes[k]) + " vs " + std::to_string(n) + ")");
   }
 
   const std::string gname = step_name(step);
@@ -274,11 +275,16 @@ void SnapshotWriter::write(const Particles& p, long step, double time) {
     write_dataset(group.id, "state", H5T_STD_I32LE, H5T_NATIVE_INT32, state.data(), n, 1, path,
                   gname);
   }
-  dbl("normal_x", p.dnx.data());
-  dbl("normal_y", p.dny.data());
-  dbl("jump_n", p.jump_n.data());
-  dbl("jump_t", p.jump_t.data());
-  dbl("ubar", p.ubar.data());
+  // The film block: zeros when no material of the run has one (same datasets in every file).
+  const std::vector<double> zeros(p.has_film() ? 0 : n, 0.0);
+  auto film = [&](const char* name, const std::vector<double>& v) {
+    dbl(name, p.has_film() ? v.data() : zeros.data());
+  };
+  film("normal_x", p.dnx);
+  film("normal_y", p.dny);
+  film("jump_n", p.jump_n);
+  film("jump_t", p.jump_t);
+  film("ubar", p.ubar);
 
   if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
 

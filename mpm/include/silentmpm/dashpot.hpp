@@ -8,6 +8,16 @@
 
 namespace smpm {
 
+// The Lysmer-Kuhlemeyer dashpot block per unit boundary length, B = zn n n^T + zt (I - n n^T)
+// (zn = a rho c_d, zt = b rho c_s; docs/physics.md section 1), for the unit normal (nx, ny). The
+// MPM silent layer and the FE dashpot boundary both assemble it.
+inline void lk_block(double zn, double zt, double nx, double ny, double& bxx, double& bxy,
+                     double& byy) {
+  bxx = zn * nx * nx + zt * (1 - nx * nx);
+  bxy = (zn - zt) * nx * ny;
+  byy = zn * ny * ny + zt * (1 - ny * ny);
+}
+
 inline void dashpot_velocity(double m, double cxx, double cxy, double cyy, double vx, double vy,
                              double fx, double fy, double dt, std::uint8_t mask, double& ax,
                              double& ay) {

@@ -1,5 +1,7 @@
 #pragma once
 // Particle data as structure of arrays: one contiguous array per field, no per-particle objects.
+// The history of a material model lives in its own block of arrays, sized only when a material
+// of the run uses that model: an elastic or von Mises run carries no film arrays.
 #include <cstdint>
 #include <vector>
 
@@ -13,6 +15,7 @@ struct Particles {
   std::vector<double> sxx, syy, szz, sxy;  // Cauchy stress
   std::vector<double> eps_p;         // accumulated equivalent plastic strain
   // Film model history (decohesion.hpp): state, plane normal, smear length, strengths, jump.
+  // Empty unless enable_film() was called (Solver::finalize does, for a j2_softening material).
   std::vector<uint8_t> state;        // ParticleState: elastic, plastic, decohesion, separated
   std::vector<double> dnx, dny;      // normal of the critical plane (0, 0 before bifurcation)
   std::vector<double> dL, dtnf, dttf;  // smear length, normal and tangential strengths
@@ -22,7 +25,11 @@ struct Particles {
   std::vector<uint16_t> group;       // material group index
 
   std::size_t size() const { return x.size(); }
+  // Resizes every array (the film block too when it is on); new entries are zero.
   void resize(std::size_t n);
+  // Turns the film block on (sized to the particles, zero: elastic, no plane, no jump).
+  void enable_film();
+  bool has_film() const { return film_; }
   // Set the seeding fields of particle k (its id is k; stresses and history stay as resize left
   // them, at zero).
   void place(std::size_t k, double px, double py, double volume, double density, double v_x,
@@ -39,9 +46,14 @@ struct Particles {
   }
   // Apply a permutation: new[k] = old[perm[k]].
   void permute(const std::vector<uint32_t>& perm);
+  // Bytes per particle of the arrays every run carries, and of the film block.
   static constexpr std::size_t bytes_per_particle() {
-    return 20 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t) + sizeof(uint8_t);
+    return 11 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t);
   }
+  static constexpr std::size_t film_bytes_per_particle() { return 8 * sizeof(double) + sizeof(uint8_t); }
+
+ private:
+  bool film_ = false;
 };
 
 }  // namespace smpm
