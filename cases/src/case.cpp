@@ -5,14 +5,16 @@
 // where the key path is written like materials.tungsten.poisson or boundaries[2].time.duration.
 //
 // Structure of this file:
-//   * Ctx / Obj     a small key walker: wraps one JSON object and its key path, gives typed
-//                   getters with defaults, rejects unknown keys, and checks every key was used.
+//   * Ctx / Obj     the key walker of every section (case_keys.hpp): wraps one JSON object and
+//                   its key path, gives typed getters with defaults, rejects unknown keys, and
+//                   checks every key was used.
 //   * parse_text    JSON text -> document (with line/column errors and duplicate-key detection).
 //   * overrides     "a.b.0.c=value" edits applied before validation.
 //   * build         the sections in dependency order: grid, time, scheme, output, materials,
 //                   bodies, probes, seeding, boundaries, finalize, time step.
 #include "silentmpm/case.hpp"
 #include "case_fem.hpp"
+#include "case_keys.hpp"
 #include "case_util.hpp"
 #include "silentmpm/geometry.hpp"
 
@@ -35,7 +37,7 @@
 namespace smpm {
 namespace {
 
-using ojson = nlohmann::ordered_json;
+using detail::ojson;
 
 // Largest grid (cells) and particle count a case may ask for; beyond these the allocation alone
 // would take tens of GB.
@@ -43,225 +45,24 @@ constexpr double kMaxCells = 2e8;
 constexpr double kMaxParticles = 2e8;
 
 using detail::a_type;
+using detail::as_integer;
+using detail::as_number;
+using detail::as_numbers;
+using detail::as_string;
+using detail::Ctx;
 using detail::fmt;
 using detail::fmt_down;
 using detail::index_path;
 using detail::join;
+using detail::Obj;
+using detail::quoted_list;
+using detail::suggestion;
 
 std::string fmt_list(const std::vector<double>& v) {
   std::string s = "[";
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + fmt(v[i]);
   return s + "]";
 }
-
-std::string quoted_list(const std::vector<std::string>& v) {
-  std::vector<std::string> q;
-  for (const auto& s : v) q.push_back("\"" + s + "\"");
-  return join(q);
-}
-
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                        std::tolower(static_cast<unsigned char>(b[j - 1]));
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (same ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
-
-// " (did you mean \"poisson\"?)" when a candidate is close to `word`, else "".
-std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
-  std::string best;
-  std::size_t best_d = std::max<std::size_t>(2, word.size() / 3) + 1;
-  for (const auto& c : candidates) {
-    const std::size_t d = edit_distance(word, c);
-    if (d < best_d) best_d = d, best = c;
-  }
-  return best.empty() ? "" : " (did you mean \"" + best + "\"?)";
-}
-
-bool starts_with(const std::string& s, const std::string& p) {
-  return s.size() >= p.size() && s.compare(0, p.size(), p) == 0;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Error context: the source name, and which key paths were set by command-line overrides (so a
-// bad value set by an override says so).
-struct Ctx {
-  std::string source;
-  std::vector<std::pair<std::string, std::string>> overridden;  // canonical path, override text
-
-  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-    std::string m = source + ": " + (path.empty() ? "" : path + ": ") + what;
-    for (const auto& [p, text] : overridden)
-      if (!path.empty() && (path == p || starts_with(path, p + ".") || starts_with(path, p + "["))) {
-        m += " (value set by override '" + text + "')";
-        break;
-      }
-    throw CaseError(m);
-  }
-};
-
-// Typed reading of one value at a known path.
-double as_number(const Ctx& ctx, const ojson& v, const std::string& path) {
-  if (!v.is_number()) ctx.fail(path, "expected a number, got " + a_type(v));
-  const double d = v.get<double>();
-  if (!std::isfinite(d)) ctx.fail(path, "expected a finite number");
-  return d;
-}
-
-long as_integer(const Ctx& ctx, const ojson& v, const std::string& path) {
-  if (v.is_number_integer()) {  // signed or unsigned
-    if (v.is_number_unsigned() && v.get<std::uint64_t>() > 1000000000000ULL)
-      ctx.fail(path, "integer too large");
-    return static_cast<long>(v.get<std::int64_t>());
-  }
-  if (v.is_number_float()) {  // 1e3 parses as a float; accept it when it is a whole number
-    const double d = v.get<double>();
-    if (std::isfinite(d) && d == std::floor(d) && std::fabs(d) <= 1e12) return static_cast<long>(d);
-    ctx.fail(path, "expected an integer, got " + fmt(d));
-  }
-  ctx.fail(path, "expected an integer, got " + a_type(v));
-}
-
-std::string as_string(const Ctx& ctx, const ojson& v, const std::string& path) {
-  if (!v.is_string()) ctx.fail(path, "expected a string, got " + a_type(v));
-  return v.get<std::string>();
-}
-
-std::vector<double> as_numbers(const Ctx& ctx, const ojson& v, const std::string& path,
-                               std::size_t n) {
-  const std::string want = "expected an array of " + std::to_string(n) + " numbers";
-  if (!v.is_array()) ctx.fail(path, want + ", got " + a_type(v));
-  if (v.size() != n)
-    ctx.fail(path, want + ", got an array of " + std::to_string(v.size()) + " element" +
-                       (v.size() == 1 ? "" : "s"));
-  std::vector<double> out;
-  for (std::size_t i = 0; i < n; ++i) out.push_back(as_number(ctx, v[i], index_path(path, i)));
-  return out;
-}
-
-// One JSON object at a key path. Reads are recorded; done() rejects any key that was not read,
-// and allow() rejects keys outside a list up front (before a misspelt key can show up as a
-// "missing required key" of its correct spelling).
-class Obj {
- public:
-  Obj(const Ctx& ctx, const ojson& j, std::string path)
-      : ctx_(&ctx), j_(&j), path_(std::move(path)) {
-    if (!j.is_object()) ctx.fail(path_, "expected an object, got " + a_type(j));
-  }
-
-  const std::string& path() const { return path_; }
-  std::string at(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-  const Ctx& ctx() const { return *ctx_; }
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    ctx_->fail(key.empty() ? path_ : at(key), what);
-  }
-  bool has(const std::string& key) const { return j_->contains(key); }
-
-  // Rejects every key not in `keys`. `where` qualifies the message ("for a fixed boundary").
-  void allow(const std::vector<std::string>& keys, const std::string& where = "") const {
-    for (const auto& item : j_->items()) {
-      if (std::find(keys.begin(), keys.end(), item.key()) != keys.end()) continue;
-      fail(item.key(), "unknown key" + (where.empty() ? "" : " " + where) +
-                           suggestion(item.key(), keys) + "; allowed: " + join(keys));
-    }
-  }
-  // Safety net: every key present must have been read by the parser.
-  void done() const {
-    std::vector<std::string> known(read_.begin(), read_.end());
-    for (const auto& item : j_->items())
-      if (!read_.count(item.key()))
-        fail(item.key(), "unknown key" + suggestion(item.key(), known));
-  }
-
-  const ojson* find(const std::string& key) {
-    read_.insert(key);
-    auto it = j_->find(key);
-    return it == j_->end() ? nullptr : &*it;
-  }
-  const ojson& need(const std::string& key) {
-    const ojson* v = find(key);
-    if (!v) fail(key, "missing required key");
-    return *v;
-  }
-
-  double num(const std::string& key) { return as_number(*ctx_, need(key), at(key)); }
-  double num(const std::string& key, double def) {
-    const ojson* v = find(key);
-    return v ? as_number(*ctx_, *v, at(key)) : def;
-  }
-  long integer(const std::string& key, long def) {
-    const ojson* v = find(key);
-    return v ? as_integer(*ctx_, *v, at(key)) : def;
-  }
-  std::string str(const std::string& key) { return as_string(*ctx_, need(key), at(key)); }
-  std::string str(const std::string& key, const std::string& def) {
-    const ojson* v = find(key);
-    return v ? as_string(*ctx_, *v, at(key)) : def;
-  }
-  bool boolean(const std::string& key, bool def) {
-    const ojson* v = find(key);
-    if (!v) return def;
-    if (!v->is_boolean()) fail(key, "expected true or false, got " + a_type(*v));
-    return v->get<bool>();
-  }
-  // A string from a fixed list; required when def is null.
-  std::string choice(const std::string& key, const std::vector<std::string>& options,
-                     const char* def = nullptr) {
-    const ojson* v = find(key);
-    if (!v) {
-      if (!def) fail(key, "missing required key (one of " + quoted_list(options) + ")");
-      return def;
-    }
-    const std::string s = as_string(*ctx_, *v, at(key));
-    if (std::find(options.begin(), options.end(), s) == options.end())
-      fail(key, "must be one of " + quoted_list(options) + ", got \"" + s + "\"" +
-                    suggestion(s, options));
-    return s;
-  }
-  std::vector<double> nums(const std::string& key, std::size_t n) {
-    return as_numbers(*ctx_, need(key), at(key), n);
-  }
-  std::vector<double> nums(const std::string& key, std::vector<double> def) {
-    const ojson* v = find(key);
-    return v ? as_numbers(*ctx_, *v, at(key), def.size()) : def;
-  }
-  Obj obj(const std::string& key) { return Obj(*ctx_, need(key), at(key)); }
-  const ojson& array(const std::string& key) {
-    const ojson& v = need(key);
-    if (!v.is_array()) fail(key, "expected an array, got " + a_type(v));
-    return v;
-  }
-
-  // Range checks on a value already read from `key`.
-  void gt(const std::string& key, double v, double lo) const {
-    if (!(v > lo)) fail(key, "must be > " + fmt(lo) + ", got " + fmt(v));
-  }
-  void ge(const std::string& key, double v, double lo) const {
-    if (!(v >= lo)) fail(key, "must be >= " + fmt(lo) + ", got " + fmt(v));
-  }
-  void lt(const std::string& key, double v, double hi) const {
-    if (!(v < hi)) fail(key, "must be < " + fmt(hi) + ", got " + fmt(v));
-  }
-  void le(const std::string& key, double v, double hi) const {
-    if (!(v <= hi)) fail(key, "must be <= " + fmt(hi) + ", got " + fmt(v));
-  }
-
- private:
-  const Ctx* ctx_;
-  const ojson* j_;
-  std::string path_;
-  std::set<std::string> read_;
-};
 
 // ---------------------------------------------------------------------------------------------
 // JSON text -> document. Errors carry line and column; a key given twice in one object is an
@@ -706,8 +507,8 @@ class Builder {
     // A case with an FEM region is built by case_fem.cpp.
     if (doc_.contains("fem"))
       return doc_.contains("bodies") || doc_.contains("grid")
-                 ? detail::build_hybrid_case(ctx_.source, doc_)  // case_hybrid.cpp
-                 : detail::build_fem_case(ctx_.source, doc_);
+                 ? detail::build_hybrid_case(ctx_, doc_)  // case_hybrid.cpp
+                 : detail::build_fem_case(ctx_, doc_);
     Obj top(ctx_, doc_, "");
     top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes", "geometry",
                "output", "contact"});
@@ -1307,7 +1108,7 @@ class Builder {
   }
 };
 
-Case build_ordered(Ctx& ctx, const ojson& doc) {
+Case build_ordered(const Ctx& ctx, const ojson& doc) {
   try {
     return Builder(ctx, doc).build();
   } catch (const CaseError&) {
@@ -1342,19 +1143,14 @@ Case build_case(const nlohmann::json& doc, const std::string& source) {
   return build_ordered(ctx, ordered);
 }
 
-// Shared with case_fem.cpp (the FEM sections use the same material and time-function keys).
+// Shared with case_fem.cpp and case_hybrid.cpp (the FEM sections use the same material and
+// time-function keys; a hybrid builds its MPM region with this parser).
 namespace detail {
-Case build_mpm_case(const std::string& source, const ojson& doc) {
-  Ctx ctx{source, {}};
-  return build_ordered(ctx, doc);
-}
-Material parse_material_at(const std::string& source, const std::string& name, const ojson& j) {
-  const Ctx ctx{source, {}};
+Case build_mpm_case(const Ctx& ctx, const ojson& doc) { return build_ordered(ctx, doc); }
+Material parse_material_at(const Ctx& ctx, const std::string& name, const ojson& j) {
   return parse_material(ctx, name, j);
 }
-TimeFunction parse_time_function_at(const std::string& source, const ojson& j,
-                                    const std::string& path) {
-  const Ctx ctx{source, {}};
+TimeFunction parse_time_function_at(const Ctx& ctx, const ojson& j, const std::string& path) {
   return parse_time_function(Obj(ctx, j, path));
 }
 }  // namespace detail

@@ -12,107 +12,14 @@
 #include <set>
 
 #include "case_fem.hpp"
+#include "case_keys.hpp"
 #include "case_util.hpp"
 
 namespace smpm::detail {
 namespace {
 
-using ojson = nlohmann::ordered_json;
 namespace fs = std::filesystem;
-
-// A small key walker (the FEM twin of case.cpp's): typed getters, unknown keys rejected.
-class Node {
- public:
-  Node(const std::string& source, const ojson& j, std::string path)
-      : src_(source), j_(j), path_(std::move(path)) {
-    if (!j.is_object()) fail("", "expected an object, got " + a_type(j));
-  }
-  std::string at(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
-  [[noreturn]] void fail(const std::string& k, const std::string& what) const {
-    const std::string p = k.empty() ? path_ : at(k);
-    throw CaseError(src_ + ": " + (p.empty() ? "" : p + ": ") + what);
-  }
-  void allow(const std::vector<std::string>& keys, const std::string& where = "") const {
-    for (const auto& it : j_.items())
-      if (std::find(keys.begin(), keys.end(), it.key()) == keys.end())
-        fail(it.key(), "unknown key" + (where.empty() ? "" : " " + where) + "; allowed: " + join(keys));
-  }
-  bool has(const std::string& k) const { return j_.contains(k); }
-  const ojson* find(const std::string& k) const {
-    auto it = j_.find(k);
-    return it == j_.end() ? nullptr : &*it;
-  }
-  const ojson& need(const std::string& k) const {
-    const ojson* v = find(k);
-    if (!v) fail(k, "missing required key");
-    return *v;
-  }
-  double num(const std::string& k) const {
-    const ojson& v = need(k);
-    if (!v.is_number()) fail(k, "expected a number, got " + a_type(v));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(k, "expected a finite number");
-    return d;
-  }
-  double num(const std::string& k, double def) const { return has(k) ? num(k) : def; }
-  long integer(const std::string& k, long def) const {
-    if (!has(k)) return def;
-    const ojson& v = need(k);
-    if (v.is_number_integer()) return static_cast<long>(v.get<std::int64_t>());
-    if (v.is_number_float() && v.get<double>() == std::floor(v.get<double>()) &&
-        std::fabs(v.get<double>()) < 1e12)
-      return static_cast<long>(v.get<double>());
-    fail(k, "expected an integer, got " + (v.is_number() ? fmt(v.get<double>()) : a_type(v)));
-  }
-  std::string str(const std::string& k) const {
-    const ojson& v = need(k);
-    if (!v.is_string()) fail(k, "expected a string, got " + a_type(v));
-    return v.get<std::string>();
-  }
-  bool boolean(const std::string& k, bool def) const {
-    if (!has(k)) return def;
-    const ojson& v = need(k);
-    if (!v.is_boolean()) fail(k, "expected true or false, got " + a_type(v));
-    return v.get<bool>();
-  }
-  std::string choice(const std::string& k, const std::vector<std::string>& opts,
-                     const char* def = nullptr) const {
-    if (!has(k)) {
-      if (!def) fail(k, "missing required key (one of " + join(opts) + ")");
-      return def;
-    }
-    const std::string s = str(k);
-    if (std::find(opts.begin(), opts.end(), s) == opts.end())
-      fail(k, "must be one of " + join(opts) + ", got \"" + s + "\"");
-    return s;
-  }
-  std::vector<double> nums(const std::string& k, std::size_t n) const {
-    const ojson& v = need(k);
-    if (!v.is_array() || v.size() != n)
-      fail(k, "expected an array of " + std::to_string(n) + " numbers, got " + a_type(v));
-    std::vector<double> out;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!v[i].is_number()) fail(k, "expected an array of " + std::to_string(n) + " numbers");
-      out.push_back(v[i].get<double>());
-    }
-    return out;
-  }
-  void gt(const std::string& k, double v, double lo) const {
-    if (!(v > lo)) fail(k, "must be > " + fmt(lo) + ", got " + fmt(v));
-  }
-  void ge(const std::string& k, double v, double lo) const {
-    if (!(v >= lo)) fail(k, "must be >= " + fmt(lo) + ", got " + fmt(v));
-  }
-  void le(const std::string& k, double v, double hi) const {
-    if (!(v <= hi)) fail(k, "must be <= " + fmt(hi) + ", got " + fmt(v));
-  }
-  const std::string& source() const { return src_; }
-
- private:
-  const std::string& src_;
-  const ojson& j_;
-  std::string path_;
-};
+constexpr Dialect kFem = Dialect::Fem;
 
 // Mesh paths are relative to the case file's folder (or the working directory when the case
 // does not come from a file).
@@ -132,24 +39,47 @@ std::vector<std::string> group_list(const std::vector<fem::PhysicalGroup>& gs) {
 }
 
 // A physical group given as a name or a tag (string or integer).
-int group_ref(const Node& o, const ojson& v, const std::string& path, const fem::Mesh& mesh,
+int group_ref(const Ctx& ctx, const ojson& v, const std::string& path, const fem::Mesh& mesh,
               bool surface) {
   std::string key;
   if (v.is_number_integer()) key = std::to_string(v.get<long>());
   else if (v.is_string()) key = v.get<std::string>();
-  else throw CaseError(o.source() + ": " + path + ": expected a group name or tag, got " + a_type(v));
+  else ctx.fail(path, "expected a group name or tag, got " + a_type(v));
   const int tag = surface ? mesh.surface_tag(key) : mesh.curve_tag(key);
   if (tag < 0)
-    throw CaseError(o.source() + ": " + path + ": no physical " + (surface ? "surface" : "curve") +
-                    " \"" + key + "\" in " + mesh.file + "; it has: " +
-                    join(group_list(surface ? mesh.surfaces : mesh.curves)));
+    ctx.fail(path, "no physical " + std::string(surface ? "surface" : "curve") + " \"" + key +
+                       "\" in " + mesh.file + "; it has: " +
+                       join(group_list(surface ? mesh.surfaces : mesh.curves)));
   return tag;
 }
 
+// Every field an FEM probe samples.
+const std::vector<std::string> kFemFields = {"sxx", "syy", "szz", "sxy", "J2",
+                                             "vx",  "vy",  "div", "curl"};
+
 }  // namespace
 
-Case build_fem_case(const std::string& source, const ojson& doc) {
-  Node top(source, doc, "");
+std::vector<std::string> fem_probe_fields(Obj& o, const std::vector<std::string>& absent) {
+  const ojson* fl = o.find("fields");
+  if (!fl) return absent;
+  if (!fl->is_array() || fl->empty()) o.fail("fields", "expected a non-empty array of field names");
+  std::vector<std::string> fields;
+  for (std::size_t k = 0; k < fl->size(); ++k) {
+    const std::string fp = index_path(o.at("fields"), k);
+    if (!(*fl)[k].is_string()) o.ctx().fail(fp, "expected a string");
+    const std::string name = (*fl)[k].get<std::string>();
+    if (std::find(kFemFields.begin(), kFemFields.end(), name) == kFemFields.end())
+      o.ctx().fail(fp, "must be one of " + join(kFemFields) + ", got \"" + name + "\"");
+    if (std::find(fields.begin(), fields.end(), name) != fields.end())
+      o.ctx().fail(fp, "field \"" + name + "\" listed twice");
+    fields.push_back(name);
+  }
+  return fields;
+}
+
+Case build_fem_case(const Ctx& ctx, const ojson& doc) {
+  const std::string& source = ctx.source;
+  Obj top(ctx, doc, "", kFem);
   if (top.has("bodies") || top.has("grid"))
     top.fail("fem", "a case with both an MPM region (grid, bodies) and an FEM region is not "
                     "supported yet (the coupled MPM-FEM hybrid); give either grid + bodies or fem");
@@ -162,7 +92,7 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
   if (top.has("title")) c.title = top.str("title");
 
   // time
-  Node t(source, top.need("time"), "time");
+  Obj t = top.obj("time");
   t.allow({"end", "dt", "cfl"});
   c.t_end = t.num("end");
   t.gt("end", c.t_end, 0);
@@ -182,7 +112,7 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
   // scheme: threads only
   int threads = 0;
   if (top.has("scheme")) {
-    Node s(source, top.need("scheme"), "scheme");
+    Obj s = top.obj("scheme");
     s.allow({"threads"}, "in an FEM case (update and flip are MPM settings)");
     const long th = s.integer("threads", 0);
     s.ge("threads", static_cast<double>(th), 0);
@@ -192,7 +122,7 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
 
   // output
   if (top.has("output")) {
-    Node o(source, top.need("output"), "output");
+    Obj o = top.obj("output");
     o.allow({"history_every", "snapshots", "progress"});
     c.output.history_every = o.integer("history_every", 1);
     o.ge("history_every", static_cast<double>(c.output.history_every), 1);
@@ -210,12 +140,12 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
   std::vector<Material> materials;
   std::vector<std::string> mat_names;
   for (const auto& it : mats.items()) {
-    materials.push_back(parse_material_at(source, it.key(), it.value()));
+    materials.push_back(parse_material_at(ctx, it.key(), it.value()));
     mat_names.push_back(it.key());
   }
 
   // fem
-  Node f(source, top.need("fem"), "fem");
+  Obj f = top.obj("fem");
   f.allow({"mesh", "size", "degree", "regions", "boundaries"});
   fem::Spec spec;
   spec.threads = threads;
@@ -243,20 +173,19 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
   std::set<std::string> used_mats;
   for (const auto& it : regs.items()) {
     const std::string path = f.at("regions") + "." + it.key();
-    const int tag = group_ref(f, ojson(it.key()), path, spec.mesh, true);
+    const int tag = group_ref(ctx, ojson(it.key()), path, spec.mesh, true);
     if (spec.region_material.count(tag))
-      throw CaseError(source + ": " + path + ": physical surface " + std::to_string(tag) + " given twice");
+      ctx.fail(path, "physical surface " + std::to_string(tag) + " given twice");
     if (!it.value().is_string())
-      throw CaseError(source + ": " + path + ": expected a material name, got " + a_type(it.value()));
+      ctx.fail(path, "expected a material name, got " + a_type(it.value()));
     const std::string mname = it.value().get<std::string>();
     auto mi = std::find(mat_names.begin(), mat_names.end(), mname);
     if (mi == mat_names.end())
-      throw CaseError(source + ": " + path + ": no material named \"" + mname + "\"; defined: " +
-                      join(mat_names));
+      ctx.fail(path, "no material named \"" + mname + "\"; defined: " + join(mat_names));
     const Material& m = materials[mi - mat_names.begin()];
     if (m.model != Model::Elastic)
-      throw CaseError(source + ": " + path + ": material \"" + mname + "\" has model \"" +
-                      model_name(m.model) + "\"; the FEM far-field is linear elastic (use \"elastic\")");
+      ctx.fail(path, "material \"" + mname + "\" has model \"" + model_name(m.model) +
+                         "\"; the FEM far-field is linear elastic (use \"elastic\")");
     spec.region_material[tag] = static_cast<int>(mi - mat_names.begin());
   }
   for (const auto& g : spec.mesh.surfaces)
@@ -271,7 +200,7 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
     if (!b->is_array()) f.fail("boundaries", "expected an array, got " + a_type(*b));
     for (std::size_t i = 0; i < b->size(); ++i) {
       const std::string path = index_path(f.at("boundaries"), i);
-      Node o(source, (*b)[i], path);
+      Obj o(ctx, (*b)[i], path, kFem);
       const std::string type = o.choice("type", {"dashpot", "traction", "fixed", "roller"});
       const std::string where = "for a " + type + " boundary";
       if (type == "dashpot") o.allow({"type", "name", "curve", "a", "b"}, where);
@@ -285,9 +214,9 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
       if (cv.is_array()) {
         if (cv.empty()) o.fail("curve", "must name at least one physical curve");
         for (std::size_t k = 0; k < cv.size(); ++k)
-          bc.curves.push_back(group_ref(o, cv[k], index_path(o.at("curve"), k), spec.mesh, false));
+          bc.curves.push_back(group_ref(ctx, cv[k], index_path(o.at("curve"), k), spec.mesh, false));
       } else {
-        bc.curves.push_back(group_ref(o, cv, o.at("curve"), spec.mesh, false));
+        bc.curves.push_back(group_ref(ctx, cv, o.at("curve"), spec.mesh, false));
       }
       if (type == "dashpot") {
         bc.kind = fem::Boundary::Kind::Dashpot;
@@ -315,7 +244,7 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
           bc.vx = v[0];
           bc.vy = v[1];
         }
-        if (const ojson* tf = o.find("time")) bc.fn = parse_time_function_at(source, *tf, o.at("time"));
+        if (const ojson* tf = o.find("time")) bc.fn = parse_time_function_at(ctx, *tf, o.at("time"));
       } else if (type == "fixed") {
         bc.kind = fem::Boundary::Kind::Fixed;
       } else {
@@ -348,10 +277,8 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
   // probes
   if (const ojson* p = top.find("probes")) {
     if (!p->is_array()) top.fail("probes", "expected an array, got " + a_type(*p));
-    static const std::vector<std::string> all = {"sxx", "syy", "szz", "sxy", "J2",
-                                                 "vx",  "vy",  "div", "curl"};
     for (std::size_t i = 0; i < p->size(); ++i) {
-      Node o(source, (*p)[i], index_path("probes", i));
+      Obj o(ctx, (*p)[i], index_path("probes", i), kFem);
       o.allow({"name", "at", "fields"});
       ProbeSpec pr;
       pr.name = o.str("name");
@@ -369,22 +296,7 @@ Case build_fem_case(const std::string& source, const ojson& doc) {
                          "] x [" + fmt(bb[1]) + ", " + fmt(bb[3]) + "]): (" + fmt(pr.x) + ", " +
                          fmt(pr.y) + ")");
       }
-      if (const ojson* fl = o.find("fields")) {
-        if (!fl->is_array() || fl->empty())
-          o.fail("fields", "expected a non-empty array of field names");
-        for (std::size_t k = 0; k < fl->size(); ++k) {
-          const std::string fp = index_path(o.at("fields"), k);
-          if (!(*fl)[k].is_string()) throw CaseError(source + ": " + fp + ": expected a string");
-          const std::string name = (*fl)[k].get<std::string>();
-          if (std::find(all.begin(), all.end(), name) == all.end())
-            throw CaseError(source + ": " + fp + ": must be one of " + join(all) + ", got \"" + name + "\"");
-          if (std::find(pr.fields.begin(), pr.fields.end(), name) != pr.fields.end())
-            throw CaseError(source + ": " + fp + ": field \"" + name + "\" listed twice");
-          pr.fields.push_back(name);
-        }
-      } else {
-        pr.fields = all;
-      }
+      pr.fields = fem_probe_fields(o, kFemFields);
       c.probes.push_back(std::move(pr));
     }
   }

@@ -8,35 +8,45 @@
 #include <regex>
 
 #include "case_fem.hpp"
+#include "case_keys.hpp"
 #include "case_util.hpp"
 
 namespace smpm::detail {
 namespace {
 
-using ojson = nlohmann::ordered_json;
-
-[[noreturn]] void fail(const std::string& source, const std::string& path, const std::string& what) {
-  throw CaseError(source + ": " + (path.empty() ? "" : path + ": ") + what);
-}
-
 std::string probe_path(std::size_t i) { return "probes[" + std::to_string(i) + "]"; }
+
+// The error context of the MPM region's document, whose probes are the document's MPM probes
+// renumbered (doc_index[k]: the document index of MPM probe k): an override of a probe names it
+// by its index in the MPM document, one of an FEM probe is dropped.
+Ctx mpm_context(const Ctx& ctx, const std::vector<std::size_t>& doc_index) {
+  Ctx m{ctx.source, {}};
+  for (const auto& [path, text] : ctx.overridden) {
+    if (path.rfind("probes[", 0) != 0) {
+      m.overridden.emplace_back(path, text);
+      continue;
+    }
+    const std::size_t close = path.find(']');
+    const std::size_t i = std::stoul(path.substr(7, close - 7));
+    const auto k = std::find(doc_index.begin(), doc_index.end(), i);
+    if (k != doc_index.end())
+      m.overridden.emplace_back(probe_path(k - doc_index.begin()) + path.substr(close + 1), text);
+  }
+  return m;
+}
 
 }  // namespace
 
-Case build_hybrid_case(const std::string& source, const ojson& doc) {
+Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
   static const std::vector<std::string> allowed = {"title",  "grid",       "time",   "scheme",
                                                    "materials", "bodies",  "boundaries", "probes",
                                                    "geometry", "output",   "contact", "fem"};
-  for (const auto& it : doc.items())
-    if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
-      std::string list;
-      for (const auto& k : allowed) list += (list.empty() ? "" : ", ") + k;
-      fail(source, it.key(), "unknown key in a hybrid (MPM + FEM) case; allowed: " + list);
-    }
+  const Obj top(ctx, doc, "", Dialect::Fem);
+  top.allow(allowed, "in a hybrid (MPM + FEM) case");
   for (const char* k : {"grid", "bodies", "time", "materials", "fem"})
-    if (!doc.contains(k))
-      fail(source, k, "missing required key (a case with both \"bodies\" and \"fem\" is an MPM-FEM "
-                      "hybrid and needs grid, bodies, time, materials and fem)");
+    if (!top.has(k))
+      top.fail(k, "missing required key (a case with both \"bodies\" and \"fem\" is an MPM-FEM "
+                  "hybrid and needs grid, bodies, time, materials and fem)");
 
   // FEM region: the FEM parser on the FEM keys (no probes yet).
   ojson dfe = ojson::object();
@@ -53,19 +63,19 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
   }
   if (doc.contains("scheme") && doc["scheme"].is_object() && doc["scheme"].contains("threads"))
     dfe["scheme"] = ojson{{"threads", doc["scheme"]["threads"]}};
-  Case cf = build_fem_case(source, dfe);
+  Case cf = build_fem_case(ctx, dfe);
   fem::Solver& fe = *cf.fem;
 
   // Probes: a point inside the FEM mesh is an FEM probe, any other one is read from particles.
   std::vector<int> fem_probe;  // per probe in the document: FEM probe index or -1
   const ojson* probes = doc.contains("probes") ? &doc["probes"] : nullptr;
-  if (probes && !probes->is_array()) fail(source, "probes", "expected an array");
+  if (probes && !probes->is_array()) ctx.fail("probes", "expected an array");
   ojson mpm_probes = ojson::array();
   std::vector<std::size_t> mpm_origin;  // document index of each MPM probe
   if (probes)
     for (std::size_t i = 0; i < probes->size(); ++i) {
       const ojson& p = (*probes)[i];
-      if (!p.is_object()) fail(source, probe_path(i), "expected an object");
+      if (!p.is_object()) ctx.fail(probe_path(i), "expected an object");
       // A probe along a curve is read from the particles: its curve is a physical curve of the
       // MPM region's geometry, and every point must lie in one of its bodies (the MPM parser
       // checks both), hence outside the FE cells.
@@ -87,14 +97,14 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
   if (!mpm_probes.empty()) dm["probes"] = mpm_probes;
   Case c;
   try {
-    c = build_mpm_case(source, dm);
+    c = build_mpm_case(mpm_context(ctx, mpm_origin), dm);
   } catch (const CaseError& e) {
     // Report MPM probe errors at their index in the document.
     std::string msg = e.what();
     for (std::size_t k = mpm_origin.size(); k-- > 0;) {
-      const std::string from = source + ": " + probe_path(k);
+      const std::string from = ctx.source + ": " + probe_path(k);
       if (msg.rfind(from, 0) == 0) {
-        msg = source + ": " + probe_path(mpm_origin[k]) + msg.substr(from.size());
+        msg = ctx.source + ": " + probe_path(mpm_origin[k]) + msg.substr(from.size());
         break;
       }
     }
@@ -102,8 +112,6 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
   }
 
   // FEM probes: the same checks as the FEM parser's.
-  static const std::vector<std::string> fem_fields = {"sxx", "syy", "szz", "sxy", "J2",
-                                                      "vx",  "vy",  "div", "curl"};
   std::vector<ProbeSpec> all;
   std::vector<std::size_t> origin;  // document index of each entry of all
   std::size_t next_mpm = 0;
@@ -122,49 +130,31 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
         continue;
       }
       const ojson& p = (*probes)[i];
-      const std::string path = probe_path(i);
+      Obj o(ctx, p, probe_path(i), Dialect::Fem);
       for (const auto& it : p.items())
         if (it.key() != "name" && it.key() != "at" && it.key() != "fields")
-          fail(source, path + "." + it.key(),
-               it.key() == "body" ? "the point lies in the FEM region, which has no bodies"
-                                  : "unknown key; allowed: name, at, fields");
+          o.fail(it.key(), it.key() == "body"
+                               ? "the point lies in the FEM region, which has no bodies"
+                               : "unknown key; allowed: name, at, fields");
       ProbeSpec pr;
       if (!p.contains("name") || !p["name"].is_string())
-        fail(source, path + ".name", "missing required key (a string)");
+        o.fail("name", "missing required key (a string)");
       pr.name = p["name"].get<std::string>();
       static const std::regex ok("[A-Za-z0-9_]+");
       if (!std::regex_match(pr.name, ok))
-        fail(source, path + ".name", "must be letters, digits and _ only, got \"" + pr.name + "\"");
+        o.fail("name", "must be letters, digits and _ only, got \"" + pr.name + "\"");
       pr.x = p["at"][0].get<double>();
       pr.y = p["at"][1].get<double>();
       pr.fem_index = fem_probe[i];
-      if (p.contains("fields")) {
-        const ojson& fl = p["fields"];
-        if (!fl.is_array() || fl.empty())
-          fail(source, path + ".fields", "expected a non-empty array of field names");
-        for (std::size_t k = 0; k < fl.size(); ++k) {
-          const std::string fp = path + ".fields[" + std::to_string(k) + "]";
-          if (!fl[k].is_string()) fail(source, fp, "expected a string");
-          const std::string f = fl[k].get<std::string>();
-          if (std::find(fem_fields.begin(), fem_fields.end(), f) == fem_fields.end()) {
-            std::string list;
-            for (const auto& x : fem_fields) list += (list.empty() ? "" : ", ") + x;
-            fail(source, fp, "must be one of " + list + ", got \"" + f + "\"");
-          }
-          if (std::find(pr.fields.begin(), pr.fields.end(), f) != pr.fields.end())
-            fail(source, fp, "field \"" + f + "\" listed twice");
-          pr.fields.push_back(f);
-        }
-      } else {
-        pr.fields = {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"};
-      }
+      pr.fields = fem_probe_fields(o, {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"});
       all.push_back(std::move(pr));
       origin.push_back(i);
     }
   for (std::size_t i = 0; i < all.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (all[i].name == all[j].name)
-        fail(source, probe_path(origin[i]) + ".name", "probe name \"" + all[i].name + "\" is used twice");
+        ctx.fail(probe_path(origin[i]) + ".name",
+                 "probe name \"" + all[i].name + "\" is used twice");
   c.probes = std::move(all);
 
   // Couple.
@@ -172,7 +162,7 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
   try {
     c.hybrid = std::make_unique<Hybrid>(*c.solver, *c.fem);
   } catch (const HybridError& e) {
-    fail(source, "fem", e.what());
+    ctx.fail("fem", e.what());
   }
   // Time step: time.dt, or time.cfl times the smaller of both regions' limits.
   const ojson& t = doc["time"];
@@ -183,15 +173,16 @@ Case build_hybrid_case(const std::string& source, const ojson& doc) {
   } else {
     dt = t["dt"].get<double>();
     if (dt > crit * (1 + 1e-12))
-      fail(source, "time.dt",
-           fmt(dt) + " s is above the stability limit of the hybrid, " + fmt_down(crit) +
-               " s (the smaller of the MPM limit h / c_d = " + fmt_down(c.solver->critical_dt()) +
-               " s and the FEM element bound " + fmt_down(c.fem->critical_dt()) + " s)");
+      ctx.fail("time.dt",
+               fmt(dt) + " s is above the stability limit of the hybrid, " + fmt_down(crit) +
+                   " s (the smaller of the MPM limit h / c_d = " +
+                   fmt_down(c.solver->critical_dt()) + " s and the FEM element bound " +
+                   fmt_down(c.fem->critical_dt()) + " s)");
   }
   try {
     c.hybrid->set_dt(dt);
   } catch (const HybridError& e) {
-    fail(source, "time", e.what());
+    ctx.fail("time", e.what());
   }
   for (const auto& n : cf.notes) c.notes.push_back("FEM: " + n);
   char line[256];

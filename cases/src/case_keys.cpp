@@ -1,0 +1,152 @@
+#include "case_keys.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "case_util.hpp"
+#include "silentmpm/case.hpp"
+
+namespace smpm::detail {
+
+namespace {
+bool starts_with(const std::string& s, const std::string& p) {
+  return s.size() >= p.size() && s.compare(0, p.size(), p) == 0;
+}
+}  // namespace
+
+void Ctx::fail(const std::string& path, const std::string& what) const {
+  std::string m = source + ": " + (path.empty() ? "" : path + ": ") + what;
+  for (const auto& [p, text] : overridden)
+    if (!path.empty() && (path == p || starts_with(path, p + ".") || starts_with(path, p + "["))) {
+      m += " (value set by override '" + text + "')";
+      break;
+    }
+  throw CaseError(m);
+}
+
+double as_number(const Ctx& ctx, const ojson& v, const std::string& path) {
+  if (!v.is_number()) ctx.fail(path, "expected a number, got " + a_type(v));
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) ctx.fail(path, "expected a finite number");
+  return d;
+}
+
+long as_integer(const Ctx& ctx, const ojson& v, const std::string& path) {
+  if (v.is_number_integer()) {  // signed or unsigned
+    if (v.is_number_unsigned() && v.get<std::uint64_t>() > 1000000000000ULL)
+      ctx.fail(path, "integer too large");
+    return static_cast<long>(v.get<std::int64_t>());
+  }
+  if (v.is_number_float()) {  // 1e3 parses as a float; accept it when it is a whole number
+    const double d = v.get<double>();
+    if (std::isfinite(d) && d == std::floor(d) && std::fabs(d) <= 1e12) return static_cast<long>(d);
+    ctx.fail(path, "expected an integer, got " + fmt(d));
+  }
+  ctx.fail(path, "expected an integer, got " + a_type(v));
+}
+
+std::string as_string(const Ctx& ctx, const ojson& v, const std::string& path) {
+  if (!v.is_string()) ctx.fail(path, "expected a string, got " + a_type(v));
+  return v.get<std::string>();
+}
+
+std::vector<double> as_numbers(const Ctx& ctx, const ojson& v, const std::string& path,
+                               std::size_t n) {
+  const std::string want = "expected an array of " + std::to_string(n) + " numbers";
+  if (!v.is_array()) ctx.fail(path, want + ", got " + a_type(v));
+  if (v.size() != n)
+    ctx.fail(path, want + ", got an array of " + std::to_string(v.size()) + " element" +
+                       (v.size() == 1 ? "" : "s"));
+  std::vector<double> out;
+  for (std::size_t i = 0; i < n; ++i) out.push_back(as_number(ctx, v[i], index_path(path, i)));
+  return out;
+}
+
+Obj::Obj(const Ctx& ctx, const ojson& j, std::string path, Dialect dialect)
+    : ctx_(&ctx), j_(&j), path_(std::move(path)), dialect_(dialect) {
+  if (!j.is_object()) ctx.fail(path_, "expected an object, got " + a_type(j));
+}
+
+void Obj::allow(const std::vector<std::string>& keys, const std::string& where) const {
+  for (const auto& item : j_->items()) {
+    if (std::find(keys.begin(), keys.end(), item.key()) != keys.end()) continue;
+    fail(item.key(), "unknown key" + (where.empty() ? "" : " " + where) +
+                         (dialect_ == Dialect::Mpm ? suggestion(item.key(), keys) : "") +
+                         "; allowed: " + join(keys));
+  }
+}
+
+void Obj::done() const {
+  std::vector<std::string> known(read_.begin(), read_.end());
+  for (const auto& item : j_->items())
+    if (!read_.count(item.key())) fail(item.key(), "unknown key" + suggestion(item.key(), known));
+}
+
+long Obj::integer(const std::string& key, long def) {
+  const ojson* v = find(key);
+  if (!v) return def;
+  if (dialect_ == Dialect::Mpm) return as_integer(*ctx_, *v, at(key));
+  if (v->is_number_integer()) return static_cast<long>(v->get<std::int64_t>());
+  if (v->is_number_float() && v->get<double>() == std::floor(v->get<double>()) &&
+      std::fabs(v->get<double>()) < 1e12)
+    return static_cast<long>(v->get<double>());
+  fail(key, "expected an integer, got " + (v->is_number() ? fmt(v->get<double>()) : a_type(*v)));
+}
+
+bool Obj::boolean(const std::string& key, bool def) {
+  const ojson* v = find(key);
+  if (!v) return def;
+  if (!v->is_boolean()) fail(key, "expected true or false, got " + a_type(*v));
+  return v->get<bool>();
+}
+
+std::string Obj::choice(const std::string& key, const std::vector<std::string>& options,
+                        const char* def) {
+  const bool mpm = dialect_ == Dialect::Mpm;
+  const std::string list = mpm ? quoted_list(options) : join(options);
+  const ojson* v = find(key);
+  if (!v) {
+    if (!def) fail(key, "missing required key (one of " + list + ")");
+    return def;
+  }
+  const std::string s = as_string(*ctx_, *v, at(key));
+  if (std::find(options.begin(), options.end(), s) == options.end())
+    fail(key, "must be one of " + list + ", got \"" + s + "\"" +
+                  (mpm ? suggestion(s, options) : ""));
+  return s;
+}
+
+std::vector<double> Obj::nums(const std::string& key, std::size_t n) {
+  const ojson& v = need(key);
+  if (dialect_ == Dialect::Mpm) return as_numbers(*ctx_, v, at(key), n);
+  const std::string want = "expected an array of " + std::to_string(n) + " numbers";
+  if (!v.is_array() || v.size() != n) fail(key, want + ", got " + a_type(v));
+  std::vector<double> out;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!v[i].is_number()) fail(key, want);
+    out.push_back(v[i].get<double>());
+  }
+  return out;
+}
+
+const ojson& Obj::array(const std::string& key) {
+  const ojson& v = need(key);
+  if (!v.is_array()) fail(key, "expected an array, got " + a_type(v));
+  return v;
+}
+
+void Obj::gt(const std::string& key, double v, double lo) const {
+  if (!(v > lo)) fail(key, "must be > " + fmt(lo) + ", got " + fmt(v));
+}
+void Obj::ge(const std::string& key, double v, double lo) const {
+  if (!(v >= lo)) fail(key, "must be >= " + fmt(lo) + ", got " + fmt(v));
+}
+void Obj::lt(const std::string& key, double v, double hi) const {
+  if (!(v < hi)) fail(key, "must be < " + fmt(hi) + ", got " + fmt(v));
+}
+void Obj::le(const std::string& key, double v, double hi) const {
+  if (!(v <= hi)) fail(key, "must be <= " + fmt(hi) + ", got " + fmt(v));
+}
+
+}  // namespace smpm::detail
