@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "silentmpm/fem.hpp"
+#include "silentmpm/gmsh_session.hpp"
 
 namespace smpm::fem {
 
@@ -27,51 +28,6 @@ std::string fmt(double v) {
 }
 
 const char* kSizeParameter = "Parameters/h";
-
-// gmsh holds global state: options set by an earlier .geo (Mesh.ElementOrder...) persist, and
-// after a syntax error its parser no longer defines the DefineConstant parameters. So every load
-// starts from a fresh gmsh (initialise, finalise, initialise: gmsh 4.8 has no isInitialized) and
-// leaves it initialised, with the model cleared, for any other user in the program.
-class GmshSession {
- public:
-  GmshSession() {
-    gmsh::initialize(0, nullptr, false);
-    gmsh::finalize();
-    gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::logger::start();
-    gmsh::onelab::clear();
-  }
-  ~GmshSession() {
-    try {
-      gmsh::logger::stop();
-      gmsh::clear();
-    } catch (...) {
-    }
-  }
-  std::string last_error() {
-    std::string e;
-    try {
-      gmsh::logger::getLastError(e);
-    } catch (...) {
-    }
-    return e;
-  }
-  // Runs one gmsh call; returns the error it raised ("" if none).
-  template <class F>
-  std::string run(F&& f) {
-    const std::string before = last_error();
-    bool threw = false;
-    try {
-      f();
-    } catch (...) {
-      threw = true;
-    }
-    const std::string after = last_error();
-    if (threw) return after.empty() ? std::string("unknown gmsh error") : after;
-    return after != before ? after : std::string();
-  }
-};
 
 std::string element_name(int type) {
   std::string name;
@@ -121,7 +77,7 @@ Mesh load_mesh(const std::string& file, double size) {
   m.size = size;
   GmshSession gs;
   auto fail = [&](const std::string& what) -> void { throw FemError(file + ": " + what); };
-  if (const std::string e = gs.run([&] { gmsh::open(file); }); !e.empty())
+  if (const std::string e = gs.call_error([&] { gmsh::open(file); }); !e.empty())
     fail("gmsh cannot read it: " + e);
   if (ext == ".geo") {
     std::vector<double> hv;
@@ -133,11 +89,11 @@ Mesh load_mesh(const std::string& file, double size) {
              " cannot be applied");
       gmsh::onelab::setNumber(kSizeParameter, {size});
       // Parse again with the new size.
-      if (const std::string e = gs.run([&] { gmsh::open(file); }); !e.empty())
+      if (const std::string e = gs.call_error([&] { gmsh::open(file); }); !e.empty())
         fail("gmsh cannot read it: " + e);
     }
     gmsh::option::setNumber("Mesh.RecombineAll", 1);
-    if (const std::string e = gs.run([] { gmsh::model::mesh::generate(2); }); !e.empty())
+    if (const std::string e = gs.call_error([] { gmsh::model::mesh::generate(2); }); !e.empty())
       fail("gmsh cannot mesh it: " + e);
   }
 
@@ -204,7 +160,7 @@ Mesh load_mesh(const std::string& file, double size) {
   const fs::path tmp = fs::temp_directory_path() /
                        ("smpm_mesh_" + std::to_string(::getpid()) + "_" +
                         std::to_string(reinterpret_cast<std::uintptr_t>(&m)) + ".msh");
-  if (const std::string e = gs.run([&] { gmsh::write(tmp.string()); }); !e.empty())
+  if (const std::string e = gs.call_error([&] { gmsh::write(tmp.string()); }); !e.empty())
     fail("gmsh cannot write the mesh: " + e);
   std::ifstream f(tmp);
   std::ostringstream ss;

@@ -1,21 +1,25 @@
 // Reading gmsh geometries (.geo meshed through the gmsh C++ API, or .msh) into plain arrays:
 // node coordinates, the elements of each physical surface, the segments of each physical curve.
-// The only file of the project outside fem/ that includes gmsh.h.
+// With fem/src/fem_mesh.cpp the only file of the project that calls gmsh (and gmsh/, the
+// session both of them open).
 #include "silentmpm/geometry.hpp"
 
 #include <gmsh.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
+#include <functional>
 #include <sstream>
 #include <unordered_map>
 
 #include <unistd.h>
+
+#include "silentmpm/gmsh_session.hpp"
 
 namespace smpm {
 
@@ -138,69 +142,11 @@ std::string lower_ext(const std::string& file) {
   return e;
 }
 
-// The gmsh API is one global state: one load at a time, initialised and finalised around it.
-std::mutex& gmsh_mutex() {
-  static std::mutex m;
-  return m;
-}
-
-struct GmshSession {
-  explicit GmshSession(const std::vector<std::string>& args) {
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    // ONELAB parameters (DefineConstant[ h = {..., Name "Parameters/h"} ]) and options outlive
-    // gmsh::finalize() in one process: clear them so that a value of an earlier load (ours or
-    // fem/'s) is never picked up by this one.
-    gmsh::initialize(1, argv.data(), /*readConfigFiles=*/false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::clear();  // also the parser's variables (h of the last .geo)
-    gmsh::onelab::clear();
-    gmsh::finalize();
-    gmsh::initialize(static_cast<int>(args.size()), argv.data(), /*readConfigFiles=*/false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);  // gmsh's default
-    gmsh::option::setNumber("Mesh.MeshSizeMin", 0);
-    gmsh::logger::start();
-  }
-  ~GmshSession() {
-    try {
-      gmsh::onelab::clear();
-      gmsh::logger::stop();
-      gmsh::finalize();
-    } catch (...) {
-    }
-  }
-  // First "Error" line of the gmsh log since the session started, without its prefix.
-  static std::string first_error() {
-    std::vector<std::string> log;
-    gmsh::logger::get(log);
-    for (const auto& l : log)
-      if (l.rfind("Error", 0) == 0) {
-        std::size_t p = l.find(':');
-        std::string m = p == std::string::npos ? l : l.substr(p + 1);
-        m.erase(0, m.find_first_not_of(' '));
-        return m;
-      }
-    return "";
-  }
-};
-
 // Run a gmsh call; turn every way gmsh reports failure (a thrown std::string, an exception, an
 // "Error" in the log) into a GeometryError.
-template <class Fn>
-void gmsh_call(const std::string& file, const char* what, Fn&& fn) {
-  std::string err;
-  try {
-    fn();
-  } catch (const std::string& s) {
-    err = s;
-  } catch (const std::exception& e) {
-    err = e.what();
-  } catch (...) {
-    err = "unknown gmsh error";
-  }
-  if (err.empty()) err = GmshSession::first_error();
+void gmsh_call(const GmshSession& session, const std::string& file, const char* what,
+               const std::function<void()>& fn) {
+  const std::string err = session.load_error(fn);
   if (!err.empty()) throw GeometryError(file + ": gmsh could not " + what + ": " + err);
 }
 
@@ -285,7 +231,6 @@ Geometry load_geometry(const std::string& file, double size,
     throw GeometryError(file + ": unsupported file type \"" + ext +
                         "\" (give a gmsh .geo or .msh file)");
 
-  std::lock_guard<std::mutex> lock(gmsh_mutex());
   // The numbers (h and the parameters) go in through a small wrapper .geo that assigns them and
   // then includes the file; the file's DefineConstant keeps an already defined value. (gmsh's
   // -setnumber is kept by gmsh across sessions of one process, so it would leak into later
@@ -307,7 +252,7 @@ Geometry load_geometry(const std::string& file, double size,
     }
   } wrapper;
   if (!preamble.empty()) {
-    static int counter = 0;
+    static std::atomic<int> counter{0};
     const fs::path abs = fs::absolute(file, ec);
     wrapper.path = (fs::temp_directory_path(ec) /
                     ("silentmpm_" + std::to_string(static_cast<long>(::getpid())) + "_" +
@@ -318,18 +263,20 @@ Geometry load_geometry(const std::string& file, double size,
     if (!w) throw GeometryError(file + ": cannot write a temporary file " + wrapper.path);
     opened = wrapper.path;
   }
-  GmshSession session({"silentmpm"});
+  GmshSession session;
 
-  gmsh_call(file, geo ? "read the geometry" : "read the mesh", [&] { gmsh::open(opened); });
+  gmsh_call(session, file, geo ? "read the geometry" : "read the mesh",
+            [&] { gmsh::open(opened); });
   if (geo) {
     if (size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", size);
-    gmsh_call(file, "mesh the geometry", [&] { gmsh::model::mesh::generate(2); });
+    gmsh_call(session, file, "mesh the geometry", [&] { gmsh::model::mesh::generate(2); });
   }
 
   Geometry g;
   g.file = file;
   gmsh::vectorpair groups;
-  gmsh_call(file, "list the physical groups", [&] { gmsh::model::getPhysicalGroups(groups); });
+  gmsh_call(session, file, "list the physical groups",
+            [&] { gmsh::model::getPhysicalGroups(groups); });
   bool any = false;
   for (const auto& dt : groups) any = any || dt.first == 1 || dt.first == 2;
   if (!any)
@@ -339,7 +286,8 @@ Geometry load_geometry(const std::string& file, double size,
   // Nodes.
   std::vector<std::size_t> node_tags;
   std::vector<double> coord, pcoord;
-  gmsh_call(file, "read the nodes", [&] { gmsh::model::mesh::getNodes(node_tags, coord, pcoord); });
+  gmsh_call(session, file, "read the nodes",
+            [&] { gmsh::model::mesh::getNodes(node_tags, coord, pcoord); });
   std::unordered_map<std::size_t, int> index;
   index.reserve(node_tags.size());
   double scale = 0;
@@ -378,7 +326,7 @@ Geometry load_geometry(const std::string& file, double size,
       if (dim == 1) curve_entities.push_back({ent, curve.segs.size()});
       std::vector<int> types;
       std::vector<std::vector<std::size_t>> etags, ntags;
-      gmsh_call(file, "read the elements", [&] {
+      gmsh_call(session, file, "read the elements", [&] {
         gmsh::model::mesh::getElements(types, etags, ntags, dim, ent);
       });
       for (std::size_t t = 0; t < types.size(); ++t) {

@@ -1,0 +1,44 @@
+#pragma once
+// One gmsh session: the gmsh API is one global state per process, shared by the FE meshes
+// (fem/src/fem_mesh.cpp) and the MPM geometries (geometry/src/geometry.cpp). This folder sits
+// below both: fem/ and geometry/ are side by side on mpm/ and neither may include the other, and
+// the session needs nothing of the project, so it is its own target under both of them.
+//
+// A session holds the process-wide gmsh lock for its lifetime (one load at a time, from any
+// thread) and starts from a fresh gmsh: initialise, clear the model and the ONELAB parameters,
+// finalise, initialise again (gmsh 4.8 has no isInitialized), with terminal output off and the
+// log recorded. Without the fresh start an earlier load's options (Mesh.ElementOrder,
+// Mesh.RecombineAll, ...) and ONELAB parameters (DefineConstant[ h = {..., Name
+// "Parameters/h"} ]) would be picked up, and after a syntax error gmsh's parser no longer
+// defines the DefineConstant parameters; a fresh initialisation resets every option to its
+// default. The session clears the ONELAB parameters and finalises gmsh when it ends. This header
+// does not include gmsh.h.
+#include <functional>
+#include <mutex>
+#include <string>
+
+namespace smpm {
+
+class GmshSession {
+ public:
+  GmshSession();
+  ~GmshSession();
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+
+  // Two ways of telling that a gmsh call failed ("" if it did not); with abort on error (the
+  // API's default) both give the text of the error gmsh threw.
+  //
+  // The error of one call: gmsh's last error if the call threw (else "unknown gmsh error"), or
+  // the last error it recorded without throwing.
+  std::string call_error(const std::function<void()>& call) const;
+  // The error of a load that stops at its first failure: the text of what the call threw
+  // ("unknown gmsh error" for anything but a string or an exception), else the first "Error"
+  // line logged since the session started, without its prefix.
+  std::string load_error(const std::function<void()>& call) const;
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
+}  // namespace smpm
