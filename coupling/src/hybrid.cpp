@@ -239,8 +239,6 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
 
   fint_.assign(2 * nfe, 0.0);
   fext_.assign(2 * nfe, 0.0);
-  inv_mfe_.resize(nfe);
-  for (std::size_t i = 0; i < nfe; ++i) inv_mfe_[i] = 1.0 / fe_.mass()[i];
   mpm_v_.assign(2 * shared_.size(), 0.0);
   sum_v_.assign(2 * shared_.size(), 0.0);
   fe_.internal_force(fe_.displacement().data(), fint_.data());
@@ -361,8 +359,6 @@ void Hybrid::after_grid_update(Solver& S) {
 void Hybrid::before_g2p(Solver& S) {
   Grid& g = S.grid;
   const double dt = S.dt;
-  const auto& D = fe_.dashpots();
-  const auto& mfe = fe_.mass();
   std::vector<double>& v = fe_.velocity();
   double absorbed = step_absorbed_;
   // FLIP increments of the particles use, at a shared node, the particles' own projected
@@ -377,41 +373,10 @@ void Hybrid::before_g2p(Solver& S) {
     if (!(g.fix[n] & 2)) g.vy[n] = mpm_v_[2 * k + 1];
   }
 
-  // FE nodes not shared: their own update (lumped mass, semi-implicit dashpots, constraints).
-  {
-    const std::int64_t nn = static_cast<std::int64_t>(mfe.size());
-    const auto& mask = fe_.constraint_mask();
-    const std::int64_t* gof = grid_of_fe_.data();
-    const std::int32_t* dof = dash_of_fe_.data();
-    const double* im = inv_mfe_.data();
-    // FE-only nodes advance u^{n+1} = u^n + dt v+ here (USL and MUSL alike: MUSL's re-mapped
-    // velocity differs from v+ only at nodes with particle mass, the shared ones, done below).
-    double* u = fe_.displacement().data();
-    double work = 0, abs2 = 0;
-#pragma omp parallel for schedule(static) reduction(+ : work, abs2) num_threads(fe_.thread_count())
-    for (std::int64_t i = 0; i < nn; ++i) {
-      if (gof[i] >= 0) continue;
-      const double fx = fint_[2 * i] + fext_[2 * i], fy = fint_[2 * i + 1] + fext_[2 * i + 1];
-      const double vx0 = v[2 * i], vy0 = v[2 * i + 1], mi = mfe[i];
-      double vx, vy;
-      if (dof[i] < 0) {
-        vx = (mask[i] & 1) ? 0.0 : vx0 + dt * fx * im[i];
-        vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy * im[i];
-      } else {
-        const auto& c = D[dof[i]];
-        dashpot_velocity(mi, c.cxx, c.cxy, c.cyy, vx0, vy0, fx, fy, dt, mask[i], vx, vy);
-        const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
-        abs2 += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
-      }
-      work += dt * (fext_[2 * i] * 0.5 * (vx0 + vx) + fext_[2 * i + 1] * 0.5 * (vy0 + vy));
-      v[2 * i] = vx;
-      v[2 * i + 1] = vy;
-      u[2 * i] += dt * vx;
-      u[2 * i + 1] += dt * vy;
-    }
-    absorbed += abs2;
-    fe_work_ += work;
-  }
+  // FE nodes not shared: their own update in the fem library (lumped mass, semi-implicit
+  // dashpots, constraints; u^{n+1} = u^n + dt v+ there, USL and MUSL alike: MUSL's re-mapped
+  // velocity differs from v+ only at nodes with particle mass, the shared ones, done below).
+  fe_.advance_free_nodes(grid_of_fe_.data(), fint_.data(), fext_.data(), dt, fe_work_, absorbed);
   // Shared nodes take the grid velocity; FE loads there (FE-only nodes) do work with it.
   for (std::size_t k = 0; k < shared_.size(); ++k) {
     const std::uint32_t e = shared_[k][0], n = shared_[k][1];

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "fem_impl.hpp"
+#include "silentmpm/dashpot.hpp"
 
 namespace smpm::fem {
 
@@ -215,6 +216,44 @@ void Solver::step() {
   t += dt;
   ++steps;
   // ku now holds -K u^n (u^n = the displacement before this step), used by update_energies().
+}
+
+void Solver::advance_free_nodes(const std::int64_t* skip, const double* f_int, const double* f_ext,
+                                double dt, double& work_out, double& absorbed_out) {
+  Impl& m = *impl_;
+  const std::int64_t nn = static_cast<std::int64_t>(m.mass.size());
+  const std::uint8_t* mask = m.mask.data();
+  const std::int32_t* dof = m.dash_of_node.data();
+  const double* im = m.inv_mass.data();
+  const double* mfe = m.mass.data();
+  const auto& D = m.dash;
+  double* u = m.u.data();
+  double* v = m.v.data();
+  double work = 0, abs2 = 0;
+#pragma omp parallel for schedule(static) reduction(+ : work, abs2) num_threads(m.threads)
+  for (std::int64_t i = 0; i < nn; ++i) {
+    if (skip[i] >= 0) continue;
+    const double fx = f_int[2 * i] + f_ext[2 * i], fy = f_int[2 * i + 1] + f_ext[2 * i + 1];
+    const double vx0 = v[2 * i], vy0 = v[2 * i + 1], mi = mfe[i];
+    double vx, vy;
+    if (dof[i] < 0) {
+      vx = (mask[i] & 1) ? 0.0 : vx0 + dt * fx * im[i];
+      vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy * im[i];
+    } else {
+      const auto& c = D[dof[i]];
+      dashpot_velocity(mi, c.cxx, c.cxy, c.cyy, vx0, vy0, fx, fy, dt, mask[i], vx, vy);
+      const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
+      abs2 += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
+    }
+    work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
+    v[2 * i] = vx;
+    v[2 * i + 1] = vy;
+    u[2 * i] += dt * vx;
+    u[2 * i + 1] += dt * vy;
+  }
+  work_out += work;
+  absorbed_out += abs2;
+  m.ku_valid = false;
 }
 
 void Solver::update_energies() {

@@ -111,7 +111,6 @@ class Hybrid : public StepHooks {
   std::vector<std::uint8_t> has_mpm_mass_; // per shared pair: node had MPM mass at setup
   std::size_t interface_count_ = 0;
   std::vector<double> fint_, fext_;        // FE per-dof work arrays
-  std::vector<double> inv_mfe_;            // 1 / lumped mass per FE node
   std::vector<double> mpm_v_, sum_v_;      // per shared node: p_MPM / m_MPM, (p_MPM + m_FE v_FE) / m
   double step_absorbed_ = 0;               // FE dashpot energy of this step at shared nodes
   double fe_kinetic_ = 0, fe_elastic_ = 0;

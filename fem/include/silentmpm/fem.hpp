@@ -157,6 +157,13 @@ class Solver {
   // hold zero on every other node (start from a zero vector written only by this call), so that
   // a step costs O(loaded nodes), not O(dofs).
   void refresh_external_force(double time, double* f) const;
+  // The explicit update of the nodes the caller does not advance itself (skip[i] < 0), from the
+  // forces f = f_int + f_ext (2 per node) and the current v: v+ = v + dt f / m, semi-implicit at a
+  // node with a dashpot block (dashpot.hpp), constraints; then u += dt v+. Adds the work of f_ext
+  // and the energy the dashpots absorb on those nodes to work and absorbed. The MPM-FEM hybrid
+  // advances its FE-only nodes with it (its shared nodes follow the grid).
+  void advance_free_nodes(const std::int64_t* skip, const double* f_int, const double* f_ext,
+                          double dt, double& work, double& absorbed);
   // Nodes on the given boundary ids (physical curve tags), sorted.
   std::vector<std::uint32_t> boundary_nodes(const std::vector<int>& curves) const;
 
