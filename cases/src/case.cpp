@@ -897,7 +897,8 @@ class Builder {
   }
 
   void parse_boundary(Obj o, std::size_t i, Case& c) {
-    const std::string type = o.choice("type", {"fixed", "roller", "traction", "silent"});
+    const std::string type =
+        o.choice("type", {"fixed", "roller", "traction", "silent", "kelvin_voigt"});
     const std::string where = "for a " + type + " boundary";
     if (type == "fixed" || type == "roller") {
       std::vector<std::string> keys = {"type", "name", "grid_side", "box", "body", "side", "curve"};
@@ -907,8 +908,12 @@ class Builder {
       o.allow({"type", "name", "body", "side", "curve", "width", "normal", "tangential", "vector",
                "time", "anchor"},
               where);
-    } else {
+    } else if (type == "silent") {
       o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor"},
+              where);
+    } else {
+      o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor",
+               "delta", "alpha_n", "alpha_t"},
               where);
     }
     const std::string name = o.str("name", type + std::to_string(i));
@@ -957,7 +962,7 @@ class Builder {
       return;
     }
 
-    // silent
+    // silent, kelvin_voigt (the same dashpots with springs)
     SilentBoundary sb;
     std::string what;
     sb.layer = select_layer(o, name, what);
@@ -965,6 +970,21 @@ class Builder {
     o.ge("a", sb.a, 0);
     sb.b = o.num("b", 1.0);
     o.ge("b", sb.b, 0);
+    if (type == "kelvin_voigt") {
+      sb.delta = o.num("delta");
+      // The spring is explicit: stiffer than one cell of the material it would cut the time step.
+      if (!(sb.delta >= grid_.h))
+        o.fail("delta", "must be >= grid.cell (" + fmt(grid_.h) + " m), got " + fmt(sb.delta));
+      sb.alpha_n = o.num("alpha_n", 1.0);
+      o.ge("alpha_n", sb.alpha_n, 0);
+      sb.alpha_t = o.num("alpha_t", 1.0);
+      o.ge("alpha_t", sb.alpha_t, 0);
+      c.notes.push_back("kelvin_voigt \"" + name + "\" on the " + what + " (" +
+                        std::to_string(sb.layer.ids.size()) + " particles): dashpots a " +
+                        fmt(sb.a) + ", b " + fmt(sb.b) + "; springs alpha_n rho c_d^2 / delta, " +
+                        "alpha_t rho c_s^2 / delta with delta " + fmt(sb.delta) + " m, alpha_n " +
+                        fmt(sb.alpha_n) + ", alpha_t " + fmt(sb.alpha_t));
+    }
     sb.form = o.choice("form", {"nodal", "particle"}, "nodal") == "nodal" ? SilentForm::Nodal
                                                                          : SilentForm::Particle;
     // The paper's lagged form is stable only when mapped at the particle (see README).

@@ -15,7 +15,7 @@ inline Material tungsten(Model model = Model::Elastic, double sigma_y = 1.0e9) {
   return m;
 }
 
-enum class End { Free, Silent, Fixed };
+enum class End { Free, Silent, Fixed, KelvinVoigt };
 
 struct ColumnSpec {
   int cells = 100;          // column length in cells
@@ -34,6 +34,7 @@ struct ColumnSpec {
   Anchor anchor = Anchor::Boundary;
   ShapeKind shape = ShapeKind::Bilinear;
   int cells_beyond = 4;     // grid cells beyond the column's right end
+  double delta = 0;         // End::KelvinVoigt: the spring length delta (m), alpha_n = alpha_t = 1
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -53,8 +54,9 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
   tl.fn = c.fn;
   tl.anchor = c.anchor;
   s->tractions.push_back(tl);
-  if (c.end == End::Silent) {
+  if (c.end == End::Silent || c.end == End::KelvinVoigt) {
     SilentBoundary sb;
+    if (c.end == End::KelvinVoigt) sb.delta = c.delta;
     sb.layer = s->select_layer("right", 0, c.offset + L, 0, c.offset + L, top, 1, 0, c.h);
     sb.form = c.form;
     sb.anchor = c.anchor;

@@ -128,6 +128,18 @@ std::vector<Bad> bad_cases() {
        "boundaries[0].component: missing required key"},
       {"silent_unknown_key", [](ojson& j) { bnd(j, 2)["normal"] = 1; },
        "boundaries[2].normal: unknown key for a silent boundary"},
+      {"kelvin_voigt_without_delta", [](ojson& j) { bnd(j, 2)["type"] = "kelvin_voigt"; },
+       "boundaries[2].delta: missing required key"},
+      {"kelvin_voigt_delta_below_cell",
+       [](ojson& j) { bnd(j, 2)["type"] = "kelvin_voigt"; bnd(j, 2)["delta"] = 1e-4; },
+       "boundaries[2].delta: must be >= grid.cell (0.001 m), got 0.0001"},
+      {"kelvin_voigt_negative_alpha",
+       [](ojson& j) {
+         bnd(j, 2)["type"] = "kelvin_voigt"; bnd(j, 2)["delta"] = 0.01; bnd(j, 2)["alpha_n"] = -1;
+       },
+       "boundaries[2].alpha_n: must be >= 0"},
+      {"silent_with_delta", [](ojson& j) { bnd(j, 2)["delta"] = 0.01; },
+       "boundaries[2].delta: unknown key for a silent boundary"},
       {"traction_both_forms", [](ojson& j) { bnd(j, 1)["vector"] = {0, 1}; },
        "boundaries[1].vector: give either normal/tangential or vector"},
       {"unknown_boundary_body", [](ojson& j) { bnd(j, 2)["body"] = "plat"; },

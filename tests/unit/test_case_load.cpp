@@ -93,6 +93,27 @@ TEST(CaseLoad, DefaultsAndOverrides) {
   EXPECT_EQ(s.tractions[0].layer.ids.size(), 10u);
 }
 
+// A kelvin_voigt boundary is the silent layer with springs k = alpha rho c^2 / delta per particle.
+TEST(CaseLoad, KelvinVoigtBoundary) {
+  const fs::path file = write_file("valid_kv.json", kValid);
+  const smpm::Case c = smpm::load_case(
+      file.string(), {"boundaries.2={\"type\": \"kelvin_voigt\", \"body\": \"plate\", "
+                      "\"side\": \"bottom\", \"delta\": 0.02, \"alpha_t\": 0.5}"});
+  const smpm::Solver& s = *c.solver;
+  ASSERT_EQ(s.silents.size(), 1u);
+  const smpm::SilentBoundary& sb = s.silents[0];
+  EXPECT_TRUE(sb.springs());
+  EXPECT_EQ(sb.form, smpm::SilentForm::Nodal);
+  ASSERT_EQ(sb.kn.size(), 40u);
+  const smpm::Material& m = s.materials[0];
+  EXPECT_NEAR(sb.kn[0], m.rho * m.cd * m.cd / 0.02, 1e-12 * sb.kn[0]);
+  EXPECT_NEAR(sb.kt[0], 0.5 * m.rho * m.cs * m.cs / 0.02, 1e-12 * sb.kt[0]);
+  EXPECT_NEAR(sb.zn[0], m.rho * m.cd, 1e-12 * sb.zn[0]);
+  for (double u : sb.ux) EXPECT_EQ(u, 0.0);
+  ASSERT_EQ(c.notes.size(), 2u);
+  EXPECT_NE(c.notes[1].find("delta 0.02 m"), std::string::npos) << c.notes[1];
+}
+
 TEST(CaseLoad, MinimalCaseUsesDefaults) {
   nlohmann::json j = {
       {"grid", {{"size", {0.004, 0.002}}, {"cell", 0.001}}},

@@ -8,6 +8,9 @@
 //  * SilentBoundary: the Lysmer-Kuhlemeyer dashpot traction carried by the boundary-layer
 //    particles (paper Eq. 21), for any outward normal n:
 //        t = -[ a rho c_d (v.n) n + b rho c_s (v - (v.n) n) ]
+//    With springs (the Kelvin-Voigt or viscous-spring boundary, docs/physics.md section 9.1) the
+//    layer also carries t_s = -[ k_n (u.n) n + k_t (u - (u.n) n) ], u the displacement of the
+//    layer particle's anchor since the start, k_n = alpha_n rho c_d^2 / delta, k_t = alpha_t rho c_s^2 / delta.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -59,6 +62,15 @@ struct SilentBoundary {
   double a = 1, b = 1;               // LK coefficients
   std::vector<double> zn, zt;        // a rho c_d and b rho c_s per particle (its material)
   SilentForm form = SilentForm::Nodal;
+  // Kelvin-Voigt springs: delta > 0 turns them on. The spring force is explicit (from the
+  // displacement at the start of the step); its energy 1/2 u.K u is booked as elastic energy.
+  // u is the displacement of the point where the layer particle's load is mapped (its anchor),
+  // integrated with the grid velocity there: the same weights as the force, so the spring's
+  // work and its energy agree.
+  double delta = 0, alpha_n = 1, alpha_t = 1;
+  std::vector<double> kn, kt;        // alpha_n rho c_d^2 / delta and alpha_t rho c_s^2 / delta
+  std::vector<double> ux, uy;        // displacement of each particle's anchor since the start
+  bool springs() const { return delta > 0; }
 };
 
 struct NodalConstraint {
