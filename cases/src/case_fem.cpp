@@ -201,9 +201,12 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
     for (std::size_t i = 0; i < b->size(); ++i) {
       const std::string path = index_path(f.at("boundaries"), i);
       Obj o(ctx, (*b)[i], path, kFem);
-      const std::string type = o.choice("type", {"dashpot", "traction", "fixed", "roller"});
+      const std::string type =
+          o.choice("type", {"dashpot", "kelvin_voigt", "traction", "fixed", "roller"});
       const std::string where = "for a " + type + " boundary";
       if (type == "dashpot") o.allow({"type", "name", "curve", "a", "b"}, where);
+      if (type == "kelvin_voigt")
+        o.allow({"type", "name", "curve", "a", "b", "delta", "alpha_n", "alpha_t"}, where);
       if (type == "traction")
         o.allow({"type", "name", "curve", "normal", "tangential", "vector", "time"}, where);
       if (type == "fixed") o.allow({"type", "name", "curve"}, where);
@@ -218,12 +221,20 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
       } else {
         bc.curves.push_back(group_ref(ctx, cv, o.at("curve"), spec.mesh, false));
       }
-      if (type == "dashpot") {
+      if (type == "dashpot" || type == "kelvin_voigt") {
         bc.kind = fem::Boundary::Kind::Dashpot;
         bc.a = o.num("a", 1.0);
         o.ge("a", bc.a, 0);
         bc.b = o.num("b", 1.0);
         o.ge("b", bc.b, 0);
+        if (type == "kelvin_voigt") {  // the springs' stiffness enters the critical time step
+          bc.delta = o.num("delta");
+          o.gt("delta", bc.delta, 0);
+          bc.alpha_n = o.num("alpha_n", 1.0);
+          o.ge("alpha_n", bc.alpha_n, 0);
+          bc.alpha_t = o.num("alpha_t", 1.0);
+          o.ge("alpha_t", bc.alpha_t, 0);
+        }
         for (const auto& other : spec.boundaries)
           if (other.kind == fem::Boundary::Kind::Dashpot)
             for (int cc : bc.curves)

@@ -364,7 +364,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
     const QGauss<1> qg(m.degree + 1);
     FEFaceValues<2> fl(d.mapping, fe, ql, update_values | update_normal_vectors | update_JxW_values);
     FEFaceValues<2> fg(d.mapping, fe, qg, update_values | update_normal_vectors | update_JxW_values);
-    std::map<std::uint32_t, std::array<double, 3>> cblocks;
+    std::map<std::uint32_t, std::array<double, 3>> cblocks, kblocks;
     std::vector<std::map<std::uint32_t, std::array<double, 2>>> loadf(spec.boundaries.size());
     for (const auto& cell : d.dofh.active_cell_iterators()) {
       const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
@@ -389,6 +389,15 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
               c[0] += bxx;
               c[1] += bxy;
               c[2] += byy;
+              if (!(bc.delta > 0)) continue;
+              // Kelvin-Voigt springs: the same block form with k_n and k_t.
+              auto& k = kblocks[static_cast<std::uint32_t>(ld[i] / 2)];
+              lk_block(mat.rho * l * bc.alpha_n * mat.cd * mat.cd / bc.delta,
+                       mat.rho * l * bc.alpha_t * mat.cs * mat.cs / bc.delta, n[0], n[1], bxx, bxy,
+                       byy);
+              k[0] += bxx;
+              k[1] += bxy;
+              k[2] += byy;
             }
           }
         }
@@ -412,6 +421,23 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
         }
       }
     }
+    // Springs into the stiffness's diagonal blocks. With M lumped, the largest eigenvalue of
+    // M^-1 (K + S) is at most that of M^-1 K plus max_i lambda_max(S_i) / m_i: the critical
+    // time step shrinks accordingly.
+    double lam_springs = 0;
+    for (const auto& [node, k] : kblocks) {
+      const std::uint32_t* b = m.col.data() + m.rowptr[node];
+      const std::uint32_t* en = m.col.data() + m.rowptr[node + 1];
+      const std::size_t j = std::lower_bound(b, en, node) - m.col.data();
+      m.val[4 * j] += k[0];
+      m.val[4 * j + 1] += k[1];
+      m.val[4 * j + 2] += k[1];
+      m.val[4 * j + 3] += k[2];
+      const double mean = 0.5 * (k[0] + k[2]), dev = 0.5 * (k[0] - k[2]);
+      lam_springs = std::max(lam_springs, (mean + std::sqrt(dev * dev + k[1] * k[1])) / m.mass[node]);
+    }
+    if (lam_springs > 0 && m.crit_dt > 0)
+      m.crit_dt = 2.0 / std::sqrt(4.0 / (m.crit_dt * m.crit_dt) + lam_springs);
     m.dash_of_node.assign(nn, -1);
     for (const auto& [node, c] : cblocks) {
       m.dash_of_node[node] = static_cast<std::int32_t>(m.dash.size());
@@ -540,7 +566,12 @@ std::vector<std::string> Solver::describe() const {
     const std::size_t n = boundary_nodes(bc.curves).size();
     s += " (" + std::to_string(n) + " nodes): ";
     switch (bc.kind) {
-      case Boundary::Kind::Dashpot: s += "LK dashpot a = " + fmt(bc.a) + ", b = " + fmt(bc.b); break;
+      case Boundary::Kind::Dashpot:
+        s += "LK dashpot a = " + fmt(bc.a) + ", b = " + fmt(bc.b);
+        if (bc.delta > 0)
+          s += ", Kelvin-Voigt springs alpha_n = " + fmt(bc.alpha_n) + ", alpha_t = " +
+               fmt(bc.alpha_t) + ", delta = " + fmt(bc.delta) + " m";
+        break;
       case Boundary::Kind::Fixed: s += "fixed"; break;
       case Boundary::Kind::Roller: s += std::string("roller, ") + (bc.component ? "y" : "x") + " held"; break;
       case Boundary::Kind::Traction:

@@ -183,6 +183,25 @@ TEST(FemErrors, BadInputs) {
   c = good_case();
   c["fem"]["boundaries"].push_back({{"type", "dashpot"}, {"curve", {12}}});
   EXPECT_ERROR(error_of(c), "fem.boundaries[2].curve", "already has a dashpot");
+
+  c = good_case();
+  c["fem"]["boundaries"][0]["type"] = "kelvin_voigt";
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].delta", "missing required key");
+
+  c = good_case();
+  c["fem"]["boundaries"][0]["type"] = "kelvin_voigt";
+  c["fem"]["boundaries"][0]["delta"] = 0;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].delta", "> 0");
+
+  c = good_case();
+  c["fem"]["boundaries"][0]["type"] = "kelvin_voigt";
+  c["fem"]["boundaries"][0]["delta"] = 0.01;
+  c["fem"]["boundaries"][0]["alpha_t"] = -0.5;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].alpha_t", ">= 0");
+
+  c = good_case();
+  c["fem"]["boundaries"][0]["delta"] = 0.01;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].delta", "unknown key");
 }
 
 // Through the CLI: non-zero exit, one line on stderr naming the key path.

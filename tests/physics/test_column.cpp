@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common.hpp"
+#include "kv_closed_form.hpp"
 
 using namespace smpm;
 using namespace smpm::testing;
@@ -327,27 +328,7 @@ TEST(KelvinVoigt, StiffestSpringStableAtHighCfl) {
   EXPECT_LE(std::abs(r.imbalance), 0.03);
 }
 
-// Reflected energy of a sin^2 pulse against the closed form |R(w)|^2 = 1 / (1 + (2 w delta / c)^2)
-// weighted by the pulse's energy spectrum (docs/physics.md section 9.1).
-double kv_predicted_ratio(const TimeFunction& fn, double dur, double delta, double c) {
-  const int nt = 2000, nw = 4000;
-  const double dtt = dur / nt, wmax = 40 * M_PI / dur, dw = wmax / nw;
-  double num = 0, den = 0;
-  for (int j = 0; j < nw; ++j) {
-    const double w = (j + 0.5) * dw;
-    double re = 0, im = 0;
-    for (int i = 0; i < nt; ++i) {
-      const double t = (i + 0.5) * dtt, f = fn(t);
-      re += f * std::cos(w * t);
-      im -= f * std::sin(w * t);
-    }
-    const double e = re * re + im * im, q = 2 * w * delta / c;
-    num += e / (1 + q * q);
-    den += e;
-  }
-  return num / den;
-}
-
+// Reflected energy of a sin^2 pulse against the closed form (kv_closed_form.hpp).
 TEST(KelvinVoigt, ReflectionMatchesClosedForm) {
   const Material m = tungsten();
   for (double dc : {4.0, 16.0}) {
@@ -357,7 +338,7 @@ TEST(KelvinVoigt, ReflectionMatchesClosedForm) {
     c.delta = dc * c.h;
     const double ratio = reflected_energy_ratio(c, 8);
     const double dur = 2.0 * 8 * c.h / m.cd;
-    const double pred = kv_predicted_ratio(sin2_pulse(dur, 0.5 * dur), dur, c.delta, m.cd);
+    const double pred = kv_reflected_energy_fraction(sin2_pulse(dur, 0.5 * dur), dur, c.delta, m.cd);
     std::printf("  [delta %g cells] reflected energy / incident = %.4e (closed form %.4e)\n", dc,
                 ratio, pred);
     EXPECT_NEAR(ratio, pred, 0.1 * pred + 1e-3) << "delta " << dc << " cells";

@@ -71,6 +71,11 @@ struct Boundary {
   std::vector<int> curves;     // physical curve tags (boundary ids)
   // Dashpot: coefficients of the LK dashpot (a = b = 1: standard).
   double a = 1, b = 1;
+  // Dashpot with delta > 0: the Kelvin-Voigt boundary, springs k_n = alpha_n rho c_d^2 / delta and
+  // k_t = alpha_t rho c_s^2 / delta per unit length beside the dashpots, lumped at the nodes as
+  // the dashpots are and added to the stiffness (so internal forces, elastic energy and the
+  // critical time step include them).
+  double delta = 0, alpha_n = 1, alpha_t = 1;
   // Traction: f(t) * (normal n + tangential s + (vx, vy)), n outward normal, s = (-n_y, n_x).
   double normal = 0, tangential = 0, vx = 0, vy = 0;
   TimeFunction fn;
