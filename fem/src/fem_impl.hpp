@@ -40,15 +40,8 @@ struct Solver::Impl {
   std::vector<std::uint32_t> col;
   std::vector<double> val;
 
-  // Dashpots and their prepared update (set_dt): v+ = P (m - dt/2 C) v- + P dt f, P = (m + dt/2 C)^-1
-  // restricted to the free components.
+  // Dashpot blocks C per dashpot node (their trapezoidal update: dashpot.hpp).
   std::vector<Solver::DashpotBlock> dash;
-  struct DashOp {
-    double pxx, pxy, pyx, pyy;  // P
-    double qxx, qxy, qyx, qyy;  // P (m - dt/2 C)
-  };
-  std::vector<DashOp> dash_op;
-  double prepared_dt = -1;
 
   // Traction loads: f_ext(t) = sum_l fn_l(t) F_l, F_l sparse over its nodes.
   struct Load {

@@ -131,119 +131,39 @@ void Solver::set_dt(double h) {
     throw FemError("FEM: time step " + fmt(h) + " s is above the stability limit " +
                    fmt(m.crit_dt) + " s (element bound, CFL " + fmt(h / m.crit_dt) + " > 1)");
   dt = h;
-  m.dash_op.resize(m.dash.size());
-  for (std::size_t k = 0; k < m.dash.size(); ++k) {
-    const auto& d = m.dash[k];
-    const double ms = m.mass[d.node];
-    const std::uint8_t mk = m.mask[d.node];
-    // A = m I + h/2 C, B = m I - h/2 C, restricted to free components.
-    double axx = ms + 0.5 * h * d.cxx, axy = 0.5 * h * d.cxy, ayy = ms + 0.5 * h * d.cyy;
-    double bxx = ms - 0.5 * h * d.cxx, bxy = -0.5 * h * d.cxy, byy = ms - 0.5 * h * d.cyy;
-    Impl::DashOp op{};
-    if (mk == 3) {
-      // both held: P = 0
-    } else if (mk & 1) {  // x held: v_x = 0, solve the y row
-      op.pyy = 1 / ayy;
-      op.qyy = byy / ayy;
-    } else if (mk & 2) {
-      op.pxx = 1 / axx;
-      op.qxx = bxx / axx;
-    } else {
-      const double det = axx * ayy - axy * axy;
-      op.pxx = ayy / det;
-      op.pxy = -axy / det;
-      op.pyx = -axy / det;
-      op.pyy = axx / det;
-      op.qxx = op.pxx * bxx + op.pxy * bxy;
-      op.qxy = op.pxx * bxy + op.pxy * byy;
-      op.qyx = op.pyx * bxx + op.pyy * bxy;
-      op.qyy = op.pyx * bxy + op.pyy * byy;
-    }
-    (void)axy;
-    m.dash_op[k] = op;
-  }
-  m.prepared_dt = h;
 }
 
-void Solver::step() {
-  Impl& m = *impl_;
-  if (m.prepared_dt != dt) set_dt(dt);
-  const std::int64_t n = static_cast<std::int64_t>(m.x.size());
-  // Internal force at u^n (reused from update_energies when still valid).
-  if (!m.ku_valid) internal_force(m.u.data(), m.ku.data());
-  // m.ku holds -K u^n.
-  // f_ext is zero away from the loaded nodes (fext is zero-initialised and only these entries
-  // are ever written): refresh just those, not the whole vector (a serial pass over every dof
-  // would cap the two-thread speed-up).
-  refresh_external_force(t, m.fext.data());
-  double* __restrict u = m.u.data();
-  double* __restrict v = m.v.data();
-  const double* __restrict fi = m.ku.data();
-  const double* __restrict fe = m.fext.data();
-  const double* __restrict im = m.inv_mass.data();
+namespace {
+// The explicit update of every node with skip == nullptr or skip[i] < 0: v+ = v + dt f / m, the
+// trapezoidal solve at a node with a dashpot block (dashpot.hpp), constraints; then u += dt v+.
+// Adds the work of f_ext (with the mid-step velocity) and the energy the dashpots absorb.
+void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __restrict f_int,
+                   const double* __restrict f_ext, double dt, bool parallel, double& work_out,
+                   double& absorbed_out) {
+  const std::int64_t n = static_cast<std::int64_t>(m.mass.size());
   const std::uint8_t* __restrict mask = m.mask.data();
   const std::int32_t* __restrict dn = m.dash_of_node.data();
-  const double h = dt;
+  const double* __restrict im = m.inv_mass.data();
+  const double* __restrict ms = m.mass.data();
+  const auto& D = m.dash;
+  double* __restrict u = m.u.data();
+  double* __restrict v = m.v.data();
   double work = 0, absorbed = 0;
 #pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
-    if (n >= kParallelMinimum)
+    if (parallel)
   for (std::int64_t i = 0; i < n; ++i) {
-    const double fx = fi[2 * i] + fe[2 * i], fy = fi[2 * i + 1] + fe[2 * i + 1];
+    if (skip && skip[i] >= 0) continue;
+    const double fx = f_int[2 * i] + f_ext[2 * i], fy = f_int[2 * i + 1] + f_ext[2 * i + 1];
     const double vx0 = v[2 * i], vy0 = v[2 * i + 1];
     double vx, vy;
     if (dn[i] < 0) {
-      vx = vx0 + h * fx * im[i];
-      vy = vy0 + h * fy * im[i];
-      if (mask[i] & 1) vx = 0;
-      if (mask[i] & 2) vy = 0;
-    } else {
-      const Impl::DashOp& o = m.dash_op[dn[i]];
-      vx = o.qxx * vx0 + o.qxy * vy0 + h * (o.pxx * fx + o.pxy * fy);
-      vy = o.qyx * vx0 + o.qyy * vy0 + h * (o.pyx * fx + o.pyy * fy);
-      const Solver::DashpotBlock& c = m.dash[dn[i]];
-      const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
-      absorbed += h * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
-    }
-    work += h * (fe[2 * i] * 0.5 * (vx0 + vx) + fe[2 * i + 1] * 0.5 * (vy0 + vy));
-    v[2 * i] = vx;
-    v[2 * i + 1] = vy;
-    u[2 * i] += h * vx;
-    u[2 * i + 1] += h * vy;
-  }
-  energy.external_work += work;
-  energy.absorbed += absorbed;
-  m.ku_valid = false;
-  t += dt;
-  ++steps;
-  // ku now holds -K u^n (u^n = the displacement before this step), used by update_energies().
-}
-
-void Solver::advance_free_nodes(const std::int64_t* skip, const double* f_int, const double* f_ext,
-                                double dt, double& work_out, double& absorbed_out) {
-  Impl& m = *impl_;
-  const std::int64_t nn = static_cast<std::int64_t>(m.mass.size());
-  const std::uint8_t* mask = m.mask.data();
-  const std::int32_t* dof = m.dash_of_node.data();
-  const double* im = m.inv_mass.data();
-  const double* mfe = m.mass.data();
-  const auto& D = m.dash;
-  double* u = m.u.data();
-  double* v = m.v.data();
-  double work = 0, abs2 = 0;
-#pragma omp parallel for schedule(static) reduction(+ : work, abs2) num_threads(m.threads)
-  for (std::int64_t i = 0; i < nn; ++i) {
-    if (skip[i] >= 0) continue;
-    const double fx = f_int[2 * i] + f_ext[2 * i], fy = f_int[2 * i + 1] + f_ext[2 * i + 1];
-    const double vx0 = v[2 * i], vy0 = v[2 * i + 1], mi = mfe[i];
-    double vx, vy;
-    if (dof[i] < 0) {
       vx = (mask[i] & 1) ? 0.0 : vx0 + dt * fx * im[i];
       vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy * im[i];
     } else {
-      const auto& c = D[dof[i]];
-      dashpot_velocity(mi, c.cxx, c.cxy, c.cyy, vx0, vy0, fx, fy, dt, mask[i], vx, vy);
+      const Solver::DashpotBlock& c = D[dn[i]];
+      dashpot_velocity(ms[i], c.cxx, c.cxy, c.cyy, vx0, vy0, fx, fy, dt, mask[i], vx, vy);
       const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
-      abs2 += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
+      absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
     }
     work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
     v[2 * i] = vx;
@@ -252,8 +172,32 @@ void Solver::advance_free_nodes(const std::int64_t* skip, const double* f_int, c
     u[2 * i + 1] += dt * vy;
   }
   work_out += work;
-  absorbed_out += abs2;
+  absorbed_out += absorbed;
   m.ku_valid = false;
+}
+}  // namespace
+
+void Solver::step() {
+  Impl& m = *impl_;
+  if (!(dt > 0) || dt > m.crit_dt * (1 + 1e-12)) set_dt(dt);  // throws with the reason
+  // Internal force at u^n (reused from update_energies when still valid).
+  if (!m.ku_valid) internal_force(m.u.data(), m.ku.data());
+  // m.ku holds -K u^n.
+  // f_ext is zero away from the loaded nodes (fext is zero-initialised and only these entries
+  // are ever written): refresh just those, not the whole vector (a serial pass over every dof
+  // would cap the two-thread speed-up).
+  refresh_external_force(t, m.fext.data());
+  const bool parallel = static_cast<std::int64_t>(m.x.size()) >= kParallelMinimum;
+  advance_nodes(m, nullptr, m.ku.data(), m.fext.data(), dt, parallel, energy.external_work,
+                energy.absorbed);
+  t += dt;
+  ++steps;
+  // ku now holds -K u^n (u^n = the displacement before this step), used by update_energies().
+}
+
+void Solver::advance_free_nodes(const std::int64_t* skip, const double* f_int, const double* f_ext,
+                                double dt, double& work_out, double& absorbed_out) {
+  advance_nodes(*impl_, skip, f_int, f_ext, dt, true, work_out, absorbed_out);
 }
 
 void Solver::update_energies() {

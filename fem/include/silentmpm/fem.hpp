@@ -122,7 +122,7 @@ class Solver {
   // Stability: the element bound 2 / sqrt(max over elements of lambda_max(M_e^-1 K_e)), which
   // never exceeds the true critical step of the assembled undamped system.
   double critical_dt() const;
-  // Sets dt (throws FemError if dt > critical_dt()) and prepares the dashpot update.
+  // Sets dt (throws FemError if dt > critical_dt()); step() checks a dt assigned directly.
   void set_dt(double dt);
 
   // One explicit step.
