@@ -511,7 +511,7 @@ class Builder {
                  : detail::build_fem_case(ctx_, doc_);
     Obj top(ctx_, doc_, "");
     top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes", "geometry",
-               "output", "contact"});
+               "output", "contact", "gravity"});
     for (const char* k : {"grid", "time", "materials", "bodies"})
       if (!top.has(k)) top.fail(k, "missing required key");
 
@@ -521,6 +521,12 @@ class Builder {
     grid_ = parse_grid(top.obj("grid"));
     parse_time(top.obj("time"), c);
     if (const ojson* s = top.find("scheme")) parse_scheme(Obj(ctx_, *s, "scheme"));
+    if (top.has("gravity")) {  // a body force per unit mass on every body (m/s^2)
+      const auto g = top.nums("gravity", 2);
+      s_->opt.gravity_x = g[0];
+      s_->opt.gravity_y = g[1];
+      c.notes.push_back("gravity (" + fmt(g[0]) + ", " + fmt(g[1]) + ") m/s^2");
+    }
     if (const ojson* ct = top.find("contact")) parse_contact(Obj(ctx_, *ct, "contact"), c);
     if (const ojson* o = top.find("output")) parse_output(Obj(ctx_, *o, "output"), c.output);
     parse_materials(top);

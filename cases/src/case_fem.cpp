@@ -83,7 +83,8 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   if (top.has("bodies") || top.has("grid"))
     top.fail("fem", "a case with both an MPM region (grid, bodies) and an FEM region is not "
                     "supported yet (the coupled MPM-FEM hybrid); give either grid + bodies or fem");
-  top.allow({"title", "time", "scheme", "materials", "fem", "probes", "output"}, "in an FEM case");
+  top.allow({"title", "time", "scheme", "materials", "fem", "probes", "output", "gravity"},
+            "in an FEM case");
   for (const char* k : {"time", "materials", "fem"})
     if (!top.has(k)) top.fail(k, "missing required key");
 
@@ -194,6 +195,11 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
                             (g.name.empty() ? "" : " \"" + g.name + "\"") + " of " + mesh_file +
                             " has no material");
   spec.materials = materials;
+  if (top.has("gravity")) {  // a body force per unit mass on every FE node's mass (m/s^2)
+    const auto g = top.nums("gravity", 2);
+    spec.gravity_x = g[0];
+    spec.gravity_y = g[1];
+  }
 
   // boundaries
   if (const ojson* b = f.find("boundaries")) {

@@ -40,7 +40,8 @@ Ctx mpm_context(const Ctx& ctx, const std::vector<std::size_t>& doc_index) {
 Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
   static const std::vector<std::string> allowed = {"title",  "grid",       "time",   "scheme",
                                                    "materials", "bodies",  "boundaries", "probes",
-                                                   "geometry", "output",   "contact", "fem"};
+                                                   "geometry", "output",   "contact", "fem",
+                                                   "gravity"};
   const Obj top(ctx, doc, "", Dialect::Fem);
   top.allow(allowed, "in a hybrid (MPM + FEM) case");
   for (const char* k : {"grid", "bodies", "time", "materials", "fem"})
@@ -50,7 +51,7 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
 
   // FEM region: the FEM parser on the FEM keys (no probes yet).
   ojson dfe = ojson::object();
-  for (const char* k : {"title", "time", "materials", "fem", "output"})
+  for (const char* k : {"title", "time", "materials", "fem", "output", "gravity"})
     if (doc.contains(k)) dfe[k] = doc[k];
   // The FEM region gets the materials its regions name (the particles' may be plastic).
   if (doc["fem"].is_object() && doc["fem"].contains("regions") && doc["fem"]["regions"].is_object() &&

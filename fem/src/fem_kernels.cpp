@@ -148,12 +148,18 @@ void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __re
   const auto& D = m.dash;
   double* __restrict u = m.u.data();
   double* __restrict v = m.v.data();
+  const double gx = m.spec.gravity_x, gy = m.spec.gravity_y;
+  const bool gravity = gx != 0 || gy != 0;
   double work = 0, absorbed = 0;
 #pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
     if (parallel)
   for (std::int64_t i = 0; i < n; ++i) {
     if (skip && skip[i] >= 0) continue;
-    const double fx = f_int[2 * i] + f_ext[2 * i], fy = f_int[2 * i + 1] + f_ext[2 * i + 1];
+    double fx = f_int[2 * i] + f_ext[2 * i], fy = f_int[2 * i + 1] + f_ext[2 * i + 1];
+    if (gravity) {  // the lumped body force m_i g
+      fx += ms[i] * gx;
+      fy += ms[i] * gy;
+    }
     const double vx0 = v[2 * i], vy0 = v[2 * i + 1];
     double vx, vy;
     if (dn[i] < 0) {
@@ -166,6 +172,7 @@ void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __re
       absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
     }
     work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
+    if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
     v[2 * i] = vx;
     v[2 * i + 1] = vy;
     u[2 * i] += dt * vx;

@@ -560,6 +560,8 @@ std::vector<std::string> Solver::describe() const {
     out.push_back("FEM region " + std::to_string(tag) + (g ? " \"" + g->name + "\"" : std::string()) +
                   ": " + m.spec.materials[mi].name);
   }
+  if (m.spec.gravity_x != 0 || m.spec.gravity_y != 0)
+    out.push_back("FEM gravity (" + fmt(m.spec.gravity_x) + ", " + fmt(m.spec.gravity_y) + ") m/s^2");
   for (const auto& bc : m.spec.boundaries) {
     std::string s = "FEM boundary \"" + bc.name + "\" on curves";
     for (int c : bc.curves) s += " " + std::to_string(c);

@@ -555,6 +555,21 @@ void Solver::apply_loads() {
   }
   std::sort(dashpot_nodes_.begin(), dashpot_nodes_.end());
   dashpot_nodes_.erase(std::unique(dashpot_nodes_.begin(), dashpot_nodes_.end()), dashpot_nodes_.end());
+  // Gravity: f_i += m_i g, the nodal form of sum_p m_p g N_i (the lumped mass is sum_p m_p N_i).
+  // On the grid's field; in multi-field contact the bodies' fields differ from it by their own
+  // deviation, in which g cancels.
+  if (opt.gravity_x != 0 || opt.gravity_y != 0) {
+    const double gx = opt.gravity_x, gy = opt.gravity_y;
+    const long n = static_cast<long>(grid.nodes());
+    const double* m = grid.m.data();
+    double* fx = grid.fx.data();
+    double* fy = grid.fy.data();
+#pragma omp parallel for schedule(static) num_threads(nthreads_)
+    for (long i = 0; i < n; ++i) {
+      fx[i] += m[i] * gx;
+      fy[i] += m[i] * gy;
+    }
+  }
 }
 
 // v+ = v + dt f / m on every node; then, on the few nodes that carry a dashpot block C,
@@ -620,6 +635,19 @@ void Solver::boundary_work(bool remapped) {
         energy.external_work += dt * tl.layer.w[q] * sf.N[a] * (tx * ax + ty * ay);
       }
     }
+  }
+  // Gravity's work with the same velocity as the tractions' (void nodes have m = 0).
+  if (opt.gravity_x != 0 || opt.gravity_y != 0) {
+    const double gx = opt.gravity_x, gy = opt.gravity_y;
+    const long n = static_cast<long>(grid.nodes());
+    const double* m = grid.m.data();
+    const double* v0x = grid.vx.data(); const double* v0y = grid.vy.data();
+    const double* wx = ux.data(); const double* wy = uy.data();
+    double w = 0;
+#pragma omp parallel for schedule(static) reduction(+ : w) num_threads(nthreads_)
+    for (long i = 0; i < n; ++i)
+      w += m[i] * (gx * 0.5 * (v0x[i] + wx[i]) + gy * 0.5 * (v0y[i] + wy[i]));
+    energy.external_work += dt * w;
   }
   for (auto& sl : silents) {
     const auto& L = sl.layer;

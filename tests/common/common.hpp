@@ -35,6 +35,7 @@ struct ColumnSpec {
   ShapeKind shape = ShapeKind::Bilinear;
   int cells_beyond = 4;     // grid cells beyond the column's right end
   double delta = 0;         // End::KelvinVoigt: the spring length delta (m), alpha_n = alpha_t = 1
+  double gravity = 0;       // body force along +x (m/s^2), towards the right end
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -68,6 +69,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
   s->opt.scheme = c.scheme;
   s->opt.shape = c.shape;
   s->opt.threads = c.threads;
+  s->opt.gravity_x = c.gravity;
   s->dt = c.cfl * c.h / s->materials[0].cd;
   s->finalize();
   return s;

@@ -53,7 +53,7 @@ TEST(OverrideNote, HybridKey) {
   EXPECT_EQ(error_of(kHybridCase, {"fem_region=1"}),
             kHybridCase + ": fem_region: unknown key in a hybrid (MPM + FEM) case; allowed: title, "
                           "grid, time, scheme, materials, bodies, boundaries, probes, geometry, "
-                          "output, contact, fem (value set by override 'fem_region=1')");
+                          "output, contact, fem, gravity (value set by override 'fem_region=1')");
   // A probe in the particles is MPM probe 0 of the MPM region; its error and its note name it
   // at its index in the document.
   EXPECT_EQ(error_of(kHybridCase, {"probes.0.fields=[\"sxx\"]",

@@ -25,6 +25,7 @@ struct Column {
   double amplitude = 100e6;
   TimeFunction fn;
   double delta = 0;  // End::KelvinVoigt: the spring length (m), alpha_n = alpha_t = 1
+  double gravity = 0;  // body force along +x (m/s^2)
 };
 
 std::unique_ptr<fem::Solver> make_column(const Column& c) {
@@ -37,6 +38,7 @@ std::unique_ptr<fem::Solver> make_column(const Column& c) {
   s.materials = {tungsten()};
   s.region_material = {{1, 0}};
   s.threads = 1;
+  s.gravity_x = c.gravity;
   auto roll = fem::Boundary::Kind::Roller;
   auto b13 = bc(roll, 13, "bottom"), b14 = bc(roll, 14, "top");
   b13.component = b14.component = c.shear ? 0 : 1;
@@ -338,4 +340,38 @@ TEST(FemColumn, KelvinVoigtReflectionMatchesClosedForm) {
     EXPECT_NEAR(r.ratio, pred, 0.02 * pred) << "delta " << dc << " cells";
     EXPECT_LE(std::abs(r.imbalance), 1e-9);
   }
+}
+
+// Gravity towards a Kelvin-Voigt end: at rest the end sits at u = rho g L delta / (rho c_d^2) and
+// sigma_xx = -rho g x; the work of gravity closes the account to round-off.
+TEST(FemColumn, KelvinVoigtUnderGravity) {
+  const Material m = tungsten();
+  Column c;
+  c.cells = 40;
+  c.end = End::KelvinVoigt;
+  c.delta = c.cells * c.h;
+  c.amplitude = 0;
+  c.gravity = 2e4;  // rho g L = 12 MPa
+  const double L = c.cells * c.h;
+  auto s = make_column(c);
+  s->set_dt(0.5 * s->critical_dt());
+  ASSERT_EQ(s->add_probe(0.5 * L, 0.5 * c.h), 0);
+  while (s->t < 30 * L / m.cd) s->step();
+  s->update_energies();
+  double u = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < s->nodes(); ++i)
+    if (std::abs(s->node_x()[i] - L) < 1e-9) {
+      u += s->displacement()[2 * i];
+      ++n;
+    }
+  u /= n;
+  const double exact = m.rho * c.gravity * L * c.delta / (m.rho * m.cd * m.cd);
+  const double sxx = s->sample()[0].sxx, sxx_exact = -m.rho * c.gravity * 0.5 * L;
+  const double imb = s->energy.imbalance() / s->energy.external_work;
+  std::printf("  end displacement %.6e m (closed form %.6e), sxx(L/2) %.5e (%.5e), imbalance "
+              "%.2e\n", u, exact, sxx, sxx_exact, imb);
+  EXPECT_NEAR(u, exact, 0.005 * exact);
+  EXPECT_NEAR(sxx, sxx_exact, 0.01 * std::abs(sxx_exact));
+  EXPECT_LE(std::abs(imb), 1e-9);
 }

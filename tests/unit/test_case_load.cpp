@@ -114,6 +114,16 @@ TEST(CaseLoad, KelvinVoigtBoundary) {
   EXPECT_NE(c.notes[1].find("delta 0.02 m"), std::string::npos) << c.notes[1];
 }
 
+TEST(CaseLoad, Gravity) {
+  const fs::path file = write_file("valid_g.json", kValid);
+  const smpm::Case c = smpm::load_case(file.string(), {"gravity=[0.5, -9.81]"});
+  EXPECT_EQ(c.solver->opt.gravity_x, 0.5);
+  EXPECT_EQ(c.solver->opt.gravity_y, -9.81);
+  const smpm::Case d = smpm::load_case(file.string());
+  EXPECT_EQ(d.solver->opt.gravity_x, 0.0);
+  EXPECT_EQ(d.solver->opt.gravity_y, 0.0);
+}
+
 TEST(CaseLoad, MinimalCaseUsesDefaults) {
   nlohmann::json j = {
       {"grid", {{"size", {0.004, 0.002}}, {"cell", 0.001}}},

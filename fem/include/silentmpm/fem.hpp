@@ -90,6 +90,7 @@ struct Spec {
   std::map<int, int> region_material;      // physical surface tag -> index into materials
   std::vector<Boundary> boundaries;
   int threads = 0;                         // 0: OpenMP default
+  double gravity_x = 0, gravity_y = 0;     // body force per unit mass (m/s^2), lumped: f_i = m_i g
 };
 
 // What a probe reads at a point: stresses, velocity, div u and curl u = du_y/dx - du_x/dy.

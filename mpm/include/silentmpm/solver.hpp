@@ -48,6 +48,7 @@ struct SolverOptions {
   double flip = 1.0;          // 1 = FLIP, 0 = PIC
   double mass_tolerance = 1e-12;  // nodes lighter than this fraction of the smallest particle mass are void
   int threads = 0;            // 0 = OpenMP default
+  double gravity_x = 0, gravity_y = 0;  // body force per unit mass (m/s^2), on every node's mass
 };
 
 struct ProbeSample {
