@@ -22,6 +22,11 @@
 
 #include "silentmpm/grid.hpp"
 
+// The kernels evaluate a shape once or twice per particle and pass: its evaluation must be
+// inlined there. GCC stops inlining Bilinear::eval once the translation unit grows (measured: an
+// out-of-line call per particle and pass cost 6-9 % of the bench), so it is forced.
+#define SMPM_SHAPE_INLINE __attribute__((always_inline)) inline
+
 namespace smpm {
 
 struct Bilinear {
@@ -36,7 +41,7 @@ struct Bilinear {
   int dj[4] = {0, 0, 1, 1};
 
   // Evaluate at (x, y) for a grid with origin (x0, y0) and inverse spacing inv_h.
-  inline void eval(double x, double y, double x0, double y0, double inv_h) {
+  SMPM_SHAPE_INLINE void eval(double x, double y, double x0, double y0, double inv_h) {
     const double gx = (x - x0) * inv_h;
     const double gy = (y - y0) * inv_h;
     ci = static_cast<int>(std::floor(gx));
@@ -49,8 +54,8 @@ struct Bilinear {
   }
 
   inline void size(double, double, double) {}
-  inline void eval(const Grid& g, double x, double y) { eval(x, y, g.x0, g.y0, g.inv_h); }
-  inline void eval_clamped(const Grid& g, double x, double y) {
+  SMPM_SHAPE_INLINE void eval(const Grid& g, double x, double y) { eval(x, y, g.x0, g.y0, g.inv_h); }
+  SMPM_SHAPE_INLINE void eval_clamped(const Grid& g, double x, double y) {
     eval_clamped(x, y, g.x0, g.y0, g.inv_h, g.nx, g.ny);
   }
 
@@ -69,7 +74,7 @@ struct Bilinear {
 
   // As eval(), for a point that may lie on the last grid line (a boundary point): the cell is
   // clamped to [0, nx) x [0, ny) so the point is at natural coordinate 1 of the last cell.
-  inline void eval_clamped(double x, double y, double x0, double y0, double inv_h, int nx,
+  SMPM_SHAPE_INLINE void eval_clamped(double x, double y, double x0, double y0, double inv_h, int nx,
                            int ny) {
     eval(x, y, x0, y0, inv_h);
     if (ci >= nx || cj >= ny || ci < 0 || cj < 0) {
@@ -98,7 +103,7 @@ namespace shape_detail {
 
 // Fold the weight of an outside node (index base = -1, or base + 2 = nn) onto the inside ones;
 // afterwards base..base+2 are all grid nodes.
-inline void fold_edges(int& base, int nn, double w[3], double d[3]) {
+SMPM_SHAPE_INLINE void fold_edges(int& base, int nn, double w[3], double d[3]) {
   if (base < 0) {
     w[1] += 2 * w[0]; w[2] -= w[0];
     d[1] += 2 * d[0]; d[2] -= d[0];
@@ -115,7 +120,7 @@ inline void fold_edges(int& base, int nn, double w[3], double d[3]) {
 }
 
 // Quadratic B-spline weights (and d/dg) of the nodes base..base+2 for fx = g - base in [1/2, 3/2).
-inline void bspline2_1d(double fx, double w[3], double d[3]) {
+SMPM_SHAPE_INLINE void bspline2_1d(double fx, double w[3], double d[3]) {
   const double a = 1.5 - fx, b = fx - 1.0, c = fx - 0.5;
   w[0] = 0.5 * a * a;  d[0] = -a;
   w[1] = 0.75 - b * b; d[1] = -2 * b;
@@ -125,7 +130,7 @@ inline void bspline2_1d(double fx, double w[3], double d[3]) {
 // Uniform GIMP weight (and d/dxi) of one node at distance xi (cell units) from a particle of
 // half-width lp (cell units, 0 < lp <= 1/2): the hat function convolved with the particle's
 // characteristic function (Bardenhagen & Kober 2004).
-inline void ugimp_1d(double xi, double lp, double& w, double& d) {
+SMPM_SHAPE_INLINE void ugimp_1d(double xi, double lp, double& w, double& d) {
   const double r = std::abs(xi), sg = xi < 0 ? -1.0 : 1.0;
   if (r < lp) {
     w = 1 - (xi * xi + lp * lp) / (2 * lp);
@@ -154,11 +159,11 @@ struct Shape3x3 {
   int bi = 0, bj = 0;  // lower-left node of the support
   double N[9], dNx[9], dNy[9];
 
-  inline void eval(const Grid& g, double x, double y) {
+  SMPM_SHAPE_INLINE void eval(const Grid& g, double x, double y) {
     eval_g(g, (x - g.x0) * g.inv_h, (y - g.y0) * g.inv_h);
   }
   // A boundary point: its grid coordinates are clamped to the grid.
-  inline void eval_clamped(const Grid& g, double x, double y) {
+  SMPM_SHAPE_INLINE void eval_clamped(const Grid& g, double x, double y) {
     double gx = (x - g.x0) * g.inv_h, gy = (y - g.y0) * g.inv_h;
     gx = gx < 0 ? 0 : (gx > g.nx ? g.nx : gx);
     gy = gy < 0 ? 0 : (gy > g.ny ? g.ny : gy);
@@ -176,7 +181,7 @@ struct Shape3x3 {
   }
 
  private:
-  inline void eval_g(const Grid& g, double gx, double gy) {
+  SMPM_SHAPE_INLINE void eval_g(const Grid& g, double gx, double gy) {
     double wx[3], dx[3], wy[3], dy[3];
     bi = static_cast<int>(std::floor(gx - 0.5));
     bj = static_cast<int>(std::floor(gy - 0.5));
