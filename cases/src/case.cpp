@@ -904,7 +904,7 @@ class Builder {
 
   void parse_boundary(Obj o, std::size_t i, Case& c) {
     const std::string type =
-        o.choice("type", {"fixed", "roller", "traction", "silent", "kelvin_voigt"});
+        o.choice("type", {"fixed", "roller", "traction", "silent", "kelvin_voigt", "damping_layer"});
     const std::string where = "for a " + type + " boundary";
     if (type == "fixed" || type == "roller") {
       std::vector<std::string> keys = {"type", "name", "grid_side", "box", "body", "side", "curve"};
@@ -914,6 +914,8 @@ class Builder {
       o.allow({"type", "name", "body", "side", "curve", "width", "normal", "tangential", "vector",
                "time", "anchor"},
               where);
+    } else if (type == "damping_layer") {
+      o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power"}, where);
     } else if (type == "silent") {
       o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor"},
               where);
@@ -965,6 +967,24 @@ class Builder {
                         std::to_string(t.layer.ids.size()) + " particles): " + amp + " x " +
                         t.fn.describe());
       s_->tractions.push_back(std::move(t));
+      return;
+    }
+
+    if (type == "damping_layer") {
+      if (!o.has("width")) o.fail("width", "missing required key (the layer's thickness, m)");
+      DampingLayer dl;
+      std::string what;
+      dl.layer = select_layer(o, name, what);
+      dl.r0 = o.num("r0", 1e-3);
+      if (!(dl.r0 > 0 && dl.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(dl.r0));
+      dl.power = o.num("power", 2.0);
+      o.ge("power", dl.power, 0);
+      o.done();
+      c.notes.push_back("damping_layer \"" + name + "\" on the " + what + " (" +
+                        std::to_string(dl.layer.ids.size()) + " particles): alpha = alpha0 s^" +
+                        fmt(dl.power) + ", alpha0 = -(" + fmt(dl.power) + " + 1) c_d ln(" +
+                        fmt(dl.r0) + ") / width");
+      s_->dampers.push_back(std::move(dl));
       return;
     }
 

@@ -20,6 +20,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -366,11 +367,22 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
     FEFaceValues<2> fg(d.mapping, fe, qg, update_values | update_normal_vectors | update_JxW_values);
     std::map<std::uint32_t, std::array<double, 3>> cblocks, kblocks;
     std::vector<std::map<std::uint32_t, std::array<double, 2>>> loadf(spec.boundaries.size());
+    // Damping layers: the boundary segments of their curves and the c_d next to them.
+    std::vector<std::vector<std::array<double, 4>>> dseg(spec.boundaries.size());
+    std::vector<double> dcd(spec.boundaries.size(), 0.0);
     for (const auto& cell : d.dofh.active_cell_iterators()) {
       const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
       for (const auto f : cell->face_indices()) {
         if (!cell->face(f)->at_boundary()) continue;
         const int id = static_cast<int>(cell->face(f)->boundary_id());
+        for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
+          const Boundary& bc = spec.boundaries[b];
+          if (bc.kind != Boundary::Kind::Damping) continue;
+          if (std::find(bc.curves.begin(), bc.curves.end(), id) == bc.curves.end()) continue;
+          const auto v0 = cell->face(f)->vertex(0), v1 = cell->face(f)->vertex(1);
+          dseg[b].push_back({{v0[0], v0[1], v1[0], v1[1]}});
+          dcd[b] = std::max(dcd[b], mat.cd);
+        }
         auto dit = dash_of_id.find(id);
         if (dit != dash_of_id.end()) {
           const Boundary& bc = *dit->second;
@@ -419,6 +431,28 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
             }
           }
         }
+      }
+    }
+    // Damping layers: C_i += alpha(x_i) m_i I at every node within `width` of the curves.
+    for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
+      const Boundary& bc = spec.boundaries[b];
+      if (bc.kind != Boundary::Kind::Damping || dseg[b].empty()) continue;
+      const double a0 = -(bc.power + 1) * dcd[b] * std::log(bc.r0) / bc.width;
+      for (std::size_t i = 0; i < nn; ++i) {
+        double dist = std::numeric_limits<double>::infinity();
+        for (const auto& sg : dseg[b]) {  // distance from node i to the segment
+          const double ex = sg[2] - sg[0], ey = sg[3] - sg[1];
+          const double l2 = ex * ex + ey * ey;
+          double t = l2 > 0 ? ((m.x[i] - sg[0]) * ex + (m.y[i] - sg[1]) * ey) / l2 : 0.0;
+          t = std::clamp(t, 0.0, 1.0);
+          dist = std::min(dist, std::hypot(m.x[i] - sg[0] - t * ex, m.y[i] - sg[1] - t * ey));
+        }
+        if (!(dist < bc.width)) continue;
+        const double alpha = a0 * std::pow(1.0 - dist / bc.width, bc.power);
+        if (alpha == 0) continue;
+        auto& c = cblocks[static_cast<std::uint32_t>(i)];
+        c[0] += alpha * m.mass[i];
+        c[2] += alpha * m.mass[i];
       }
     }
     // Springs into the stiffness's diagonal blocks. With M lumped, the largest eigenvalue of
@@ -575,6 +609,9 @@ std::vector<std::string> Solver::describe() const {
                fmt(bc.alpha_t) + ", delta = " + fmt(bc.delta) + " m";
         break;
       case Boundary::Kind::Fixed: s += "fixed"; break;
+      case Boundary::Kind::Damping:
+        s += "damping layer " + fmt(bc.width) + " m thick, r0 = " + fmt(bc.r0) + ", power " + fmt(bc.power);
+        break;
       case Boundary::Kind::Roller: s += std::string("roller, ") + (bc.component ? "y" : "x") + " held"; break;
       case Boundary::Kind::Traction:
         s += "traction normal " + fmt(bc.normal) + " Pa, tangential " + fmt(bc.tangential) +

@@ -156,6 +156,17 @@ void Solver::finalize() {
       s.kt[k] = s.alpha_t * m.rho * m.cs * m.cs / s.delta;
     }
   }
+  // Damping of each layer particle from its depth and its material's c_d.
+  for (auto& dl : dampers) {
+    const BoundaryLayer& L = dl.layer;
+    dl.alpha.resize(L.idx.size());
+    for (std::size_t k = 0; k < L.idx.size(); ++k) {
+      const Material& m = materials[p.group[L.idx[k]]];
+      const double a0 = -(dl.power + 1) * m.cd * std::log(dl.r0) / L.depth;
+      const double sdep = std::clamp(1.0 - L.d[k] / L.depth, 0.0, 1.0);
+      dl.alpha[k] = a0 * std::pow(sdep, dl.power);
+    }
+  }
   sort_particles();
   update_energies();
   energy.initial = energy.kinetic + energy.elastic;
@@ -207,6 +218,8 @@ void Solver::sort_particles() {
     for (std::size_t k = 0; k < tl.layer.ids.size(); ++k) tl.layer.idx[k] = where_[tl.layer.ids[k]];
   for (auto& sl : silents)
     for (std::size_t k = 0; k < sl.layer.ids.size(); ++k) sl.layer.idx[k] = where_[sl.layer.ids[k]];
+  for (auto& dl : dampers)
+    for (std::size_t k = 0; k < dl.layer.ids.size(); ++k) dl.layer.idx[k] = where_[dl.layer.ids[k]];
   refresh_strip_rows();
   strips_ok_ = !strips_conflict();
   refresh_fields();
@@ -553,6 +566,21 @@ void Solver::apply_loads() {
       }
     }
   }
+  // Damping layers: C_i += alpha_q m_q N_i(x_q) I, at the particle (a volume term).
+  for (const auto& dl : dampers) {
+    const auto& L = dl.layer;
+    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+      if (dl.alpha[q] == 0) continue;
+      load_weights(L, q, Anchor::Particle, sf, nodes);
+      has_nodal_dashpot_ = true;
+      const double c = dl.alpha[q] * p.mass[L.idx[q]];
+      for (int a = 0; a < S::kNodes; ++a) {
+        grid.cxx[nodes[a]] += c * sf.N[a];
+        grid.cyy[nodes[a]] += c * sf.N[a];
+        dashpot_nodes_.push_back(nodes[a]);
+      }
+    }
+  }
   std::sort(dashpot_nodes_.begin(), dashpot_nodes_.end());
   dashpot_nodes_.erase(std::unique(dashpot_nodes_.begin(), dashpot_nodes_.end()), dashpot_nodes_.end());
   // Gravity: f_i += m_i g, the nodal form of sum_p m_p g N_i (the lumped mass is sum_p m_p N_i).
@@ -662,6 +690,21 @@ void Solver::boundary_work(bool remapped) {
         if (sl.form == SilentForm::Particle) dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
         else dashpot_of(sl, q, ax, ay, tx, ty);
         energy.absorbed -= dt * L.w[q] * sf.N[a] * (tx * bx + ty * by);
+      }
+    }
+  }
+  // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i.
+  for (const auto& dl : dampers) {
+    const auto& L = dl.layer;
+    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+      if (dl.alpha[q] == 0) continue;
+      load_weights(L, q, Anchor::Particle, sf, nodes);
+      const double c = dl.alpha[q] * p.mass[L.idx[q]];
+      for (int a = 0; a < S::kNodes; ++a) {
+        double ax, ay, bx, by;
+        vbar(nodes[a], ax, ay);
+        wbar(nodes[a], bx, by);
+        energy.absorbed += dt * c * sf.N[a] * (ax * bx + ay * by);
       }
     }
   }

@@ -36,6 +36,8 @@ struct ColumnSpec {
   int cells_beyond = 4;     // grid cells beyond the column's right end
   double delta = 0;         // End::KelvinVoigt: the spring length delta (m), alpha_n = alpha_t = 1
   double gravity = 0;       // body force along +x (m/s^2), towards the right end
+  int damp_cells = 0;       // a damping layer this many cells thick at the right end (r0, power 2)
+  double damp_r0 = 1e-3;
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -65,6 +67,13 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
   } else if (c.end == End::Fixed) {
     const double xr = c.offset + L;
     s->constraints.push_back({"right", s->nodes_in_box(xr - 1e-9, 0, xr + 1e-9, top), 3});
+  }
+  if (c.damp_cells > 0) {
+    DampingLayer dl;
+    dl.layer = s->select_layer("damping", 0, c.offset + L, 0, c.offset + L, top, 1, 0,
+                               c.damp_cells * c.h);
+    dl.r0 = c.damp_r0;
+    s->dampers.push_back(dl);
   }
   s->opt.scheme = c.scheme;
   s->opt.shape = c.shape;

@@ -132,6 +132,26 @@ std::vector<Bad> bad_cases() {
        "gravity: expected"},
       {"gravity_not_numbers", [](ojson& j) { j["gravity"] = {"down", 1}; },
        "gravity"},
+      {"damping_layer_without_width",
+       [](ojson& j) { bnd(j, 2) = {{"type", "damping_layer"}, {"body", "plate"}, {"side", "bottom"}}; },
+       "boundaries[2].width: missing required key (the layer's thickness, m)"},
+      {"damping_layer_r0_out_of_range",
+       [](ojson& j) {
+         bnd(j, 2) = {{"type", "damping_layer"}, {"body", "plate"}, {"side", "bottom"},
+                      {"width", 0.002}, {"r0", 1.5}};
+       },
+       "boundaries[2].r0: must be in (0, 1), got 1.5"},
+      {"damping_layer_thicker_than_body",
+       [](ojson& j) {
+         bnd(j, 2) = {{"type", "damping_layer"}, {"body", "plate"}, {"side", "bottom"}, {"width", 1.0}};
+       },
+       "boundaries[2].width: must be <= the size of body \"plate\""},
+      {"damping_layer_unknown_key",
+       [](ojson& j) {
+         bnd(j, 2) = {{"type", "damping_layer"}, {"body", "plate"}, {"side", "bottom"},
+                      {"width", 0.002}, {"a", 1}};
+       },
+       "boundaries[2].a: unknown key for a damping_layer boundary"},
       {"kelvin_voigt_without_delta", [](ojson& j) { bnd(j, 2)["type"] = "kelvin_voigt"; },
        "boundaries[2].delta: missing required key"},
       {"kelvin_voigt_delta_below_cell",

@@ -202,6 +202,19 @@ TEST(FemErrors, BadInputs) {
   c = good_case();
   c["fem"]["boundaries"][0]["delta"] = 0.01;
   EXPECT_ERROR(error_of(c), "fem.boundaries[0].delta", "unknown key");
+
+  c = good_case();
+  c["fem"]["boundaries"][0] = {{"type", "damping_layer"}, {"curve", "right"}};
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].width", "missing required key");
+
+  c = good_case();
+  c["fem"]["boundaries"][0] = {{"type", "damping_layer"}, {"curve", "right"}, {"width", -0.01}};
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].width", "> 0");
+
+  c = good_case();
+  c["fem"]["boundaries"][0] = {{"type", "damping_layer"}, {"curve", "right"}, {"width", 0.01},
+                               {"r0", 0}};
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].r0", "must be in (0, 1)");
 }
 
 // Through the CLI: non-zero exit, one line on stderr naming the key path.

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "common.hpp"
-#include "kv_closed_form.hpp"
+#include "absorbing_oracles.hpp"
 
 using namespace smpm;
 using namespace smpm::testing;
@@ -90,6 +90,7 @@ double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
   ColumnSpec cb = c;
   cb.cells = 3 * c.cells;
   cb.end = End::Free;
+  cb.damp_cells = 0;
   auto B = make_column(cb);
   const double tstar = dur + 1.8 * c.cells * c.h / cw;
   while (A->t < tstar - 0.5 * A->dt) A->step();
@@ -110,7 +111,7 @@ double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
                                                A->p.sxy[k] - B->p.sxy[kb]);
   }
   EXPECT_NEAR(A->energy.external_work, B->energy.external_work, 1e-9 * B->energy.external_work);
-  if ((c.end == End::Silent || c.end == End::KelvinVoigt) && c.ppc_side == 1) {
+  if ((c.end == End::Silent || c.end == End::KelvinVoigt || c.damp_cells > 0) && c.ppc_side == 1) {
     // Energy balance with the dashpots: kinetic + elastic + absorbed = external work. (At 4 and 9
     // particles per cell the FLIP particle kinetic energy exceeds the grid's by about 1 %.)
     A->update_energies();
@@ -328,7 +329,7 @@ TEST(KelvinVoigt, StiffestSpringStableAtHighCfl) {
   EXPECT_LE(std::abs(r.imbalance), 0.03);
 }
 
-// Reflected energy of a sin^2 pulse against the closed form (kv_closed_form.hpp).
+// Reflected energy of a sin^2 pulse against the closed form (absorbing_oracles.hpp).
 TEST(KelvinVoigt, ReflectionMatchesClosedForm) {
   const Material m = tungsten();
   for (double dc : {4.0, 16.0}) {
@@ -386,6 +387,35 @@ TEST(KelvinVoigt, ColumnUnderGravity) {
       const double sink = 29 * (L / m.cd) * (g * L / m.cd);
       std::printf("  [LK] end displacement %.6e m (terminal-velocity estimate %.6e)\n", u, sink);
       EXPECT_NEAR(u, sink, 0.1 * sink);
+    }
+  }
+}
+
+// ---- Graded damping layer, docs/physics.md section 9.2 ----
+
+// A mass-proportional layer of 10 and 20 cells (alpha0 from r0 = 1e-3, power 2) before a fixed
+// end, and 10 cells before an LK end: the reflected energy of the 16-cell sin^2 pulse against the
+// continuum solution of the layer (absorbing_oracles.hpp), within 10 %; thicker reflects less.
+TEST(DampingLayer, ReflectionMatchesContinuum) {
+  const Material m = tungsten();
+  double last = 1;
+  for (auto [end, dc] : {std::pair{End::Fixed, 10}, {End::Fixed, 20}, {End::Silent, 10}}) {
+    ColumnSpec c;
+    c.cells = 100;
+    c.end = end;
+    c.damp_cells = dc;
+    const double ratio = reflected_energy_ratio(c, 8);
+    const double dur = 2.0 * 8 * c.h / m.cd, L = dc * c.h;
+    const double a0 = -3 * m.cd * std::log(c.damp_r0) / L;
+    const double pred = reflected_energy_fraction(sin2_pulse(dur, 0.5 * dur), dur, [&](double w) {
+      return damping_layer_r2(w, L, a0, 2, m.cd, end == End::Silent);
+    });
+    std::printf("  [%d cells, %s end] reflected energy / incident = %.4e (continuum %.4e)\n", dc,
+                end == End::Silent ? "LK" : "fixed", ratio, pred);
+    EXPECT_NEAR(ratio, pred, 0.1 * pred) << dc << " cells";
+    if (end == End::Fixed) {
+      EXPECT_LT(ratio, last);
+      last = ratio;
     }
   }
 }

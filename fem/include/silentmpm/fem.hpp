@@ -65,7 +65,7 @@ Mesh load_mesh(const std::string& file, double size);
 
 // ---- model -------------------------------------------------------------------------------------
 struct Boundary {
-  enum class Kind { Dashpot, Traction, Fixed, Roller };
+  enum class Kind { Dashpot, Traction, Fixed, Roller, Damping };
   Kind kind = Kind::Fixed;
   std::string name;
   std::vector<int> curves;     // physical curve tags (boundary ids)
@@ -81,6 +81,11 @@ struct Boundary {
   TimeFunction fn;
   // Roller: the component held at zero (0 = x, 1 = y).
   int component = 0;
+  // Damping: a graded mass-proportional damping layer of thickness `width` inside the curves,
+  // alpha(s) = alpha0 s^power per unit mass, s = 1 - (distance to the curves) / width, alpha0 =
+  // -(power + 1) c_d ln(r0) / width (c_d of the material next to the curves); nodal blocks
+  // C_i = alpha(x_i) m_i I beside the dashpots (docs/physics.md section 9.2).
+  double width = 0, r0 = 1e-3, power = 2;
 };
 
 struct Spec {

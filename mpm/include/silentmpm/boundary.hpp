@@ -73,6 +73,17 @@ struct SilentBoundary {
   bool springs() const { return delta > 0; }
 };
 
+// A graded (Rayleigh, mass-proportional) damping layer: the particles within `width` of an edge
+// carry a damping alpha(s) = alpha0 s^power per unit mass, s = 1 - d / width the normalised depth
+// (0 at the layer's inner edge, 1 on the boundary), assembled each step into the nodal dashpot
+// blocks, C_i += alpha_q m_q N_i(x_q) I, and integrated with them (docs/physics.md section 9.2).
+// alpha0 = -(power + 1) c_d ln(R0) / width makes the normal-incidence round trip return R0.
+struct DampingLayer {
+  BoundaryLayer layer;
+  double r0 = 1e-3, power = 2;
+  std::vector<double> alpha;         // alpha per layer particle (1/s), set by Solver::finalize
+};
+
 struct NodalConstraint {
   std::string name;
   std::vector<uint32_t> nodes;

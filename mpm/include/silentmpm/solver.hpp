@@ -75,6 +75,7 @@ class Solver {
   std::vector<NodalConstraint> constraints;
   std::vector<TractionLoad> tractions;
   std::vector<SilentBoundary> silents;
+  std::vector<DampingLayer> dampers;
   SolverOptions opt;
   double dt = 0, t = 0;
   long steps = 0;

@@ -1,0 +1,75 @@
+#pragma once
+// Closed forms (or their numerical evaluation) for the absorbing ends of the 1D column
+// (docs/physics.md section 9): the fraction of a pulse's energy an end sends back, from the
+// end's reflection coefficient R(w) weighted by the energy spectrum |F(w)|^2 of the load history
+// fn on [0, duration].
+#include <cmath>
+#include <complex>
+#include <functional>
+
+#include "silentmpm/time_function.hpp"
+
+namespace smpm::testing {
+
+// sum_w |F(w)|^2 |R(w)|^2 / sum_w |F(w)|^2 over 0 < w < 40 pi / duration.
+inline double reflected_energy_fraction(const TimeFunction& fn, double duration,
+                                        const std::function<double(double)>& r2) {
+  const int nt = 1000, nw = 1000;
+  const double wmax = 40 * M_PI / duration, dw = wmax / nw, dtt = duration / nt;
+  double num = 0, den = 0;
+  for (int j = 0; j < nw; ++j) {
+    const double w = (j + 0.5) * dw;
+    double re = 0, im = 0;
+    for (int i = 0; i < nt; ++i) {
+      const double t = (i + 0.5) * dtt, f = fn(t);
+      re += f * std::cos(w * t);
+      im -= f * std::sin(w * t);
+    }
+    const double e = re * re + im * im;
+    num += e * r2(w);
+    den += e;
+  }
+  return num / den;
+}
+
+// Kelvin-Voigt end: |R(w)|^2 = 1 / (1 + (2 w delta / c)^2) (section 9.1).
+inline double kv_reflected_energy_fraction(const TimeFunction& fn, double duration, double delta,
+                                           double c) {
+  return reflected_energy_fraction(fn, duration, [&](double w) {
+    const double q = 2 * w * delta / c;
+    return 1 / (1 + q * q);
+  });
+}
+
+// A graded mass-proportional damping layer of thickness L (alpha = alpha0 (x / L)^power, x from
+// its inner edge) ending in a fixed end (lk = false) or an LK dashpot (lk = true), in a medium
+// of wave speed c (section 9.2): U'' = -(w^2 - i w alpha(x)) / c^2 U integrated by RK4 from the
+// end back to x = 0, where U = A e^{-ikx} + B e^{ikx} gives R = B / A.
+inline double damping_layer_r2(double w, double L, double alpha0, double power, double c,
+                               bool lk) {
+  using C = std::complex<double>;
+  const C I(0, 1);
+  auto k2 = [&](double x) {
+    const double a = alpha0 * std::pow(std::max(x, 0.0) / L, power);
+    return (w * w - I * w * a) / (c * c);
+  };
+  C u = lk ? C(1) : C(0), du = lk ? -I * w / c : C(1);
+  const int n = 1000;
+  const double h = -L / n;
+  for (int s = 0; s < n; ++s) {
+    const double x = L + s * h;
+    auto f = [&](double xx, C uu, C dd, C& fu, C& fd) { fu = dd; fd = -k2(xx) * uu; };
+    C a1, b1, a2, b2, a3, b3, a4, b4;
+    f(x, u, du, a1, b1);
+    f(x + 0.5 * h, u + 0.5 * h * a1, du + 0.5 * h * b1, a2, b2);
+    f(x + 0.5 * h, u + 0.5 * h * a2, du + 0.5 * h * b2, a3, b3);
+    f(x + h, u + h * a3, du + h * b3, a4, b4);
+    u += h / 6 * (a1 + 2. * a2 + 2. * a3 + a4);
+    du += h / 6 * (b1 + 2. * b2 + 2. * b3 + b4);
+  }
+  const double k0 = w / c;
+  const C q = du / (I * k0);
+  return std::norm((u + q) / (u - q));
+}
+
+}  // namespace smpm::testing
