@@ -3,6 +3,7 @@
 // traces OUT/trace_<P|SV>_<angle>.csv.
 //
 //   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N] [--shape bilinear|gimp|bspline]
+//           [--boundary lk|kv|damping] [--delta CELLS] [--band CELLS] [--r0 R]  (the right side of run A)
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -17,7 +18,8 @@ using namespace smpm;
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
-                         "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline]\n");
+                         "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
+                         "[--boundary lk|kv|damping] [--delta CELLS] [--band CELLS] [--r0 R]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -46,6 +48,18 @@ int main(int argc, char** argv) {
       base.taper = std::atoi(argv[i + 1]);
     } else if (a == "--threads") {
       base.threads = std::atoi(argv[i + 1]);
+    } else if (a == "--boundary") {
+      base.boundary = argv[i + 1];
+      if (base.boundary != "lk" && base.boundary != "kv" && base.boundary != "damping") {
+        std::fprintf(stderr, "oblique: --boundary must be lk, kv or damping\n");
+        return 1;
+      }
+    } else if (a == "--delta") {
+      base.delta = std::atof(argv[i + 1]);
+    } else if (a == "--band") {
+      base.band = std::atof(argv[i + 1]);
+    } else if (a == "--r0") {
+      base.r0 = std::atof(argv[i + 1]);
     } else if (a == "--shape") {
       const std::string v = argv[i + 1];
       if (v == "bilinear") base.shape = ShapeKind::Bilinear;
@@ -70,6 +84,12 @@ int main(int argc, char** argv) {
                       : std::string("MPM, 1 particle per cell, MUSL, nodal semi-implicit silent layer "
                                     "a = b = 1, CFL 0.3; extended-domain differencing (div u, curl u: the sampled velocity's div and curl integrated over the steps)");
     if (method == "mpm") j["shape"] = shape_name(base.shape);
+    j["boundary"] = base.boundary;
+    if (base.boundary == "kv") j["kv_delta_cells"] = base.delta;
+    if (base.boundary == "damping") {
+      j["damping_band_cells"] = base.band;
+      j["damping_r0"] = base.r0;
+    }
     j["nu"] = base.nu;
     j["pulse_fwhm_cells"] = base.fwhm;
     j["results"] = nlohmann::ordered_json::array();

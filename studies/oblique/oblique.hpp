@@ -46,6 +46,10 @@ struct Setup {
   int flat = 200;          // half width of the beam's flat top (cells)
   int taper = 60;          // cos^2 taper beyond it (cells)
   smpm::ShapeKind shape = smpm::ShapeKind::Bilinear;  // MPM grid shape functions
+  // The right side of run A: "lk" (dashpots), "kv" (dashpots and springs with `delta` cells),
+  // "damping" (a graded damping band of `band` cells with r0 and power 2, then the dashpots).
+  std::string boundary = "lk";
+  double delta = 40, band = 10, r0 = 1e-3;
 };
 
 struct Result {
@@ -193,7 +197,17 @@ inline Result measure(const Setup& su) {
       b.kind = fem::Boundary::Kind::Dashpot;
       b.curves = {12};
       b.name = "right";
+      if (su.boundary == "kv") b.delta = su.delta * h;
       s.boundaries.push_back(b);
+      if (su.boundary == "damping") {
+        fem::Boundary d;
+        d.kind = fem::Boundary::Kind::Damping;
+        d.curves = {12};
+        d.name = "band";
+        d.width = su.band * h;
+        d.r0 = su.r0;
+        s.boundaries.push_back(d);
+      }
     }
     return std::make_unique<fem::Solver>(s);
   };

@@ -33,7 +33,15 @@ inline Result measure_mpm(const Setup& su) {
     if (silent) {
       SilentBoundary sb;
       sb.layer = s->select_layer("right", 0, cells_x * h, 0, cells_x * h, w.ly * h, 1, 0, h);
+      if (su.boundary == "kv") sb.delta = su.delta * h;
       s->silents.push_back(sb);
+      if (su.boundary == "damping") {
+        DampingLayer dl;
+        dl.layer = s->select_layer("band", 0, cells_x * h, 0, cells_x * h, w.ly * h, 1, 0,
+                                   su.band * h);
+        dl.r0 = su.r0;
+        s->dampers.push_back(dl);
+      }
     }
     s->opt.threads = su.threads;
     s->opt.shape = su.shape;
