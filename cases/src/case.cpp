@@ -126,6 +126,20 @@ ojson parse_text(const std::string& text, const std::string& source) {
     }
     throw CaseError(source + ": invalid JSON at line " + std::to_string(line) + ", column " +
                     std::to_string(col) + ": " + w);
+  } catch (const ojson::out_of_range& e) {
+    // A number beyond the range of a double (e.g. 1e999): name the key being read.
+    const std::string w = e.what();
+    const std::size_t q0 = w.find('\''), q1 = q0 == std::string::npos ? q0 : w.find('\'', q0 + 1);
+    const std::string num = q1 == std::string::npos ? std::string() : w.substr(q0 + 1, q1 - q0 - 1);
+    std::string at = "the case";
+    if (!stack.empty()) {
+      std::string base = path_to("");
+      if (!base.empty() && base.back() == '.') base.pop_back();
+      at = stack.back().object ? path_to(stack.back().key)
+                               : base + "[" + std::to_string(stack.back().index) + "]";
+    }
+    throw CaseError(source + ": " + at + ": number " + (num.empty() ? "" : num + " ") +
+                    "is out of the range of a double (about 1.8e308)");
   }
 }
 
@@ -158,6 +172,9 @@ void apply_override(Ctx& ctx, ojson& doc, const std::string& text) {
     value = ojson::parse(raw);
   } catch (const ojson::parse_error&) {
     value = raw;
+  } catch (const ojson::out_of_range&) {
+    throw CaseError(ctx.source + ": " + where + ": a number in the value is out of the range of a "
+                    "double (about 1.8e308)");
   }
 
   auto bad = [&](const std::string& path, const std::string& what) {
@@ -577,11 +594,13 @@ class Builder {
   std::unique_ptr<Geometry> geo_;  // the "geometry" key (silentmpm/geometry.hpp)
   bool use_cfl_ = false;
   double dt_or_cfl_ = 0;
+  double t_end_ = 0;
 
   void parse_time(Obj t, Case& c) {
     t.allow({"end", "dt", "cfl"});
     c.t_end = t.num("end");
     t.gt("end", c.t_end, 0);
+    t_end_ = c.t_end;
     const bool has_dt = t.has("dt"), has_cfl = t.has("cfl");
     if (has_dt && has_cfl) t.fail("", "give either dt or cfl, not both");
     if (!has_dt && !has_cfl)
@@ -1149,6 +1168,8 @@ class Builder {
                                  " s = h / max c_d (CFL " + fmt(dt / crit) +
                                  " > 1); use dt <= " + fmt_down(crit) + " or set time.cfl");
     }
+    const std::string e = detail::step_count_error(t_end_, dt);
+    if (!e.empty()) ctx_.fail("time", e);
     s_->dt = dt;
     s_->t = 0;
   }

@@ -297,6 +297,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
     t.fail("dt", fmt(dt) + " s is above the FEM stability limit " + fmt_down(crit) +
                      " s (element bound, CFL " + fmt(dt / crit) + " > 1); use dt <= " +
                      fmt_down(crit) + " or set time.cfl");
+  if (const std::string e = step_count_error(c.t_end, std::min(dt, crit)); !e.empty()) t.fail("", e);
   s.set_dt(std::min(dt, crit));
   s.t = 0;
 

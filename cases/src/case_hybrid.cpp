@@ -180,6 +180,7 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
                    fmt_down(c.solver->critical_dt()) + " s and the FEM element bound " +
                    fmt_down(c.fem->critical_dt()) + " s)");
   }
+  if (const std::string e = step_count_error(c.t_end, dt); !e.empty()) ctx.fail("time", e);
   try {
     c.hybrid->set_dt(dt);
   } catch (const HybridError& e) {

@@ -32,6 +32,18 @@ inline std::string fmt_down(double v) {
   return fmt(std::floor(v * scale + 1e-9) / scale);
 }
 
+// A run takes ceil(time.end / dt) steps; beyond kMaxSteps it is refused (a typo in time.end or
+// time.dt, and a count that would overflow the step counter). Empty when the count is fine.
+constexpr double kMaxSteps = 1e10;
+inline std::string step_count_error(double t_end, double dt) {
+  const double n = std::ceil(t_end / dt - 1e-9);
+  if (n <= kMaxSteps) return {};
+  char b[160];
+  std::snprintf(b, sizeof b, "time.end / dt = %.6g s / %.6g s is %.3g steps; at most %.0e are supported",
+                t_end, dt, n, kMaxSteps);
+  return b;
+}
+
 inline std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
   std::string s;
   for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <sstream>
 #include <fstream>
 #include <iomanip>
 #include <stdexcept>
@@ -188,14 +191,32 @@ nlohmann::ordered_json bodies_json(const Case& c, const Solver& s) {
   return a;
 }
 
+// summary.json marks a complete run, so it is written last and whole or not at all: into a
+// temporary file, every write, the flush, fsync and close checked, then renamed. A failure (disk
+// full, an I/O error) removes the temporary file and is an error naming the file and the cause.
 void write_summary(const fs::path& dir, const nlohmann::ordered_json& j) {
-  const fs::path tmp = dir / "summary.json.tmp";
-  {
-    std::ofstream f(tmp);
-    if (!f) throw std::runtime_error((dir / "summary.json").string() + ": cannot write");
-    f << std::setw(2) << j << "\n";
-  }
-  fs::rename(tmp, dir / "summary.json");
+  const fs::path tmp = dir / "summary.json.tmp", dst = dir / "summary.json";
+  auto fail = [&](const std::string& what, int err) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw std::runtime_error(dst.string() + ": " + what + ": " + std::strerror(err));
+  };
+  std::ostringstream text;
+  text << std::setw(2) << j << "\n";
+  const std::string s = text.str();
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) fail("cannot create " + tmp.filename().string(), errno);
+  const bool wrote = std::fwrite(s.data(), 1, s.size(), f) == s.size() && std::fflush(f) == 0;
+  const int werr = errno;
+  const bool synced = wrote && ::fsync(::fileno(f)) == 0;
+  const int serr = errno;
+  const bool closed = std::fclose(f) == 0;
+  if (!wrote) fail("cannot write", werr);
+  if (!synced && serr != EINVAL && serr != EROFS) fail("cannot sync", serr);  // EINVAL: no fsync here
+  if (!closed) fail("cannot close", errno);
+  std::error_code ec;
+  fs::rename(tmp, dst, ec);
+  if (ec) fail("cannot rename " + tmp.filename().string() + " to it", ec.value());
 }
 
 }  // namespace smpm::detail

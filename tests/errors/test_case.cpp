@@ -65,6 +65,16 @@ std::vector<Bad> bad_cases() {
       {"duplicate_key", nullptr, "materials.m.young: key given twice",
        R"({"materials": {"m": {"young": 1, "young": 2}}})"},
       {"not_an_object", nullptr, "must be a JSON object", "[1, 2, 3]"},
+      {"number_overflow", nullptr, "time.end: number 1e999 is out of the range of a double",
+       R"({"grid": {"size": [1, 1], "cell": 0.1}, "time": {"end": 1e999, "cfl": 0.5}})"},
+      {"number_overflow_in_array", nullptr,
+       "grid.size[1]: number -2e400 is out of the range of a double",
+       R"({"grid": {"size": [1, -2e400], "cell": 0.1}})"},
+      {"too_many_steps", [](ojson& j) { j["time"]["end"] = 1e300; },
+       "time: time.end / dt = 1e+300 s"},
+      {"override_number_overflow", nullptr,
+       "override 'time.end=1e999': a number in the value is out of the range of a double", "",
+       {"time.end=1e999"}},
       {"unknown_top_key", [](ojson& j) { j["gird"] = 1; }, "gird: unknown key"},
       {"unknown_body_key", [](ojson& j) { j["bodies"][0]["colour"] = "red"; },
        "bodies[0].colour: unknown key"},
@@ -292,6 +302,25 @@ TEST(CaseCliValid, RunThreadsWithoutSchemeOrOutputSection) {
   EXPECT_EQ(WEXITSTATUS(r3.status), 1);
   EXPECT_NE(r3.err.find("scheme.shape: must be one of \"bilinear\", \"gimp\", \"bspline\""),
             std::string::npos) << r3.err;
+}
+
+// Disk full while writing summary.json (its temporary file is a link to /dev/full): one error
+// naming the file and the cause, exit 1, and no summary.json (nothing that looks complete).
+TEST(CaseCliFaults, DiskFullWritingSummary) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const fs::path file = write_file("disk_full.json", kValid);
+  const fs::path out = scratch() / "disk_full_out";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", out / "summary.json.tmp");
+  const CliResult r = run_cli("run \"" + file.string() + "\" --out \"" + out.string() + "\" --quiet",
+                              "disk_full");
+  EXPECT_EQ(WEXITSTATUS(r.status), 1);
+  EXPECT_NE(r.err.find("summary.json: cannot write: No space left on device"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_FALSE(fs::exists(fs::symlink_status(out / "summary.json.tmp")));
 }
 
 }  // namespace
