@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <iostream>
@@ -29,7 +30,15 @@ int main(int argc, char** argv) {
   run->add_option("--out,-o", out_dir, "Output directory (created if missing)")->required();
   run->add_option("--set", overrides, "Override a case key, e.g. --set grid.cell=0.002 "
                                       "(repeatable; value parsed as JSON)");
-  run->add_option("--threads", threads, "OpenMP threads (default: the case's scheme.threads)");
+  run->add_option("--threads", threads, "OpenMP threads, 0 = all cores (default: the case's "
+                                        "scheme.threads)")
+      ->check([](const std::string& v) -> std::string {
+        char* end = nullptr;
+        const long n = std::strtol(v.c_str(), &end, 10);
+        if (v.empty() || *end != '\0' || n < 0 || n > 4096)
+          return "must be a whole number from 0 (all cores) to 4096, got \"" + v + "\"";
+        return "";
+      });
   std::string shape;
   run->add_option("--shape", shape, "Grid shape functions: bilinear, gimp or bspline (default: "
                                     "the case's scheme.shape)");
@@ -50,7 +59,46 @@ int main(int argc, char** argv) {
   cmp->add_option("--from", t0, "Window start (s)");
   cmp->add_option("--to", t1, "Window end (s)");
 
-  CLI11_PARSE(app, argc, argv);
+  // Command-line errors exit 1, as bad case files do (CLI11's own codes are 100 and more).
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string w = argv[1];
+    const char* known[] = {"run", "check", "compare"};
+    if (std::find(std::begin(known), std::end(known), w) == std::end(known)) {
+      // The nearest command by edit distance, if it is close.
+      auto dist = [](const std::string& a, const std::string& b) {
+        std::vector<std::size_t> d(b.size() + 1);
+        for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
+        for (std::size_t i = 1; i <= a.size() && i <= 64; ++i) {
+          std::size_t prev = d[0];
+          d[0] = i;
+          for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t t = d[j];
+            d[j] = std::min({d[j] + 1, d[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            prev = t;
+          }
+        }
+        return d[b.size()];
+      };
+      std::string best;
+      std::size_t bd = 3;
+      for (const char* k : known)
+        if (dist(w, k) < bd) bd = dist(w, k), best = k;
+      std::fprintf(stderr, "silentmpm: error: unknown command \"%.64s\"%s (commands: run, check, "
+                           "compare; see silentmpm --help)\n",
+                   w.c_str(), best.empty() ? "" : (" (did you mean \"" + best + "\"?)").c_str());
+      return 1;
+    }
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "silentmpm: error: %s (see silentmpm --help)\n", e.what());
+    return 1;
+  }
   try {
     if (*cmp) {
       const auto a = smpm::read_history(a_csv);

@@ -304,6 +304,27 @@ TEST(CaseCliValid, RunThreadsWithoutSchemeOrOutputSection) {
             std::string::npos) << r3.err;
 }
 
+// Command-line mistakes: one line, exit 1 (not CLI11's codes of 100 and more).
+TEST(CaseCliFaults, CommandLineErrors) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path file = write_file("cli_errors.json", kValid);
+  const std::string out = (scratch() / "cli_errors_out").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"run \"" + file.string() + "\" --out " + out + " --threads -3",
+       "--threads: must be a whole number from 0 (all cores) to 4096, got \"-3\""},
+      {"run \"" + file.string() + "\" --out " + out + " --threads four",
+       "--threads: must be a whole number from 0 (all cores) to 4096, got \"four\""},
+      {"chek \"" + file.string() + "\"", "unknown command \"chek\" (did you mean \"check\"?)"},
+      {"run \"" + file.string() + "\"", "--out"},
+  };
+  int k = 0;
+  for (const auto& [args, expect] : cases) {
+    const CliResult r = run_cli(args, "cli_error_" + std::to_string(k++));
+    EXPECT_EQ(WEXITSTATUS(r.status), 1) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(expect), std::string::npos) << args << "\n" << r.err;
+  }
+}
+
 // Disk full while writing summary.json (its temporary file is a link to /dev/full): one error
 // naming the file and the cause, exit 1, and no summary.json (nothing that looks complete).
 TEST(CaseCliFaults, DiskFullWritingSummary) {
