@@ -77,6 +77,7 @@ inline std::size_t edit_distance(const std::string& a, const std::string& b) {
 
 // " (did you mean \"poisson\"?)" when a candidate is close to `word`, else "".
 inline std::string suggestion(const std::string& word, const std::vector<std::string>& candidates) {
+  if (word.size() > 64) return "";  // no name is that long; and the search stays bounded
   std::string best;
   std::size_t best_d = std::max<std::size_t>(2, word.size() / 3) + 1;
   for (const auto& c : candidates) {

@@ -25,7 +25,21 @@ fs::path prepare_output_dir(const std::string& out_dir) {
   fs::create_directories(out_dir, ec);
   if (ec) throw std::runtime_error(out_dir + ": cannot create output directory: " + ec.message());
   const fs::path dir(out_dir);
-  fs::remove(dir / "summary.json", ec);  // its presence marks a complete run
+  // A run owns these names: remove what an earlier run left, so that no stale file sits beside
+  // the new ones (a rerun with fewer or no snapshots). summary.json first: its presence marks a
+  // complete run. Nothing else in the folder is touched.
+  for (const char* f : {"summary.json", "history.csv", "probes.csv",
+                        "particles.h5", "particles.xdmf", "fem.xdmf"}) {
+    fs::remove(dir / f, ec);
+    if (ec) throw std::runtime_error((dir / f).string() + ": cannot remove the earlier run's file: " +
+                                     ec.message());
+  }
+  for (const auto& e : fs::directory_iterator(dir, ec)) {  // FEM snapshots fem_NNNNN.h5
+    const std::string n = e.path().filename().string();
+    if (n.size() == 12 && n.compare(0, 4, "fem_") == 0 && n.compare(9, 3, ".h5") == 0 &&
+        std::all_of(n.begin() + 4, n.begin() + 9, [](char c) { return c >= '0' && c <= '9'; }))
+      fs::remove(e.path(), ec);
+  }
   return dir;
 }
 

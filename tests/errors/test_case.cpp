@@ -65,6 +65,8 @@ std::vector<Bad> bad_cases() {
       {"duplicate_key", nullptr, "materials.m.young: key given twice",
        R"({"materials": {"m": {"young": 1, "young": 2}}})"},
       {"not_an_object", nullptr, "must be a JSON object", "[1, 2, 3]"},
+      {"very_long_unknown_key", [](ojson& j) { j[std::string(100000, 'x')] = 1; },
+       "unknown key"},
       {"number_overflow", nullptr, "time.end: number 1e999 is out of the range of a double",
        R"({"grid": {"size": [1, 1], "cell": 0.1}, "time": {"end": 1e999, "cfl": 0.5}})"},
       {"number_overflow_in_array", nullptr,
@@ -323,6 +325,28 @@ TEST(CaseCliFaults, CommandLineErrors) {
     EXPECT_EQ(WEXITSTATUS(r.status), 1) << args << "\n" << r.err;
     EXPECT_NE(r.err.find(expect), std::string::npos) << args << "\n" << r.err;
   }
+}
+
+// A rerun into the same folder removes what the earlier run wrote and it will own (here its
+// snapshots, which the rerun does not write) and leaves other files alone.
+TEST(CaseCliFaults, RerunLeavesNoStaleOutputs) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path file = write_file("rerun.json", kValid);
+  const fs::path out = scratch() / "rerun_out";
+  fs::remove_all(out);
+  const std::string run = "run \"" + file.string() + "\" --out \"" + out.string() + "\" --quiet";
+  const CliResult a = run_cli(run + " --set output.snapshots=2", "rerun_a");
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_TRUE(fs::exists(out / "particles.h5"));
+  ASSERT_TRUE(fs::exists(out / "particles.xdmf"));
+  std::ofstream(out / "notes.txt") << "mine\n";
+  const CliResult b = run_cli(run, "rerun_b");
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_FALSE(fs::exists(out / "particles.h5"));
+  EXPECT_FALSE(fs::exists(out / "particles.xdmf"));
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+  EXPECT_TRUE(fs::exists(out / "history.csv"));
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
 }
 
 // Disk full while writing summary.json (its temporary file is a link to /dev/full): one error
