@@ -570,6 +570,18 @@ class Builder {
         parse_boundary(Obj(ctx_, (*bnd)[i], index_path("boundaries", i)), i, c);
 
     s_->finalize();
+    // A point probe must see particles (of its body, when it names one): else it would record
+    // zeros all run. (Points along a curve are checked against their bodies when placed.)
+    for (std::size_t q = 0; q < c.probes.size(); ++q) {
+      const ProbeSpec& pr = c.probes[q];
+      if (!pr.along.empty()) continue;
+      const auto smp = s_->sample({{pr.x, pr.y}}, {pr.body});
+      if (!smp[0].valid)
+        ctx_.fail(index_path("probes", probe_doc_[q]) + ".at",
+                  "(" + fmt(pr.x) + ", " + fmt(pr.y) + ") is in no body" +
+                      (pr.body >= 0 ? " named \"" + bodies_[pr.body].name + "\"" : std::string()) +
+                      ": no particle within a cell of it, so it would record zeros");
+    }
     const long out = s_->first_particle_outside();
     if (out >= 0) {
       const auto k = static_cast<std::size_t>(out);
@@ -594,6 +606,7 @@ class Builder {
   std::unique_ptr<Geometry> geo_;  // the "geometry" key (silentmpm/geometry.hpp)
   bool use_cfl_ = false;
   double dt_or_cfl_ = 0;
+  std::vector<std::size_t> probe_doc_;  // document index of each probe in c.probes
   double t_end_ = 0;
 
   void parse_time(Obj t, Case& c) {
@@ -729,6 +742,19 @@ class Builder {
       const auto v = o.nums("velocity", std::vector<double>{0.0, 0.0});
       b.vx = v[0];
       b.vy = v[1];
+      // Two boxes must not overlap (their particles would double the mass there); touching
+      // along an edge is fine (contact). Bodies from gmsh surfaces are separate surfaces.
+      if (b.surface < 0)
+        for (std::size_t k = 0; k < bodies_.size(); ++k) {
+          const BodySpec& a = bodies_[k];
+          if (a.surface >= 0) continue;
+          const double ox = std::min(a.x1, b.x1) - std::max(a.x0, b.x0);
+          const double oy = std::min(a.y1, b.y1) - std::max(a.y0, b.y0);
+          if (ox > tol && oy > tol)
+            o.fail("box", "overlaps body \"" + a.name + "\" (" + index_path("bodies", k) +
+                              ") over " + fmt(ox) + " x " + fmt(oy) +
+                              " m: bodies must not overlap (the mass there would count twice)");
+        }
       o.done();
       bodies_.push_back(b);
     }
@@ -755,7 +781,10 @@ class Builder {
                           ", " + fmt(a.y) + ") ... " + z.name + " (" + fmt(z.x) + ", " + fmt(z.y) +
                           "), every " + fmt(points[1].s - a.s) + " m of arc length");
       }
-      for (auto& pt : points) c.probes.push_back(std::move(pt));
+      for (auto& pt : points) {
+        probe_doc_.push_back(i);
+        c.probes.push_back(std::move(pt));
+      }
     }
   }
 

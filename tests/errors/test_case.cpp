@@ -65,6 +65,14 @@ std::vector<Bad> bad_cases() {
       {"duplicate_key", nullptr, "materials.m.young: key given twice",
        R"({"materials": {"m": {"young": 1, "young": 2}}})"},
       {"not_an_object", nullptr, "must be a JSON object", "[1, 2, 3]"},
+      {"overlapping_bodies",
+       [](ojson& j) {
+         j["bodies"].push_back({{"name", "patch"}, {"material", "tungsten"},
+                                {"box", {0.008, 0.004, 0.01, 0.006}}});
+       },
+       "bodies[1].box: overlaps body \"plate\" (bodies[0]) over 0.002 x 0.001 m"},
+      {"probe_in_no_body", [](ojson& j) { j["probes"][0]["at"] = {0.005, 0.0085}; },
+       "probes[0].at: (0.005, 0.0085) is in no body: no particle within a cell of it"},
       {"very_long_unknown_key", [](ojson& j) { j[std::string(100000, 'x')] = 1; },
        "unknown key"},
       {"number_overflow", nullptr, "time.end: number 1e999 is out of the range of a double",
