@@ -19,6 +19,10 @@ int main(int argc, char** argv) {
       "of Shen & Chen (2005).\nCase files are JSON in SI units; every key is documented in "
       "docs/case-reference.md."};
   app.require_subcommand(1);
+#ifndef SMPM_VERSION
+#define SMPM_VERSION "unknown"
+#endif
+  app.set_version_flag("--version,-V", std::string("silentmpm ") + SMPM_VERSION);
   std::vector<std::string> overrides;
   std::string case_path, out_dir;
   int threads = -1;
@@ -94,6 +98,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "silentmpm: error: %s (see silentmpm --help)\n", e.what());

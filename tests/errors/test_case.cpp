@@ -327,6 +327,9 @@ TEST(CaseCliFaults, CommandLineErrors) {
       {"chek \"" + file.string() + "\"", "unknown command \"chek\" (did you mean \"check\"?)"},
       {"run \"" + file.string() + "\"", "--out"},
   };
+  const CliResult v = run_cli("--version", "cli_version");
+  EXPECT_EQ(WEXITSTATUS(v.status), 0) << v.err;
+  EXPECT_EQ(v.out.rfind("silentmpm 0.", 0), 0u) << v.out;
   int k = 0;
   for (const auto& [args, expect] : cases) {
     const CliResult r = run_cli(args, "cli_error_" + std::to_string(k++));
