@@ -614,13 +614,18 @@ void Solver::grid_update() {
   const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
   const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
   double* ux = grid.vnx.data(); double* uy = grid.vny.data();
-#pragma omp parallel for schedule(static) num_threads(nthreads_)
+  // Health check at no extra pass: a NaN or Inf anywhere in the particles' mass, momentum or
+  // stress reaches the nodes' updated velocities this step (x - x is 0 only for finite x).
+  int bad = 0;
+#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
   for (long i = 0; i < n; ++i) {
     const double mi = m[i];
     if (mi <= floor) { ux[i] = 0; uy[i] = 0; continue; }
     ux[i] = (fix[i] & 1) ? 0.0 : vx[i] + DT * fx[i] / mi;
     uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * fy[i] / mi;
+    bad |= !(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0);
   }
+  if (bad) fail_nonfinite();
   if (!has_nodal_dashpot_) return;
   for (long i : dashpot_nodes_) {
     if (m[i] <= floor) continue;
@@ -783,6 +788,24 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
 
 // The passes that move particles count, per strip, the particles outside the grid's columns and
 // track the rows; no extra pass over the particles is needed unless one has left.
+// The first node whose updated velocity is not finite, named with the step, the time and the
+// node's position; the run stops there.
+void Solver::fail_nonfinite() const {
+  for (long i = 0; i < static_cast<long>(grid.nodes()); ++i) {
+    if (std::isfinite(grid.vnx[i]) && std::isfinite(grid.vny[i])) continue;
+    const long ii = i % grid.nnx, jj = i / grid.nnx;
+    std::ostringstream o;
+    o << "non-finite velocity at step " << steps + 1 << " (t = " << t + dt << " s) at grid node ("
+      << ii << ", " << jj << "), position (" << grid.x0 + ii * grid.h << ", " << grid.y0 + jj * grid.h
+      << "): mass " << grid.m[i] << ", force (" << grid.fx[i] << ", " << grid.fy[i]
+      << "); the run is unstable (reduce time.cfl or time.dt) or a load or material value is not "
+         "finite";
+    throw std::runtime_error(o.str());
+  }
+  throw std::runtime_error("non-finite velocity at step " + std::to_string(steps + 1) +
+                           ": the run is unstable");
+}
+
 void Solver::check_outside() {
   bool bad = false;
   for (int s = 0; s < nstrips_; ++s)

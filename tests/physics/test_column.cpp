@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include "common.hpp"
 #include "absorbing_oracles.hpp"
@@ -416,6 +418,31 @@ TEST(DampingLayer, ReflectionMatchesContinuum) {
     if (end == End::Fixed) {
       EXPECT_LT(ratio, last);
       last = ratio;
+    }
+  }
+}
+
+// ---- Health check: a NaN or Inf stops the run within the step it reaches the grid ----
+TEST(HealthCheck, NonFiniteStopsWithinOneStep) {
+  for (int what = 0; what < 3; ++what) {
+    ColumnSpec c;
+    c.cells = 40;
+    c.fn = sin2_pulse(16 * c.h / 5918.5, 8 * c.h / 5918.5);
+    auto s = make_column(c);
+    for (int i = 0; i < 20; ++i) s->step();
+    const std::size_t k = s->p.size() / 2;
+    if (what == 0) s->p.sxx[k] = std::nan("");
+    if (what == 1) s->p.vx[k] = std::numeric_limits<double>::infinity();
+    if (what == 2) s->p.mass[k] = std::nan("");
+    const long before = s->steps;
+    try {
+      s->step();
+      FAIL() << "no error (case " << what << ")";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("non-finite velocity at step " + std::to_string(before + 1)),
+                std::string::npos) << m;
+      EXPECT_NE(m.find("at grid node ("), std::string::npos) << m;
     }
   }
 }

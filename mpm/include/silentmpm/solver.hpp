@@ -170,6 +170,7 @@ class Solver {
   void begin_moving_pass();
   void merge_rows(int strip, const RowSpan& r);
   void check_outside();
+  [[noreturn]] void fail_nonfinite() const;
   long outside_ = -1;  // index of a particle that left the grid in the last pass
 };
 
