@@ -5,10 +5,12 @@
 //   reset grid
 //   p2g            masses, momenta (USL, MUSL: and internal forces)         -> after_momentum
 //   [USF: nodal velocities, stress update, p2g of the internal forces]
-//   loads          tractions and silent-layer dashpots of boundary particles -> after_forces
-//   grid update    v+ = v + dt f / m (semi-implicit on nodes with a dashpot block), constraints
-//                                                                           -> after_grid_update
-//   boundary work  work of tractions, energy absorbed by dashpots           -> before_g2p
+//   loads          tractions, silent-layer dashpots and Kelvin-Voigt springs of boundary
+//                  particles, damping bands, gravity                       -> after_forces
+//   grid update    v+ = v + dt f / m (semi-implicit on nodes with a dashpot block), constraints;
+//                  a non-finite velocity stops the run here                -> after_grid_update
+//   boundary work  work of tractions and gravity, energy absorbed by dashpots and bands
+//                                                                           -> before_g2p
 //   g2p            particle velocities (FLIP/PIC); MUSL re-maps the momenta -> after_remap
 //   stress         velocity gradient -> strain increment -> material update; positions advance
 //   clock          t += dt; particles still on the grid?                   -> end_of_step
