@@ -26,6 +26,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <set>
+#include <fstream>
 #include <sstream>
 
 #include "fem_impl.hpp"
@@ -41,8 +42,40 @@ struct Deal {
   DoFHandler<2> dofh;
   MappingQ<2> mapping{1};
   std::vector<XDMFEntry> xdmf;
+  std::vector<double> xdmf_times;  // each entry's time, written with full precision (below)
   Deal() : dofh(tria) {}
 };
+
+// deal.II writes the XDMF time values with 6 digits, the particles' file with 10: a reader
+// then pairs an FE snapshot with the wrong particle one. Rewrite them as the particles' file
+// does (%.9e), in order, through a temporary file and a rename.
+static void rewrite_xdmf_times(const std::string& path, const std::vector<double>& times) {
+  std::ifstream in(path);
+  std::stringstream buf;
+  buf << in.rdbuf();
+  std::string text = buf.str(), outtext;
+  const std::string key = "<Time Value=\"";
+  std::size_t pos = 0, k = 0;
+  while (true) {
+    const std::size_t a = text.find(key, pos);
+    if (a == std::string::npos || k >= times.size()) break;
+    const std::size_t b = text.find('"', a + key.size());
+    if (b == std::string::npos) break;
+    char v[40];
+    std::snprintf(v, sizeof v, "%.9e", times[k++]);
+    outtext += text.substr(pos, a + key.size() - pos) + v;
+    pos = b;
+  }
+  outtext += text.substr(pos);
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream o(tmp);
+    o << outtext;
+    o.flush();
+    if (!o) throw std::runtime_error(path + ": cannot write");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename");
+}
 
 Solver::Impl::Impl() = default;
 Solver::Impl::~Impl() = default;
@@ -576,7 +609,10 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   try {
     out.write_hdf5_parallel(filter, (fs::path(dir) / h5).string(), MPI_COMM_WORLD);
     d.xdmf.push_back(out.create_xdmf_entry(filter, h5, t, MPI_COMM_WORLD));
-    out.write_xdmf_file(d.xdmf, (fs::path(dir) / (base + ".xdmf")).string(), MPI_COMM_WORLD);
+    d.xdmf_times.push_back(t);
+    const std::string path = (fs::path(dir) / (base + ".xdmf")).string();
+    out.write_xdmf_file(d.xdmf, path, MPI_COMM_WORLD);
+    rewrite_xdmf_times(path, d.xdmf_times);
   } catch (const std::exception& e) {
     throw FemError(dir + ": cannot write the FEM snapshot: " + deal_message(e));
   }

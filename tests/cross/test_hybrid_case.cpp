@@ -8,6 +8,8 @@
 #include <string>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "silentmpm/case.hpp"
@@ -48,6 +50,20 @@ TEST(HybridCase, PlateAllMpmHybridAllFemAgree) {
       EXPECT_EQ(s["outputs"]["fem_snapshots"].get<int>(), 3);
       EXPECT_TRUE(fs::exists(out / "fem.xdmf"));
       EXPECT_TRUE(fs::exists(out / "particles.xdmf"));
+      // Both files give each snapshot the same time, digit for digit (so a reader pairs them).
+      auto times = [](const fs::path& p) {
+        std::ifstream in(p);
+        std::stringstream b;
+        b << in.rdbuf();
+        const std::string t = b.str(), key = "<Time Value=\"";
+        std::vector<std::string> v;
+        for (std::size_t a = t.find(key); a != std::string::npos; a = t.find(key, a + 1))
+          v.push_back(t.substr(a + key.size(), t.find('"', a + key.size()) - a - key.size()));
+        return v;
+      };
+      const auto tf = times(out / "fem.xdmf"), tp = times(out / "particles.xdmf");
+      EXPECT_EQ(tf.size(), 3u);
+      EXPECT_EQ(tf, tp);
       EXPECT_EQ(c.probes[0].fem_index, -1);  // A in the particles
       EXPECT_EQ(c.probes[1].fem_index, 0);   // B in the elements
     }
