@@ -66,30 +66,12 @@ int main(int argc, char** argv) {
   // Command-line errors exit 1, as bad case files do (CLI11's own codes are 100 and more).
   if (argc > 1 && argv[1][0] != '-') {
     const std::string w = argv[1];
-    const char* known[] = {"run", "check", "compare"};
-    if (std::find(std::begin(known), std::end(known), w) == std::end(known)) {
-      // The nearest command by edit distance, if it is close.
-      auto dist = [](const std::string& a, const std::string& b) {
-        std::vector<std::size_t> d(b.size() + 1);
-        for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
-        for (std::size_t i = 1; i <= a.size() && i <= 64; ++i) {
-          std::size_t prev = d[0];
-          d[0] = i;
-          for (std::size_t j = 1; j <= b.size(); ++j) {
-            const std::size_t t = d[j];
-            d[j] = std::min({d[j] + 1, d[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
-            prev = t;
-          }
-        }
-        return d[b.size()];
-      };
-      std::string best;
-      std::size_t bd = 3;
-      for (const char* k : known)
-        if (dist(w, k) < bd) bd = dist(w, k), best = k;
+    const std::vector<std::string> known = {"run", "check", "compare"};
+    if (std::find(known.begin(), known.end(), w) == known.end()) {
+      const std::string hint = smpm::did_you_mean(w, known);
       std::fprintf(stderr, "silentmpm: error: unknown command \"%.64s\"%s (commands: run, check, "
                            "compare; see silentmpm --help)\n",
-                   w.c_str(), best.empty() ? "" : (" (did you mean \"" + best + "\"?)").c_str());
+                   w.c_str(), hint.c_str());
       return 1;
     }
   }

@@ -1218,6 +1218,10 @@ Case build_ordered(const Ctx& ctx, const ojson& doc) {
 
 }  // namespace
 
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
+  return detail::suggestion(word, candidates);
+}
+
 Case load_case(const std::string& path, const std::vector<std::string>& overrides) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))

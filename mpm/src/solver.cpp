@@ -473,22 +473,24 @@ static inline void traction_of(const TractionLoad& tl, std::size_t q, double f, 
   ty = f * (tl.normal * ny + tl.tangential * nx + tl.vy);
 }
 
+// The traction -[a (u.n) n + b (u - (u.n) n)] of a normal / tangential pair of coefficients.
+static inline void normal_tangential(double a, double b, double nx, double ny, double ux,
+                                     double uy, double& tx, double& ty) {
+  const double un = ux * nx + uy * ny;
+  tx = -(a * un * nx + b * (ux - un * nx));
+  ty = -(a * un * ny + b * (uy - un * ny));
+}
+
 // LK dashpot traction for velocity (ux, uy) on particle q of layer sl (Eq. 21).
 static inline void dashpot_of(const SilentBoundary& sl, std::size_t q, double ux, double uy,
                               double& tx, double& ty) {
-  const double nx = sl.layer.nx[q], ny = sl.layer.ny[q];
-  const double vn = ux * nx + uy * ny;
-  tx = -(sl.zn[q] * vn * nx + sl.zt[q] * (ux - vn * nx));
-  ty = -(sl.zn[q] * vn * ny + sl.zt[q] * (uy - vn * ny));
+  normal_tangential(sl.zn[q], sl.zt[q], sl.layer.nx[q], sl.layer.ny[q], ux, uy, tx, ty);
 }
 
 // Kelvin-Voigt spring traction on particle q of layer sl for its displacement (ux, uy).
 static inline void spring_of(const SilentBoundary& sl, std::size_t q, double ux, double uy,
                              double& tx, double& ty) {
-  const double nx = sl.layer.nx[q], ny = sl.layer.ny[q];
-  const double un = ux * nx + uy * ny;
-  tx = -(sl.kn[q] * un * nx + sl.kt[q] * (ux - un * nx));
-  ty = -(sl.kn[q] * un * ny + sl.kt[q] * (uy - un * ny));
+  normal_tangential(sl.kn[q], sl.kt[q], sl.layer.nx[q], sl.layer.ny[q], ux, uy, tx, ty);
 }
 
 // A Kelvin-Voigt spring's displacement advances with the grid velocity (vx, vy) at its anchor,

@@ -67,6 +67,10 @@ struct Case {
 // string if it is not valid JSON) applied before validation; array elements by index
 // ("bodies.0.particles_per_cell=4").
 Case load_case(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// " (did you mean \"check\"?)" when one of the candidates is close to word, else "" (the
+// suggestion every case error gives, for the command line's use too).
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
 // Same from an already parsed document; `source` names it in messages.
 Case build_case(const nlohmann::json& doc, const std::string& source);
 
