@@ -18,6 +18,9 @@ int main(int argc, char** argv) {
       "silentmpm - explicit 2D plane-strain MPM with the Lysmer-Kuhlemeyer silent boundary layer "
       "of Shen & Chen (2005).\nCase files are JSON in SI units; every key is documented in "
       "docs/case-reference.md."};
+  app.footer("Exit status: 0 success; 1 bad input (case file, command line, restart file); "
+             "2 the run failed (instability, I/O error: DIR/RUN_INCOMPLETE says why); "
+             "3 interrupted by SIGINT/SIGTERM (a checkpoint was written: continue with --restart).");
   app.require_subcommand(1);
 #ifndef SMPM_VERSION
 #define SMPM_VERSION "unknown"
@@ -47,6 +50,10 @@ int main(int argc, char** argv) {
   run->add_option("--shape", shape, "Grid shape functions: bilinear, gimp or bspline (default: "
                                     "the case's scheme.shape)");
   run->add_flag("--quiet,-q", quiet, "No progress line");
+  std::string restart;
+  run->add_option("--restart", restart, "Continue from a checkpoint (DIR/checkpoint.smpm) of this "
+                                        "case, written by output.checkpoint_every/_time or an "
+                                        "interrupt");
 
   auto* check = app.add_subcommand("check", "Validate a case file without running it and "
                                             "print what it would run");
@@ -116,6 +123,8 @@ int main(int argc, char** argv) {
     if (*run && quiet) setting("output", "progress", "false");
     overrides.insert(overrides.begin(), cli.begin(), cli.end());
     smpm::Case c = smpm::load_case(case_path, overrides);
+    smpm::RunOptions ropt;
+    ropt.restart = restart;
     if (!c.solver && c.fem) {  // FEM-only case
       const smpm::fem::Solver& f = *c.fem;
       if (*check) {
@@ -127,7 +136,7 @@ int main(int argc, char** argv) {
         for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
         return 0;
       }
-      const auto r = smpm::run_case(c, out_dir);
+      const auto r = smpm::run_case(c, out_dir, ropt);
       if (!quiet)
         std::printf("%s: %ld steps, %zu dofs, %.2f s, %.3g dof-updates/s -> %s\n",
                     case_path.c_str(), r.steps, r.dofs, r.wall_seconds, r.dof_updates_per_second,
@@ -147,12 +156,18 @@ int main(int argc, char** argv) {
       for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
       return 0;
     }
-    const auto r = smpm::run_case(c, out_dir);
+    const auto r = smpm::run_case(c, out_dir, ropt);
     if (!quiet)
       std::printf("%s: %ld steps, %zu particles, %.2f s, %.3g particle-updates/s -> %s\n",
                   case_path.c_str(), r.steps, s.p.size(), r.wall_seconds,
                   r.particle_updates_per_second, out_dir.c_str());
     return 0;
+  } catch (const smpm::RunInterrupted& e) {
+    std::fprintf(stderr, "silentmpm: %s\n", e.what());
+    return 3;
+  } catch (const smpm::RunFailure& e) {
+    std::fprintf(stderr, "silentmpm: error: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "silentmpm: error: %s\n", e.what());
     return 1;

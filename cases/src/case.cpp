@@ -50,6 +50,7 @@ using detail::as_number;
 using detail::as_numbers;
 using detail::as_string;
 using detail::Ctx;
+using detail::parse_output_section;
 using detail::fmt;
 using detail::fmt_down;
 using detail::index_path;
@@ -668,14 +669,7 @@ class Builder {
   }
 
   void parse_output(Obj o, OutputSpec& out) {
-    o.allow({"history_every", "snapshots", "progress"});
-    out.history_every = o.integer("history_every", 1);
-    o.ge("history_every", static_cast<double>(out.history_every), 1);
-    const long snaps = o.integer("snapshots", 10);
-    o.ge("snapshots", static_cast<double>(snaps), 0);
-    o.le("snapshots", static_cast<double>(snaps), 1000000);
-    out.snapshots = static_cast<int>(snaps);
-    out.progress = o.boolean("progress", true);
+    parse_output_section(o, out, 1000000);
     o.done();
   }
 
@@ -1234,13 +1228,17 @@ Case load_case(const std::string& path, const std::vector<std::string>& override
   Ctx ctx{path, {}};
   ojson doc = parse_text(ss.str(), path);
   for (const auto& o : overrides) apply_override(ctx, doc, o);
-  return build_ordered(ctx, doc);
+  Case c = build_ordered(ctx, doc);
+  c.fingerprint = detail::case_fingerprint(doc);
+  return c;
 }
 
 Case build_case(const nlohmann::json& doc, const std::string& source) {
   Ctx ctx{source, {}};
   const ojson ordered(doc);  // nlohmann::json keeps keys sorted; material groups follow that order
-  return build_ordered(ctx, ordered);
+  Case c = build_ordered(ctx, ordered);
+  c.fingerprint = detail::case_fingerprint(ordered);
+  return c;
 }
 
 // Shared with case_fem.cpp and case_hybrid.cpp (the FEM sections use the same material and

@@ -124,14 +124,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   // output
   if (top.has("output")) {
     Obj o = top.obj("output");
-    o.allow({"history_every", "snapshots", "progress"});
-    c.output.history_every = o.integer("history_every", 1);
-    o.ge("history_every", static_cast<double>(c.output.history_every), 1);
-    const long snaps = o.integer("snapshots", 10);
-    o.ge("snapshots", static_cast<double>(snaps), 0);
-    o.le("snapshots", static_cast<double>(snaps), 100000);
-    c.output.snapshots = static_cast<int>(snaps);
-    c.output.progress = o.boolean("progress", true);
+    parse_output_section(o, c.output, 100000);
   }
 
   // materials

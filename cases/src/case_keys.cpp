@@ -1,5 +1,8 @@
 #include "case_keys.hpp"
 
+#include "silentmpm/case.hpp"
+#include "silentmpm/state_io.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -147,6 +150,34 @@ void Obj::lt(const std::string& key, double v, double hi) const {
 }
 void Obj::le(const std::string& key, double v, double hi) const {
   if (!(v <= hi)) fail(key, "must be <= " + fmt(hi) + ", got " + fmt(v));
+}
+
+void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots) {
+  o.allow({"history_every", "snapshots", "progress", "checkpoint_every", "checkpoint_time"});
+  out.history_every = o.integer("history_every", 1);
+  o.ge("history_every", static_cast<double>(out.history_every), 1);
+  const long snaps = o.integer("snapshots", 10);
+  o.ge("snapshots", static_cast<double>(snaps), 0);
+  o.le("snapshots", static_cast<double>(snaps), static_cast<double>(max_snapshots));
+  out.snapshots = static_cast<int>(snaps);
+  out.progress = o.boolean("progress", true);
+  if (o.has("checkpoint_every") && o.has("checkpoint_time"))
+    o.fail("checkpoint_time", "give checkpoint_every (steps) or checkpoint_time (seconds), not both");
+  out.checkpoint_every = o.integer("checkpoint_every", 0);
+  o.ge("checkpoint_every", static_cast<double>(out.checkpoint_every), 0);
+  out.checkpoint_time = o.num("checkpoint_time", 0.0);
+  o.ge("checkpoint_time", out.checkpoint_time, 0);
+}
+
+std::uint64_t case_fingerprint(const ojson& doc) {
+  nlohmann::json d(doc);  // keys sorted: the same document gives the same text
+  if (d.is_object()) {
+    d.erase("output");
+    if (d.contains("time") && d["time"].is_object()) d["time"].erase("end");
+    if (d.contains("scheme") && d["scheme"].is_object()) d["scheme"].erase("threads");
+  }
+  const std::string text = d.dump();
+  return fnv1a64(text.data(), text.size());
 }
 
 }  // namespace smpm::detail

@@ -4,11 +4,16 @@
 // overrides set; every error goes through Ctx::fail, so that a bad value set by an override says
 // so ("(value set by override '...')") in every section. Obj wraps one JSON object at its key
 // path: typed getters with defaults, range checks, unknown keys rejected.
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
+
+namespace smpm {
+struct OutputSpec;
+}
 
 namespace smpm::detail {
 
@@ -107,5 +112,12 @@ class Obj {
   Dialect dialect_;
   std::set<std::string> read_;
 };
+
+// The "output" section of every kind of case (the keys in docs/case-reference.md "output").
+void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots);
+
+// The case's fingerprint for checkpoints: a hash of the whole document as validated (overrides
+// applied) except the keys a restart may change (output.*, time.end, scheme.threads).
+std::uint64_t case_fingerprint(const ojson& doc);
 
 }  // namespace smpm::detail

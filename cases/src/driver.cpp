@@ -1,14 +1,24 @@
-// The run loop: one for every case, over the region the case advances (run_loop.hpp).
+// The run loop: one for every case, over the region the case advances (run_loop.hpp), with its
+// checkpoints, restarts and clean interrupts.
 #include "silentmpm/driver.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "driver_common.hpp"
 #include "run_loop.hpp"
 #include "silentmpm/output.hpp"
+#include "silentmpm/state_io.hpp"
+
+#ifndef SMPM_VERSION
+#define SMPM_VERSION "unknown"
+#endif
 
 namespace smpm {
 
@@ -17,65 +27,217 @@ using detail::seconds_since;
 
 namespace {
 
-RunResult run_region(const Case& c, detail::Region& region, const std::string& out_dir) {
-  namespace fs = std::filesystem;
-  const fs::path dir = detail::prepare_output_dir(out_dir);
-  region.prepare(out_dir);
+namespace fs = std::filesystem;
 
-  const std::vector<std::string> cols = detail::history_columns(c.probes);
-  detail::write_probe_table(dir, c.probes);
-  HistoryWriter hist;
-  hist.open((dir / "history.csv").string(), cols);
-  std::vector<double> row(cols.size());
-  auto record = [&]() {
-    region.record(row);
-    hist.row(region.time(), row);
-  };
+// SIGINT / SIGTERM: the handler only records the signal; the loop stops after the step it is in.
+// The handler is one-shot (SA_RESETHAND), so a second signal stops the process at once.
+volatile std::sig_atomic_t g_signal = 0;
+extern "C" void on_stop_signal(int sig) { g_signal = sig; }
 
+class SignalGuard {
+ public:
+  SignalGuard() {
+    g_signal = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND | SA_RESTART;
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~SignalGuard() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  SignalGuard(const SignalGuard&) = delete;
+  SignalGuard& operator=(const SignalGuard&) = delete;
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+std::string read_whole(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw std::runtime_error(p.string() + ": cannot read it back");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string hex(std::uint64_t v) {
+  char b[20];
+  std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(v));
+  return b;
+}
+
+// Checks a checkpoint's run record against this case and restores the region. Returns the step
+// it continues from and the history text written before it.
+long restore_run(const Case& c, detail::Region& region, const std::string& file,
+                 std::string& history, std::string& note) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) throw StateError(file + ": no such checkpoint file");
+  const std::string bytes = read_whole(file);
+  StateReader r(bytes, file);
+  const std::string version = r.get_string("run.version");
+  if (version != SMPM_VERSION)
+    r.fail("written by silentmpm " + version + ", this is " + SMPM_VERSION +
+           " (a checkpoint is read by the version that wrote it)");
+  const std::string kind = r.get_string("run.kind");
+  if (kind != region.kind())
+    r.fail("a checkpoint of an " + kind + " run, this case is an " + region.kind() + " run");
+  const std::uint64_t fp = r.get<std::uint64_t>("run.fingerprint");
+  if (fp != c.fingerprint)
+    r.fail("written for another case (" + r.get_string("run.case") + ", fingerprint " + hex(fp) +
+           "; this case " + hex(c.fingerprint) + "): only output.*, time.end and scheme.threads "
+           "may change between a run and its restart");
+  history = r.get_string("run.history");
+  const long step = static_cast<long>(r.get<std::int64_t>("run.step"));
+  const int threads = r.get<std::int32_t>("run.threads");
+  const bool same_order = region.restore(r);
+  if (region.steps() != step) r.fail("step counts disagree (corrupt checkpoint)");
+  if (!same_order || threads != region.threads())
+    note = "note: continuing on " + std::to_string(region.threads()) + " thread(s); the checkpoint "
+           "was written on " + std::to_string(threads) + ", so sums run in another order and the "
+           "history differs from an uninterrupted run in round-off";
+  return step;
+}
+
+void write_checkpoint(const Case& c, const detail::Region& region, const fs::path& dir,
+                      HistoryWriter& hist) {
+  hist.flush();
+  StateWriter w;
+  w.put_string("run.version", SMPM_VERSION);
+  w.put_string("run.kind", region.kind());
+  w.put_string("run.case", c.source);
+  w.put("run.fingerprint", c.fingerprint);
+  w.put("run.step", static_cast<std::int64_t>(region.steps()));
+  w.put("run.threads", static_cast<std::int32_t>(region.threads()));
+  w.put_string("run.history", read_whole(dir / "history.csv"));
+  region.save(w);
+  detail::write_file_atomically(dir / checkpoint_file_name(), w.bytes());
+}
+
+// DIR/RUN_INCOMPLETE: why the run stopped and how far it came (no summary.json is written).
+void mark_incomplete(const fs::path& dir, const std::string& why) {
+  try {
+    detail::write_file_atomically(dir / "RUN_INCOMPLETE", why + "\n");
+  } catch (const std::exception&) {
+    // The run's own error is the one to report.
+  }
+}
+
+RunResult run_region(const Case& c, detail::Region& region, const std::string& out_dir,
+                     const RunOptions& opt) {
+  std::string history, note;
+  const long first = opt.restart.empty() ? 0 : restore_run(c, region, opt.restart, history, note);
+  const bool resuming = !opt.restart.empty();
   const long nsteps = std::max(1L, static_cast<long>(std::ceil(c.t_end / region.dt() - 1e-9)));
-  long snap_every = 0;
-  if (c.output.snapshots > 0) {
-    snap_every = std::max(1L, nsteps / c.output.snapshots);
-    region.open_snapshots(out_dir);
+  if (first >= nsteps)
+    throw StateError(opt.restart + ": the checkpoint is at step " + std::to_string(first) +
+                     ", the case ends at step " + std::to_string(nsteps) +
+                     ": nothing left to run (raise time.end to continue)");
+  fs::path dir;
+  try {
+    dir = detail::prepare_output_dir(out_dir, resuming);
+  } catch (const std::exception& e) {
+    throw RunFailure(e.what());
   }
-  const long hist_every = std::max(1L, c.output.history_every);
+  if (!note.empty()) std::fprintf(stderr, "%s\n", note.c_str());
+  SignalGuard signals;
+  try {
+    region.prepare(out_dir, resuming);
 
-  const auto t_start = Clock::now();
-  double step_seconds = 0;
-  detail::Progress prog(c.output.progress, nsteps, region.progress_eta(), t_start);
-  record();
-  if (snap_every) region.write_snapshot(out_dir);
-  for (long n = 1; n <= nsteps; ++n) {
-    const auto t0 = Clock::now();
-    region.step();
-    step_seconds += seconds_since(t0);
-    if (n % hist_every == 0 || n == nsteps) record();
-    if (snap_every && (n % snap_every == 0 || n == nsteps)) region.write_snapshot(out_dir);
-    prog.update(n);
+    const std::vector<std::string> cols = detail::history_columns(c.probes);
+    detail::write_probe_table(dir, c.probes);
+    HistoryWriter hist;
+    if (resuming) hist.resume((dir / "history.csv").string(), cols, history);
+    else hist.open((dir / "history.csv").string(), cols);
+    std::vector<double> row(cols.size());
+    auto record = [&]() {
+      region.record(row);
+      hist.row(region.time(), row);
+    };
+
+    long snap_every = 0;
+    if (c.output.snapshots > 0) {
+      snap_every = std::max(1L, nsteps / c.output.snapshots);
+      region.open_snapshots(out_dir);
+    }
+    const long hist_every = std::max(1L, c.output.history_every);
+    // Checkpoints every ck_steps steps, or each time the clock passes a multiple of ck_time.
+    const long ck_steps = c.output.checkpoint_every;
+    const double ck_time = c.output.checkpoint_time;
+    auto checkpoint_due = [&](long n, double t_before, double t_after) {
+      if (n >= nsteps) return false;  // the run completes: no checkpoint needed
+      if (ck_steps > 0) return n % ck_steps == 0;
+      if (ck_time > 0) return std::floor(t_after / ck_time + 1e-9) > std::floor(t_before / ck_time + 1e-9);
+      return false;
+    };
+
+    const auto t_start = Clock::now();
+    double step_seconds = 0;
+    detail::Progress prog(c.output.progress, nsteps, region.progress_eta(), t_start, first);
+    if (!resuming) {
+      record();
+      if (snap_every) region.write_snapshot(out_dir);
+    }
+    for (long n = first + 1; n <= nsteps; ++n) {
+      const double t_before = region.time();
+      const auto t0 = Clock::now();
+      region.step();
+      step_seconds += seconds_since(t0);
+      if (n % hist_every == 0 || n == nsteps) record();
+      if (snap_every && (n % snap_every == 0 || n == nsteps)) region.write_snapshot(out_dir);
+      if (g_signal != 0 && n < nsteps) {
+        const char* name = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
+        write_checkpoint(c, region, dir, hist);
+        hist.close();
+        region.finish();
+        std::ostringstream why;
+        why << "interrupted by " << name << " after step " << n << " of " << nsteps
+            << " (t = " << region.time() << " s); checkpoint " << (dir / checkpoint_file_name()).string()
+            << "; continue with: silentmpm run " << c.source << " --out " << out_dir
+            << " --restart " << (dir / checkpoint_file_name()).string();
+        mark_incomplete(dir, why.str());
+        throw RunInterrupted(why.str());
+      }
+      if (checkpoint_due(n, t_before, region.time())) write_checkpoint(c, region, dir, hist);
+      prog.update(n);
+    }
+    hist.close();
+    region.finish();
+
+    RunResult r;
+    r.steps = nsteps;
+    r.wall_seconds = seconds_since(t_start);
+    region.rates(r, nsteps - first, step_seconds);
+
+    nlohmann::ordered_json j =
+        detail::summary_head(c, r, region.dt(), region.time(), region.cfl(), step_seconds);
+    region.summary(j, r, snap_every != 0);
+    if (resuming)
+      j["restart"] = {{"checkpoint", opt.restart}, {"from_step", first}};
+    detail::write_summary(dir, j);
+    return r;
+  } catch (const RunInterrupted&) {
+    throw;
+  } catch (const HybridError& e) {  // a guard of the coupling that only a step finds: bad input
+    mark_incomplete(dir, std::string("failed: ") + e.what());
+    throw;
+  } catch (const std::exception& e) {
+    mark_incomplete(dir, std::string("failed: ") + e.what());
+    throw RunFailure(e.what());
   }
-  hist.close();
-  region.finish();
-
-  RunResult r;
-  r.steps = nsteps;
-  r.wall_seconds = seconds_since(t_start);
-  region.rates(r, step_seconds);
-
-  nlohmann::ordered_json j =
-      detail::summary_head(c, r, region.dt(), region.time(), region.cfl(), step_seconds);
-  region.summary(j, r, snap_every != 0);
-  detail::write_summary(dir, j);
-  return r;
 }
 
 }  // namespace
 
-RunResult run_case(Case& c, const std::string& out_dir) {
+RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt) {
   const std::unique_ptr<detail::Region> region =
       c.hybrid     ? detail::hybrid_region(c)
       : c.solver   ? detail::mpm_region(c)
                    : detail::fem_region(c);
-  return run_region(c, *region, out_dir);
+  return run_region(c, *region, out_dir, opt);
 }
 
 }  // namespace smpm

@@ -20,7 +20,7 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-fs::path prepare_output_dir(const std::string& out_dir) {
+fs::path prepare_output_dir(const std::string& out_dir, bool resuming) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) throw std::runtime_error(out_dir + ": cannot create output directory: " + ec.message());
@@ -28,19 +28,59 @@ fs::path prepare_output_dir(const std::string& out_dir) {
   // A run owns these names: remove what an earlier run left, so that no stale file sits beside
   // the new ones (a rerun with fewer or no snapshots). summary.json first: its presence marks a
   // complete run. Nothing else in the folder is touched.
-  for (const char* f : {"summary.json", "history.csv", "probes.csv",
-                        "particles.h5", "particles.xdmf", "fem.xdmf"}) {
+  std::vector<const char*> owned = {"summary.json", "RUN_INCOMPLETE", "history.csv", "probes.csv"};
+  // A restart keeps the snapshots (trimmed to the checkpoint later) and the checkpoint it read
+  // until it writes its own.
+  if (!resuming) owned.insert(owned.end(), {"particles.h5", "particles.xdmf", "checkpoint.smpm"});
+  for (const char* f : owned) {
     fs::remove(dir / f, ec);
     if (ec) throw std::runtime_error((dir / f).string() + ": cannot remove the earlier run's file: " +
                                      ec.message());
   }
+  if (!resuming) remove_fem_snapshots(out_dir, 0);
+  return dir;
+}
+
+void remove_fem_snapshots(const std::string& out_dir, int keep) {
+  const fs::path dir(out_dir);
+  std::error_code ec;
+  fs::remove(dir / "fem.xdmf", ec);
   for (const auto& e : fs::directory_iterator(dir, ec)) {  // FEM snapshots fem_NNNNN.h5
     const std::string n = e.path().filename().string();
     if (n.size() == 12 && n.compare(0, 4, "fem_") == 0 && n.compare(9, 3, ".h5") == 0 &&
-        std::all_of(n.begin() + 4, n.begin() + 9, [](char c) { return c >= '0' && c <= '9'; }))
+        std::all_of(n.begin() + 4, n.begin() + 9, [](char c) { return c >= '0' && c <= '9'; }) &&
+        std::stoi(n.substr(4, 5)) >= keep)
       fs::remove(e.path(), ec);
   }
-  return dir;
+}
+
+SnapshotList SnapshotList::read(const StateReader& r) {
+  SnapshotList l;
+  std::vector<std::int64_t> steps;
+  std::vector<std::uint64_t> sizes;
+  r.get("snapshots.steps", steps);
+  r.get("snapshots.times", l.times, steps.size());
+  r.get("snapshots.sizes", sizes, steps.size());
+  l.steps.assign(steps.begin(), steps.end());
+  l.sizes.assign(sizes.begin(), sizes.end());
+  return l;
+}
+
+void SnapshotList::open(SnapshotWriter& w, const std::string& out_dir) const {
+  if (steps.empty()) {
+    w.open(out_dir, "particles");
+    return;
+  }
+  if (w.resume(out_dir, "particles", steps, times, sizes) == 0)
+    std::fprintf(stderr, "note: %s/particles.h5 does not hold the %zu snapshot(s) written before "
+                         "the checkpoint; particles.xdmf lists the snapshots from the restart on\n",
+                 out_dir.c_str(), steps.size());
+}
+
+void save_snapshot_list(StateWriter& w, const SnapshotWriter& snap) {
+  w.put("snapshots.steps", std::vector<std::int64_t>(snap.steps().begin(), snap.steps().end()));
+  w.put("snapshots.times", snap.times());
+  w.put("snapshots.sizes", std::vector<std::uint64_t>(snap.sizes().begin(), snap.sizes().end()));
 }
 
 std::vector<std::string> history_columns(const std::vector<ProbeSpec>& probes) {
@@ -76,8 +116,8 @@ double probe_field(const fem::Sample& s, const std::string& f) {
   return probe_field(p, f);
 }
 
-Progress::Progress(bool on, long total, bool eta, Clock::time_point t0)
-    : on_(on), total_(total), eta_(eta), tty_(isatty(2)), t0_(t0) {}
+Progress::Progress(bool on, long total, bool eta, Clock::time_point t0, long first)
+    : on_(on), total_(total), first_(first), eta_(eta), tty_(isatty(2)), t0_(t0) {}
 
 void Progress::update(long step) {
   if (!on_) return;
@@ -91,7 +131,7 @@ void Progress::update(long step) {
     return;
   }
   last_ = el;
-  const double rate = step / std::max(el, 1e-9);
+  const double rate = (step - first_) / std::max(el, 1e-9);
   if (eta_) {
     const double left = (total_ - step) / std::max(rate, 1e-9);
     std::fprintf(stderr, "%s  %5.1f%%  step %ld/%ld  %.0f steps/s  %.1f s left%s",
@@ -205,19 +245,16 @@ nlohmann::ordered_json bodies_json(const Case& c, const Solver& s) {
   return a;
 }
 
-// summary.json marks a complete run, so it is written last and whole or not at all: into a
-// temporary file, every write, the flush, fsync and close checked, then renamed. A failure (disk
-// full, an I/O error) removes the temporary file and is an error naming the file and the cause.
-void write_summary(const fs::path& dir, const nlohmann::ordered_json& j) {
-  const fs::path tmp = dir / "summary.json.tmp", dst = dir / "summary.json";
+// Whole or not at all: into a temporary file, every write, the flush, fsync and close checked,
+// then renamed. A failure (disk full, an I/O error) removes the temporary file and is an error
+// naming the file and the cause.
+void write_file_atomically(const fs::path& dst, const std::string& s) {
+  const fs::path tmp = dst.string() + ".tmp";
   auto fail = [&](const std::string& what, int err) {
     std::error_code ec;
     fs::remove(tmp, ec);
     throw std::runtime_error(dst.string() + ": " + what + ": " + std::strerror(err));
   };
-  std::ostringstream text;
-  text << std::setw(2) << j << "\n";
-  const std::string s = text.str();
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f) fail("cannot create " + tmp.filename().string(), errno);
   const bool wrote = std::fwrite(s.data(), 1, s.size(), f) == s.size() && std::fflush(f) == 0;
@@ -231,6 +268,13 @@ void write_summary(const fs::path& dir, const nlohmann::ordered_json& j) {
   std::error_code ec;
   fs::rename(tmp, dst, ec);
   if (ec) fail("cannot rename " + tmp.filename().string() + " to it", ec.value());
+}
+
+// summary.json marks a complete run, so it is written last and whole or not at all.
+void write_summary(const fs::path& dir, const nlohmann::ordered_json& j) {
+  std::ostringstream text;
+  text << std::setw(2) << j << "\n";
+  write_file_atomically(dir / "summary.json", text.str());
 }
 
 }  // namespace smpm::detail

@@ -11,15 +11,37 @@
 
 #include "silentmpm/case.hpp"
 #include "silentmpm/driver.hpp"
+#include "silentmpm/output.hpp"
+#include "silentmpm/state_io.hpp"
 
 namespace smpm::detail {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0);
 
-// Creates the output folder (throws if it cannot) and removes a previous summary.json, whose
-// presence marks a complete run.
-std::filesystem::path prepare_output_dir(const std::string& out_dir);
+// Creates the output folder (throws if it cannot) and removes the files an earlier run left
+// that this run owns (summary.json first: its presence marks a complete run; RUN_INCOMPLETE;
+// history, probes, snapshots). A restart (resuming) keeps the snapshot files: the regions keep
+// those of the steps before the checkpoint and drop the rest.
+std::filesystem::path prepare_output_dir(const std::string& out_dir, bool resuming);
+// Removes DIR/fem_NNNNN.h5 with NNNNN >= keep, and DIR/fem.xdmf.
+void remove_fem_snapshots(const std::string& out_dir, int keep);
+
+// The particle snapshots a checkpoint lists (the run before a restart), and how the regions
+// save and reopen them.
+struct SnapshotList {
+  std::vector<long> steps;
+  std::vector<double> times;
+  std::vector<std::size_t> sizes;
+  static SnapshotList read(const StateReader& r);
+  // A restart: reopens the earlier file keeping these snapshots; else opens a new one.
+  void open(SnapshotWriter& w, const std::string& out_dir) const;
+};
+void save_snapshot_list(StateWriter& w, const SnapshotWriter& snap);
+
+// Writes `bytes` to `dst` whole or not at all: a temporary file beside it, every write, the
+// flush, fsync and close checked, then a rename. Throws naming dst and the cause.
+void write_file_atomically(const std::filesystem::path& dst, const std::string& bytes);
 
 // history.csv columns: "<probe>.<field>" for every probe, then "energy.<term>".
 std::vector<std::string> history_columns(const std::vector<ProbeSpec>& probes);
@@ -38,12 +60,13 @@ double probe_field(const fem::Sample& s, const std::string& f);
 // the FEM / hybrid form: no estimate, and runs shorter than 2 s print nothing.
 class Progress {
  public:
-  Progress(bool on, long total, bool eta, Clock::time_point t0 = Clock::now());
+  // `first`: the step the run starts from (a restart's checkpoint), so rates count this run's steps.
+  Progress(bool on, long total, bool eta, Clock::time_point t0 = Clock::now(), long first = 0);
   void update(long step);
 
  private:
   bool on_;
-  long total_;
+  long total_, first_;
   bool eta_;
   bool tty_;
   Clock::time_point t0_;

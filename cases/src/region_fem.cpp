@@ -19,9 +19,11 @@ class FemRegion final : public Region {
   double time() const override { return s_.t; }
   double cfl() const override { return s_.dt / s_.critical_dt(); }
   bool progress_eta() const override { return false; }
-  void prepare(const std::string& out_dir) override {
-    std::error_code ec;
-    std::filesystem::remove(std::filesystem::path(out_dir) / "fem.xdmf", ec);
+  const char* kind() const override { return "fem"; }
+  int threads() const override { return s_.thread_count(); }
+  long steps() const override { return s_.steps; }
+  void prepare(const std::string& out_dir, bool resuming) override {
+    remove_fem_snapshots(out_dir, resuming ? s_.snapshot_count() : 0);
   }
 
   void step() override { s_.step(); }
@@ -38,14 +40,22 @@ class FemRegion final : public Region {
                                ": energy is not finite");
   }
 
-  void open_snapshots(const std::string&) override {}
+  void save(StateWriter& w) const override { s_.save_state(w, "fem."); }
+  bool restore(const StateReader& r) override {
+    s_.load_state(r, "fem.");
+    return true;
+  }
+
+  void open_snapshots(const std::string& out_dir) override {
+    s_.resume_snapshots(out_dir, "fem");
+  }
   void write_snapshot(const std::string& out_dir) override { s_.write_snapshot(out_dir, "fem"); }
   void finish() override { s_.update_energies(); }
 
-  void rates(RunResult& r, double step_seconds) const override {
+  void rates(RunResult& r, long steps_run, double step_seconds) const override {
     r.dofs = s_.dofs();
     r.dof_updates_per_second =
-        static_cast<double>(s_.dofs()) * r.steps / std::max(step_seconds, 1e-12);
+        static_cast<double>(s_.dofs()) * steps_run / std::max(step_seconds, 1e-12);
   }
 
   void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const override {

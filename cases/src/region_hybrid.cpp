@@ -29,9 +29,11 @@ class HybridRegion final : public Region {
   double time() const override { return s_.t; }
   double cfl() const override { return hy_.dt() / hy_.critical_dt(); }
   bool progress_eta() const override { return false; }
-  void prepare(const std::string& out_dir) override {
-    std::error_code ec;
-    std::filesystem::remove(std::filesystem::path(out_dir) / "fem.xdmf", ec);
+  const char* kind() const override { return "hybrid"; }
+  int threads() const override { return s_.thread_count(); }
+  long steps() const override { return s_.steps; }
+  void prepare(const std::string& out_dir, bool resuming) override {
+    remove_fem_snapshots(out_dir, resuming ? fe_.snapshot_count() : 0);
   }
 
   void step() override { hy_.step(); }
@@ -55,7 +57,19 @@ class HybridRegion final : public Region {
                                " (t = " + std::to_string(s_.t) + " s): energy is not finite");
   }
 
-  void open_snapshots(const std::string& out_dir) override { snap_.open(out_dir, "particles"); }
+  void save(StateWriter& w) const override {
+    hy_.save_state(w);
+    save_snapshot_list(w, snap_);
+  }
+  bool restore(const StateReader& r) override {
+    earlier_ = SnapshotList::read(r);
+    return hy_.load_state(r);
+  }
+
+  void open_snapshots(const std::string& out_dir) override {
+    earlier_.open(snap_, out_dir);
+    fe_.resume_snapshots(out_dir, "fem");
+  }
   void write_snapshot(const std::string& out_dir) override {
     snap_.write(s_.p, s_.steps, s_.t);
     fe_.write_snapshot(out_dir, "fem");
@@ -65,12 +79,12 @@ class HybridRegion final : public Region {
     hy_.update_energies();
   }
 
-  void rates(RunResult& r, double step_seconds) const override {
+  void rates(RunResult& r, long steps_run, double step_seconds) const override {
     r.particle_updates_per_second =
-        static_cast<double>(s_.p.size()) * r.steps / std::max(step_seconds, 1e-12);
+        static_cast<double>(s_.p.size()) * steps_run / std::max(step_seconds, 1e-12);
     r.dofs = fe_.dofs();
     r.dof_updates_per_second =
-        static_cast<double>(fe_.dofs()) * r.steps / std::max(step_seconds, 1e-12);
+        static_cast<double>(fe_.dofs()) * steps_run / std::max(step_seconds, 1e-12);
   }
 
   void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const override {
@@ -109,6 +123,7 @@ class HybridRegion final : public Region {
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
   SnapshotWriter snap_;
+  SnapshotList earlier_;
 };
 
 }  // namespace

@@ -25,6 +25,9 @@ class MpmRegion final : public Region {
   double time() const override { return s_.t; }
   double cfl() const override { return s_.dt / s_.critical_dt(); }
   bool progress_eta() const override { return true; }
+  const char* kind() const override { return "mpm"; }
+  int threads() const override { return s_.thread_count(); }
+  long steps() const override { return s_.steps; }
 
   void step() override { s_.step(); }
 
@@ -40,16 +43,25 @@ class MpmRegion final : public Region {
                                std::to_string(s_.t) + " s): energy is not finite; reduce time.dt");
   }
 
-  void open_snapshots(const std::string& out_dir) override { snap_.open(out_dir, "particles"); }
+  void save(StateWriter& w) const override {
+    s_.save_state(w, "mpm.");
+    save_snapshot_list(w, snap_);
+  }
+  bool restore(const StateReader& r) override {
+    earlier_ = SnapshotList::read(r);
+    return s_.load_state(r, "mpm.");
+  }
+
+  void open_snapshots(const std::string& out_dir) override { earlier_.open(snap_, out_dir); }
   void write_snapshot(const std::string&) override { snap_.write(s_.p, s_.steps, s_.t); }
   void finish() override {
     snap_.close();
     s_.update_energies();
   }
 
-  void rates(RunResult& r, double step_seconds) const override {
+  void rates(RunResult& r, long steps_run, double step_seconds) const override {
     r.particle_updates_per_second =
-        static_cast<double>(s_.p.size()) * r.steps / std::max(step_seconds, 1e-12);
+        static_cast<double>(s_.p.size()) * steps_run / std::max(step_seconds, 1e-12);
   }
 
   void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const override {
@@ -74,6 +86,7 @@ class MpmRegion final : public Region {
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
   SnapshotWriter snap_;
+  SnapshotList earlier_;  // a restart's snapshots of the run before it
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "silentmpm/case.hpp"
 #include "silentmpm/driver.hpp"
+#include "silentmpm/state_io.hpp"
 
 namespace smpm::detail {
 
@@ -24,21 +25,31 @@ class Region {
   virtual double cfl() const = 0;
   // The progress line's form (Progress: eta).
   virtual bool progress_eta() const = 0;
-  // Called once the output folder exists (removes stale files of the region's own outputs).
-  virtual void prepare(const std::string& /*out_dir*/) {}
+  // Called once the output folder exists (removes stale files of the region's own outputs; on a
+  // restart, resuming, only those written after the checkpoint).
+  virtual void prepare(const std::string& /*out_dir*/, bool /*resuming*/) {}
+  virtual const char* kind() const = 0;  // "mpm", "fem", "hybrid" (checkpoints record it)
+  virtual int threads() const = 0;
+  virtual long steps() const = 0;        // steps taken since t = 0
 
   virtual void step() = 0;
   // One history row: the probe columns in the order of Case::probes, then the energy terms.
   // Throws std::runtime_error when the energy is not finite (the run diverged).
   virtual void record(std::vector<double>& row) = 0;
-  // Snapshots (only when the case asks for them): opened before the first one is written.
+  // Checkpoints: the region's state (and its snapshot lists). restore() is called on a region
+  // built from the same case, before the output folder is touched; it returns false when the
+  // continuation sums over particles in another order (another thread count). Throws StateError.
+  virtual void save(StateWriter& w) const = 0;
+  virtual bool restore(const StateReader& r) = 0;
+  // Snapshots (only when the case asks for them): opened before the first one is written; after
+  // restore(), the earlier run's snapshots in the folder are kept and listed again.
   virtual void open_snapshots(const std::string& out_dir) = 0;
   virtual void write_snapshot(const std::string& out_dir) = 0;
   // After the last step: closes the snapshots and brings the energies up to date.
   virtual void finish() = 0;
 
-  // RunResult's rates from the time spent in step().
-  virtual void rates(RunResult& r, double step_seconds) const = 0;
+  // RunResult's rates from the steps taken in this process and the time spent in step().
+  virtual void rates(RunResult& r, long steps_run, double step_seconds) const = 0;
   // summary.json after the common head; `snapshots`: whether the run wrote snapshots.
   virtual void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const = 0;
 };

@@ -470,3 +470,40 @@ std::array<double, 2> Hybrid::momentum() const {
 }
 
 }  // namespace smpm
+
+namespace smpm {
+
+// Checkpoints: both regions' states and the coupling's own accounts (the FE region's energy
+// terms as the coupled step books them) and work arrays.
+void Hybrid::save_state(StateWriter& w) const {
+  mpm_.save_state(w, "mpm.");
+  fe_.save_state(w, "fem.");
+  w.put("hybrid.energy", energy);
+  w.put("hybrid.fe_terms", std::vector<double>{step_absorbed_, fe_kinetic_, fe_elastic_,
+                                               fe_absorbed_, fe_work_, fe_initial_});
+  w.put("hybrid.fint", fint_);
+  w.put("hybrid.fext", fext_);
+  w.put("hybrid.mpm_v", mpm_v_);
+  w.put("hybrid.sum_v", sum_v_);
+}
+
+bool Hybrid::load_state(const StateReader& r) {
+  const bool same_order = mpm_.load_state(r, "mpm.");
+  fe_.load_state(r, "fem.");
+  energy = r.get<Energies>("hybrid.energy");
+  std::vector<double> terms;
+  r.get("hybrid.fe_terms", terms, 6);
+  step_absorbed_ = terms[0];
+  fe_kinetic_ = terms[1];
+  fe_elastic_ = terms[2];
+  fe_absorbed_ = terms[3];
+  fe_work_ = terms[4];
+  fe_initial_ = terms[5];
+  r.get("hybrid.fint", fint_, fint_.size());
+  r.get("hybrid.fext", fext_, fext_.size());
+  r.get("hybrid.mpm_v", mpm_v_, mpm_v_.size());
+  r.get("hybrid.sum_v", sum_v_, sum_v_.size());
+  return same_order;
+}
+
+}  // namespace smpm

@@ -73,6 +73,7 @@ struct Solver::Impl {
 
   std::unique_ptr<Deal> deal;
   int snapshots = 0;
+  std::vector<double> snapshot_times;  // every snapshot's time (a restart's earlier ones too)
 };
 
 // Largest eigenvalue of the symmetric n x n matrix a (row-major; destroyed), cyclic Jacobi.

@@ -61,6 +61,7 @@ int Solver::thread_count() const { return impl_->threads; }
 std::array<double, 4> Solver::bounds() const { return impl_->box; }
 double Solver::critical_dt() const { return impl_->crit_dt; }
 int Solver::snapshot_count() const { return impl_->snapshots; }
+std::vector<double> Solver::snapshot_times() const { return impl_->snapshot_times; }
 const std::vector<double>& Solver::node_x() const { return impl_->x; }
 const std::vector<double>& Solver::node_y() const { return impl_->y; }
 const std::vector<double>& Solver::mass() const { return impl_->mass; }
@@ -255,6 +256,42 @@ std::vector<Sample> Solver::sample() const {
     out[p] = s;
   }
   return out;
+}
+
+}  // namespace smpm::fem
+
+namespace smpm::fem {
+
+// Checkpoints: displacement, velocity, -K u^n (the step and the elastic energy reuse it), the
+// clock, the energies and the snapshot times (fem.xdmf is rebuilt from them on restart).
+void Solver::save_state(StateWriter& w, const std::string& pre) const {
+  const Impl& m = *impl_;
+  w.put(pre + "dt", dt);
+  w.put(pre + "t", t);
+  w.put(pre + "steps", static_cast<std::int64_t>(steps));
+  w.put(pre + "energy", energy);
+  w.put(pre + "u", m.u);
+  w.put(pre + "v", m.v);
+  w.put(pre + "ku", m.ku);
+  w.put(pre + "ku_valid", static_cast<std::uint8_t>(m.ku_valid));
+  w.put(pre + "snapshot_times", snapshot_times());
+}
+
+void Solver::load_state(const StateReader& r, const std::string& pre) {
+  Impl& m = *impl_;
+  const double dt_saved = r.get<double>(pre + "dt");
+  if (dt_saved != dt)
+    r.fail("FE time step " + fmt(dt_saved) + " s in the checkpoint, " + fmt(dt) +
+           " s in this case (a checkpoint of another case)");
+  r.get(pre + "u", m.u, m.u.size());
+  r.get(pre + "v", m.v, m.v.size());
+  r.get(pre + "ku", m.ku, m.ku.size());
+  m.ku_valid = r.get<std::uint8_t>(pre + "ku_valid") != 0;
+  t = r.get<double>(pre + "t");
+  steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
+  energy = r.get<Energies>(pre + "energy");
+  r.get(pre + "snapshot_times", m.snapshot_times);
+  m.snapshots = static_cast<int>(m.snapshot_times.size());
 }
 
 }  // namespace smpm::fem

@@ -581,42 +581,87 @@ int Solver::add_probe(double x, double y) {
   return static_cast<int>(m.probes.size()) - 1;
 }
 
+// The patches of a snapshot (displacement, velocity, stresses, material) and their filter. The
+// vectors and the postprocessor live in the struct because DataOut keeps references to them.
+struct SnapshotPatches {
+  Vector<double> u, v;
+  Vector<float> mat;
+  StressPostprocessor post;
+  DataOut<2> out;
+  DataOutBase::DataOutFilter filter{DataOutBase::DataOutFilterFlags(true, true)};
+  SnapshotPatches(const Solver::Impl& m, const Deal& d)
+      : u(m.u.begin(), m.u.end()), v(m.v.begin(), m.v.end()), mat(d.tria.n_active_cells()),
+        post(m.spec.materials, m.spec.region_material) {
+    for (const auto& cell : d.tria.active_cell_iterators())
+      mat[cell->active_cell_index()] = static_cast<float>(cell->material_id());
+    const std::vector<DataComponentInterpretation::DataComponentInterpretation> vec(
+        2, DataComponentInterpretation::component_is_part_of_vector);
+    out.attach_dof_handler(d.dofh);
+    out.add_data_vector(u, std::vector<std::string>(2, "displacement"), DataOut<2>::type_dof_data,
+                        vec);
+    out.add_data_vector(v, std::vector<std::string>(2, "velocity"), DataOut<2>::type_dof_data, vec);
+    out.add_data_vector(u, post);
+    out.add_data_vector(mat, "material", DataOut<2>::type_cell_data);
+    out.build_patches(d.mapping, m.degree);
+    out.write_filtered_data(filter);
+  }
+};
+
+static std::string snapshot_file(const std::string& base, int k) {
+  char num[16];
+  std::snprintf(num, sizeof num, "_%05d", k);
+  return base + num + ".h5";
+}
+
 void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   ensure_mpi();  // deal.II's HDF5/XDMF writers take MPI_COMM_WORLD
   Impl& m = *impl_;
   Deal& d = *m.deal;
   namespace fs = std::filesystem;
-  char num[16];
-  std::snprintf(num, sizeof num, "_%05d", m.snapshots);
-  const std::string h5 = base + num + ".h5";
-  Vector<double> uvec(m.u.begin(), m.u.end()), vvec(m.v.begin(), m.v.end());
-  Vector<float> mat(d.tria.n_active_cells());
-  for (const auto& cell : d.tria.active_cell_iterators())
-    mat[cell->active_cell_index()] = static_cast<float>(cell->material_id());
-  const std::vector<DataComponentInterpretation::DataComponentInterpretation> vec(
-      2, DataComponentInterpretation::component_is_part_of_vector);
-  StressPostprocessor post(m.spec.materials, m.spec.region_material);
-  DataOut<2> out;
-  out.attach_dof_handler(d.dofh);
-  out.add_data_vector(uvec, std::vector<std::string>(2, "displacement"),
-                      DataOut<2>::type_dof_data, vec);
-  out.add_data_vector(vvec, std::vector<std::string>(2, "velocity"), DataOut<2>::type_dof_data, vec);
-  out.add_data_vector(uvec, post);
-  out.add_data_vector(mat, "material", DataOut<2>::type_cell_data);
-  out.build_patches(d.mapping, m.degree);
-  DataOutBase::DataOutFilter filter(DataOutBase::DataOutFilterFlags(true, true));
-  out.write_filtered_data(filter);
+  const std::string h5 = snapshot_file(base, m.snapshots);
+  SnapshotPatches sp(m, d);
   try {
-    out.write_hdf5_parallel(filter, (fs::path(dir) / h5).string(), MPI_COMM_WORLD);
-    d.xdmf.push_back(out.create_xdmf_entry(filter, h5, t, MPI_COMM_WORLD));
+    sp.out.write_hdf5_parallel(sp.filter, (fs::path(dir) / h5).string(), MPI_COMM_WORLD);
+    d.xdmf.push_back(sp.out.create_xdmf_entry(sp.filter, h5, t, MPI_COMM_WORLD));
     d.xdmf_times.push_back(t);
     const std::string path = (fs::path(dir) / (base + ".xdmf")).string();
-    out.write_xdmf_file(d.xdmf, path, MPI_COMM_WORLD);
+    sp.out.write_xdmf_file(d.xdmf, path, MPI_COMM_WORLD);
     rewrite_xdmf_times(path, d.xdmf_times);
   } catch (const std::exception& e) {
     throw FemError(dir + ": cannot write the FEM snapshot: " + deal_message(e));
   }
+  m.snapshot_times.push_back(t);
   ++m.snapshots;
+}
+
+int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
+  Impl& m = *impl_;
+  Deal& d = *m.deal;
+  namespace fs = std::filesystem;
+  d.xdmf.clear();
+  d.xdmf_times.clear();
+  const std::vector<double>& times = m.snapshot_times;
+  if (times.empty()) return 0;
+  ensure_mpi();
+  SnapshotPatches sp(m, d);  // the same mesh and fields as every earlier snapshot
+  int found = 0;
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    const std::string h5 = snapshot_file(base, static_cast<int>(k));
+    std::error_code ec;
+    if (!fs::is_regular_file(fs::path(dir) / h5, ec)) continue;
+    d.xdmf.push_back(sp.out.create_xdmf_entry(sp.filter, h5, times[k], MPI_COMM_WORLD));
+    d.xdmf_times.push_back(times[k]);
+    ++found;
+  }
+  if (found == 0) return 0;
+  const std::string path = (fs::path(dir) / (base + ".xdmf")).string();
+  try {
+    sp.out.write_xdmf_file(d.xdmf, path, MPI_COMM_WORLD);
+    rewrite_xdmf_times(path, d.xdmf_times);
+  } catch (const std::exception& e) {
+    throw FemError(path + ": cannot write: " + deal_message(e));
+  }
+  return found;
 }
 
 std::vector<std::string> Solver::describe() const {

@@ -49,6 +49,7 @@ void HistoryWriter::open(const std::string& path, const std::vector<std::string>
     throw std::runtime_error("cannot open history file '" + path +
                              "' for writing: " + std::strerror(errno));
   ncol_ = columns.size();
+  path_ = path;
   std::string header = "time";
   for (const auto& c : columns) header += "," + c;
   header += "\n";
@@ -57,6 +58,27 @@ void HistoryWriter::open(const std::string& path, const std::vector<std::string>
     f_ = nullptr;
     throw std::runtime_error("cannot write to history file '" + path + "'");
   }
+}
+
+void HistoryWriter::resume(const std::string& path, const std::vector<std::string>& columns,
+                           const std::string& text) {
+  open(path, columns);
+  std::string header = "time";
+  for (const auto& c : columns) header += "," + c;
+  header += "\n";
+  if (text.compare(0, header.size(), header) != 0) {
+    close();
+    throw std::runtime_error("the checkpoint's history has other columns than this case's");
+  }
+  const std::string rest = text.substr(header.size());
+  if (std::fwrite(rest.data(), 1, rest.size(), f_) != rest.size()) flush();
+}
+
+void HistoryWriter::flush() {
+  if (!f_) return;
+  if (std::fflush(f_) != 0 || std::ferror(f_))
+    throw std::runtime_error("cannot write the history file '" + path_ + "': " +
+                             std::strerror(errno));
 }
 
 void HistoryWriter::row(double time, const std::vector<double>& values) {
@@ -75,7 +97,8 @@ void HistoryWriter::close() {
   const bool close_failed = std::fclose(f_) != 0;
   f_ = nullptr;
   ncol_ = 0;
-  if (bad || close_failed) throw std::runtime_error("error writing the history file (disk full?)");
+  if (bad || close_failed)
+    throw std::runtime_error("cannot write the history file '" + path_ + "' (disk full?)");
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -201,6 +224,56 @@ void SnapshotWriter::open(const std::string& dir, const std::string& base) {
             "writable?)",
             path);
   file_ = f;
+}
+
+namespace {
+herr_t collect_name(hid_t, const char* name, const H5L_info_t*, void* out) {
+  static_cast<std::vector<std::string>*>(out)->push_back(name);
+  return 0;
+}
+}  // namespace
+
+int SnapshotWriter::resume(const std::string& dir, const std::string& base,
+                           const std::vector<long>& steps, const std::vector<double>& times,
+                           const std::vector<std::size_t>& sizes) {
+  close();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const std::string path = (dir.empty() ? std::string(".") : dir) + "/" + base + ".h5";
+  hid_t f = -1;
+  if (!steps.empty()) {  // a missing or unreadable file: f < 0
+    H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+#if H5_VERSION_GE(1, 10, 7)
+    H5Pset_file_locking(fapl.id, 0, 1);
+#endif
+    f = H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
+  }
+  bool whole = f >= 0;
+  for (std::size_t k = 0; whole && k < steps.size(); ++k)
+    whole = H5Lexists(f, step_name(steps[k]).c_str(), H5P_DEFAULT) > 0;
+  if (!whole) {
+    if (f >= 0) H5Fclose(f);
+    H5Eclear2(H5E_DEFAULT);
+    open(dir, base);
+    return 0;
+  }
+  dir_ = dir.empty() ? std::string(".") : dir;
+  base_ = base;
+  file_ = f;
+  std::vector<std::string> names;
+  if (H5Literate(f, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_name, &names) < 0)
+    h5_fail("cannot list the snapshot groups", path);
+  for (const auto& n : names) {
+    bool listed = false;
+    for (long st : steps) listed = listed || n == step_name(st);
+    if (!listed && H5Ldelete(f, n.c_str(), H5P_DEFAULT) < 0)
+      h5_fail("cannot remove the later snapshot '/" + n + "'", path);
+  }
+  if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
+  steps_ = steps;
+  times_ = times;
+  sizes_ = sizes;
+  write_xdmf();
+  return static_cast<int>(steps.size());
 }
 
 void SnapshotWriter::write(const Particles& p, long step, double time) {

@@ -361,7 +361,8 @@ TEST(CaseCliFaults, RerunLeavesNoStaleOutputs) {
 }
 
 // Disk full while writing summary.json (its temporary file is a link to /dev/full): one error
-// naming the file and the cause, exit 1, and no summary.json (nothing that looks complete).
+// naming the file and the cause, exit 2 (the run failed), no summary.json (nothing that looks
+// complete) and RUN_INCOMPLETE saying why.
 TEST(CaseCliFaults, DiskFullWritingSummary) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
@@ -372,10 +373,11 @@ TEST(CaseCliFaults, DiskFullWritingSummary) {
   fs::create_symlink("/dev/full", out / "summary.json.tmp");
   const CliResult r = run_cli("run \"" + file.string() + "\" --out \"" + out.string() + "\" --quiet",
                               "disk_full");
-  EXPECT_EQ(WEXITSTATUS(r.status), 1);
+  EXPECT_EQ(WEXITSTATUS(r.status), 2);
   EXPECT_NE(r.err.find("summary.json: cannot write: No space left on device"), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_NE(read_file(out / "RUN_INCOMPLETE").find("No space left on device"), std::string::npos);
   EXPECT_FALSE(fs::exists(fs::symlink_status(out / "summary.json.tmp")));
 }
 

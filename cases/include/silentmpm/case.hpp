@@ -3,6 +3,7 @@
 // key and builds a ready-to-run Solver. Any problem throws CaseError whose message names the
 // file and the key path (e.g. "pulse.json: materials.tungsten.poisson: must be < 0.5, got 0.5").
 // The full key reference with defaults is docs/case-reference.md.
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -45,6 +46,10 @@ struct OutputSpec {
   long history_every = 1;   // steps between history rows
   int snapshots = 10;       // number of particle snapshots over the run (0: none)
   bool progress = true;     // print a progress line on long runs
+  // Checkpoints (DIR/checkpoint.smpm, overwritten each time): every checkpoint_every steps, or
+  // each time the clock passes a multiple of checkpoint_time seconds (0: none).
+  long checkpoint_every = 0;
+  double checkpoint_time = 0;
 };
 
 struct Case {
@@ -61,6 +66,8 @@ struct Case {
   // Both an MPM and an FEM region (case_hybrid.cpp): the coupled step over solver and fem.
   std::unique_ptr<Hybrid> hybrid;
   std::vector<std::string> notes;  // human-readable description of the loads (time functions...)
+  // Hash of the validated document without the keys a restart may change (checkpoints carry it).
+  std::uint64_t fingerprint = 0;
 };
 
 // Read a case file. overrides are "key.path=value" strings (value parsed as JSON, or taken as a

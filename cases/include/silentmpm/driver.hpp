@@ -1,6 +1,7 @@
 #pragma once
 // The run driver: steps a Case to t_end, samples probes and energies into history.csv, writes
 // snapshots and summary.json, prints progress.
+#include <stdexcept>
 #include <string>
 
 #include "silentmpm/case.hpp"
@@ -15,8 +16,30 @@ struct RunResult {
   double dof_updates_per_second = 0;    // FEM region
 };
 
-// Runs the case and writes DIR/history.csv, DIR/summary.json, DIR/particles.{h5,xdmf}.
-// summary.json is written last, so its presence marks a complete run.
-RunResult run_case(Case& c, const std::string& out_dir);
+// A run that started and then failed (instability, a particle leaving the grid, an I/O error):
+// the command exits 2. DIR/RUN_INCOMPLETE says why; the last checkpoint, if any, is kept.
+struct RunFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// A run stopped by SIGINT or SIGTERM after finishing its step: it wrote DIR/checkpoint.smpm, the
+// history and snapshots so far and DIR/RUN_INCOMPLETE (no summary.json); the command exits 3.
+struct RunInterrupted : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct RunOptions {
+  // A checkpoint to continue from ("": start at t = 0). It must come from the same case (the
+  // same keys and values, except output.*, time.end and scheme.threads) and the same version.
+  std::string restart;
+};
+
+// Runs the case and writes DIR/history.csv, DIR/summary.json, DIR/particles.{h5,xdmf}, and
+// DIR/checkpoint.smpm when the case asks for checkpoints. summary.json is written last, so its
+// presence marks a complete run. Throws CaseError/StateError for an unusable restart file
+// (before the output folder is touched), RunFailure and RunInterrupted as above.
+RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt = {});
+
+// The checkpoint file's name in the output folder.
+inline const char* checkpoint_file_name() { return "checkpoint.smpm"; }
 
 }  // namespace smpm

@@ -97,6 +97,11 @@ class Hybrid : public StepHooks {
   // with the shared velocity).
   std::array<double, 2> momentum() const;
 
+  // Checkpoints: both regions (blocks "mpm." and "fem.") and the coupling's accounts. load_state
+  // returns Solver::load_state's answer (false: particles re-sorted for another thread count).
+  void save_state(StateWriter& w) const;
+  bool load_state(const StateReader& r);
+
   Solver& mpm() { return mpm_; }
   fem::Solver& fe() { return fe_; }
 

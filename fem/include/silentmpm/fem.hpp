@@ -29,6 +29,7 @@
 
 #include "silentmpm/material.hpp"
 #include "silentmpm/energies.hpp"
+#include "silentmpm/state_io.hpp"
 #include "silentmpm/time_function.hpp"
 
 namespace smpm::fem {
@@ -145,6 +146,17 @@ class Solver {
   // material id.
   void write_snapshot(const std::string& dir, const std::string& base);
   int snapshot_count() const;
+  // The times of the snapshots written so far.
+  std::vector<double> snapshot_times() const;
+  // After load_state: the earlier run's snapshots DIR/BASE_00000.h5 ... are listed again in
+  // BASE.xdmf (those whose file is missing are left out; numbering continues after them).
+  // Returns how many were found (0, and nothing written, without a checkpoint).
+  int resume_snapshots(const std::string& dir, const std::string& base);
+
+  // Checkpoints: the state a later step reads (u, v, -K u^n, clock, energies, snapshot times) as
+  // blocks named `prefix` + ...; load_state restores it into a solver built from the same case.
+  void save_state(StateWriter& w, const std::string& prefix) const;
+  void load_state(const StateReader& r, const std::string& prefix);
 
   // --- access for the MPM-FEM coupling and tests ---------------------------------------------
   const std::vector<double>& node_x() const;

@@ -37,6 +37,7 @@
 #include "silentmpm/material.hpp"
 #include "silentmpm/particles.hpp"
 #include "silentmpm/shape.hpp"
+#include "silentmpm/state_io.hpp"
 #include "silentmpm/step_hooks.hpp"
 
 namespace smpm {
@@ -130,6 +131,15 @@ class Solver {
   void layer_shape(const BoundaryLayer& L, std::size_t q, Anchor anchor, S& sf, long* nodes) const;
   // Check every particle is inside the grid; returns the index of the first outside, or -1.
   long first_particle_outside() const;
+
+  // --- checkpoints (solver_state.cpp) --------------------------------------------------------
+  // The state a later step reads, as blocks named `prefix` + ...: clock, energies, every particle
+  // array in the current order, the strips, spring displacements, contact dissipation.
+  void save_state(StateWriter& w, const std::string& prefix) const;
+  // Restores it into a solver built from the same case (finalize() called). Returns false when
+  // the checkpoint was cut into another number of strips (another thread count): the particles
+  // are then re-sorted, and sums over them run in another order. Throws StateError.
+  bool load_state(const StateReader& r, const std::string& prefix);
 
  private:
   int nthreads_ = 1;

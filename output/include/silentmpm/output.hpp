@@ -20,12 +20,19 @@ class HistoryWriter {
   HistoryWriter& operator=(const HistoryWriter&) = delete;
   // Opens path and writes the header line: "time," + columns joined by ','. Throws on failure.
   void open(const std::string& path, const std::vector<std::string>& columns);
+  // A restart: writes `text` (the header and rows of the run before the checkpoint; its first
+  // line must be this header) and continues after it. Throws on failure or another header.
+  void resume(const std::string& path, const std::vector<std::string>& columns,
+              const std::string& text);
   void row(double time, const std::vector<double>& values);  // %.9e, one line
+  // Flushes to the file; throws when a write failed (disk full, I/O error).
+  void flush();
   void close();
 
  private:
   std::FILE* f_ = nullptr;
   std::size_t ncol_ = 0;
+  std::string path_;
 };
 
 // Particle snapshots: one HDF5 file with a group per snapshot ("/step_000123") holding datasets
@@ -45,6 +52,15 @@ class SnapshotWriter {
   void write(const Particles& p, long step, double time);
   void close();
   int count() const { return static_cast<int>(times_.size()); }
+  // Restart: reopens DIR/<base>.h5 of an earlier run that wrote the snapshots listed (their
+  // steps, times and particle counts), removes any later snapshot group it holds, and lists them
+  // again in the XDMF. Returns how many were kept: all of them, or 0 when the file or one of the
+  // listed groups is missing (the file is then started afresh). Throws std::runtime_error.
+  int resume(const std::string& dir, const std::string& base, const std::vector<long>& steps,
+             const std::vector<double>& times, const std::vector<std::size_t>& sizes);
+  const std::vector<long>& steps() const { return steps_; }
+  const std::vector<double>& times() const { return times_; }
+  const std::vector<std::size_t>& sizes() const { return sizes_; }
 
  private:
   long long file_ = -1;  // hid_t

@@ -1,0 +1,94 @@
+#pragma once
+// The state of a run as named binary blocks: what a checkpoint holds (the run loop writes it to
+// DIR/checkpoint.smpm; docs/case-reference.md "Checkpoints and restart").
+//
+// A StateWriter collects blocks, each a name, an element size and the raw bytes of an array
+// (or one scalar); a StateReader finds them again by name and checks their element size and
+// count, so that a block of the wrong kind or length is one error naming the block and the file.
+// Values are stored bit for bit (a restored double is the same double), in the byte order of
+// the machine that wrote them (the file's header records it; another order is refused).
+//
+// File layout (StateWriter::bytes):
+//   "SMPMSTATE\0" (10 bytes), uint32 layout version, uint32 byte-order mark 0x01020304,
+//   then per block: uint32 name length, name, uint32 element size, uint64 count, the data;
+//   then the block "end" (no data) and a uint64 FNV-1a hash of every byte before it.
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace smpm {
+
+// A checkpoint that cannot be used: truncated, corrupt, of another case or version. The message
+// names the file and what is wrong.
+struct StateError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// 64-bit FNV-1a of a byte string (checksums and case fingerprints).
+std::uint64_t fnv1a64(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull);
+
+class StateWriter {
+ public:
+  StateWriter();
+  template <class T>
+  void put(const std::string& name, const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>, "blocks hold plain values");
+    raw(name, sizeof(T), v.size(), v.data());
+  }
+  template <class T>
+  void put(const std::string& name, const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>, "blocks hold plain values");
+    raw(name, sizeof(T), 1, &value);
+  }
+  void put_string(const std::string& name, const std::string& s) { raw(name, 1, s.size(), s.data()); }
+  // The file's bytes: header, blocks, end mark and checksum.
+  std::string bytes() const;
+
+ private:
+  std::string buf_;
+  std::map<std::string, bool> names_;
+  void raw(const std::string& name, std::size_t elem, std::size_t count, const void* data);
+};
+
+class StateReader {
+ public:
+  // Parses and checks the whole file (header, block table, checksum); `file` names it in errors.
+  StateReader(std::string bytes, std::string file);
+  bool has(const std::string& name) const { return blocks_.count(name) != 0; }
+  // An array block; `count` (when not npos) is the length the caller expects.
+  template <class T>
+  void get(const std::string& name, std::vector<T>& v, std::size_t count = npos) const {
+    const Block& b = find(name, sizeof(T));
+    if (count != npos && b.count != count) mismatch(name, b.count, count);
+    v.resize(b.count);
+    if (b.count) std::memcpy(v.data(), data_.data() + b.offset, b.count * sizeof(T));
+  }
+  template <class T>
+  T get(const std::string& name) const {
+    const Block& b = find(name, sizeof(T));
+    if (b.count != 1) mismatch(name, b.count, 1);
+    T v;
+    std::memcpy(&v, data_.data() + b.offset, sizeof(T));
+    return v;
+  }
+  std::string get_string(const std::string& name) const;
+  const std::string& file() const { return file_; }
+  [[noreturn]] void fail(const std::string& what) const;
+
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+
+ private:
+  struct Block {
+    std::size_t elem = 0, count = 0, offset = 0;
+  };
+  std::string data_, file_;
+  std::map<std::string, Block> blocks_;
+  const Block& find(const std::string& name, std::size_t elem) const;
+  [[noreturn]] void mismatch(const std::string& name, std::size_t got, std::size_t want) const;
+};
+
+}  // namespace smpm

@@ -1,0 +1,113 @@
+// The MPM solver's state for checkpoints (Solver::save_state / load_state): everything a step
+// reads that an earlier step wrote. What setup computes from the case (grid, materials, layer
+// selections, dashpot and spring coefficients, damping) is rebuilt from the case file itself.
+#include <algorithm>
+#include <limits>
+
+#include "silentmpm/solver.hpp"
+#include "silentmpm/state_io.hpp"
+
+namespace smpm {
+
+namespace {
+
+// fn(name, array) for every particle array the run carries (the film block only when on).
+template <class P, class Fn>
+void particle_arrays(P& p, Fn&& fn) {
+  fn("x", p.x); fn("y", p.y); fn("vx", p.vx); fn("vy", p.vy); fn("mass", p.mass);
+  fn("vol", p.vol); fn("sxx", p.sxx); fn("syy", p.syy); fn("szz", p.szz); fn("sxy", p.sxy);
+  fn("eps_p", p.eps_p); fn("id", p.id); fn("body", p.body); fn("group", p.group);
+  if (!p.has_film()) return;
+  fn("state", p.state); fn("dnx", p.dnx); fn("dny", p.dny); fn("dL", p.dL); fn("dtnf", p.dtnf);
+  fn("dttf", p.dttf); fn("jump_n", p.jump_n); fn("jump_t", p.jump_t); fn("ubar", p.ubar);
+}
+
+}  // namespace
+
+void Solver::save_state(StateWriter& w, const std::string& pre) const {
+  w.put(pre + "dt", dt);
+  w.put(pre + "t", t);
+  w.put(pre + "steps", static_cast<std::int64_t>(steps));
+  w.put(pre + "energy", energy);
+  w.put(pre + "contact_dissipated", contact.dissipated);
+  w.put(pre + "film", static_cast<std::uint8_t>(p.has_film()));
+  particle_arrays(p, [&](const char* n, const auto& v) { w.put(pre + "p." + n, v); });
+  for (std::size_t k = 0; k < silents.size(); ++k) {
+    if (!silents[k].springs()) continue;
+    w.put(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux);
+    w.put(pre + "silent" + std::to_string(k) + ".uy", silents[k].uy);
+  }
+  // The particle order and the strips it was cut into (a re-sort happens only when the strips
+  // conflict, so the order is part of the state: sums over particles follow it).
+  w.put(pre + "strips", static_cast<std::int32_t>(nstrips_));
+  std::vector<std::uint32_t> ranges;
+  for (const auto& r : ranges_) ranges.insert(ranges.end(), {r[0], r[1]});
+  w.put(pre + "ranges", ranges);
+  w.put(pre + "strip_lo", strip_lo_);
+  w.put(pre + "strip_hi", strip_hi_);
+  w.put(pre + "strip_out", strip_out_);
+  w.put(pre + "strips_ok", static_cast<std::uint8_t>(strips_ok_));
+  std::vector<std::int32_t> boxes;
+  for (const auto& F : fields_) boxes.insert(boxes.end(), F.box.begin(), F.box.end());
+  w.put(pre + "field_boxes", boxes);
+}
+
+bool Solver::load_state(const StateReader& r, const std::string& pre) {
+  const std::size_t n = p.size();
+  if (r.get<std::uint8_t>(pre + "film") != static_cast<std::uint8_t>(p.has_film()))
+    r.fail("the film model's history is " + std::string(p.has_film() ? "absent" : "present") +
+           " in the checkpoint and the opposite in this case (a checkpoint of another case)");
+  particle_arrays(p, [&](const char* name, auto& v) { r.get(pre + "p." + name, v, n); });
+  for (std::size_t k = 0; k < silents.size(); ++k) {
+    if (!silents[k].springs()) continue;
+    const std::size_t m = silents[k].layer.ids.size();
+    r.get(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux, m);
+    r.get(pre + "silent" + std::to_string(k) + ".uy", silents[k].uy, m);
+  }
+  const double dt_saved = r.get<double>(pre + "dt");
+  if (dt_saved != dt)
+    r.fail("time step " + std::to_string(dt_saved) + " s in the checkpoint, " + std::to_string(dt) +
+           " s in this case (a checkpoint of another case)");
+  t = r.get<double>(pre + "t");
+  steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
+  energy = r.get<Energies>(pre + "energy");
+  contact.dissipated = r.get<double>(pre + "contact_dissipated");
+  for (uint32_t id : p.id)
+    if (id >= n) r.fail("particle id " + std::to_string(id) + " out of range (corrupt checkpoint)");
+  where_.assign(n, 0);
+  for (std::size_t k = 0; k < n; ++k) where_[p.id[k]] = static_cast<uint32_t>(k);
+  auto reindex = [&](BoundaryLayer& L) {
+    for (std::size_t k = 0; k < L.ids.size(); ++k) L.idx[k] = where_[L.ids[k]];
+  };
+  for (auto& tl : tractions) reindex(tl.layer);
+  for (auto& sl : silents) reindex(sl.layer);
+  for (auto& dl : dampers) reindex(dl.layer);
+
+  const int saved_strips = r.get<std::int32_t>(pre + "strips");
+  if (saved_strips != nstrips_) {
+    // Another thread count: the particles are re-cut into this run's strips. The continuation is
+    // the same computation with sums over particles in another order (round-off differences).
+    sort_particles();
+    return false;
+  }
+  const std::size_t G = std::max<std::size_t>(1, materials.size());
+  std::vector<std::uint32_t> ranges;
+  r.get(pre + "ranges", ranges, 2 * nstrips_ * G);
+  for (std::size_t k = 0; k < ranges_.size(); ++k) {
+    if (ranges[2 * k] > ranges[2 * k + 1] || ranges[2 * k + 1] > n)
+      r.fail("particle range out of bounds (corrupt checkpoint)");
+    ranges_[k] = {ranges[2 * k], ranges[2 * k + 1]};
+  }
+  r.get(pre + "strip_lo", strip_lo_, nstrips_);
+  r.get(pre + "strip_hi", strip_hi_, nstrips_);
+  r.get(pre + "strip_out", strip_out_, nstrips_);
+  strips_ok_ = r.get<std::uint8_t>(pre + "strips_ok") != 0;
+  refresh_fields();
+  std::vector<std::int32_t> boxes;
+  r.get(pre + "field_boxes", boxes, 4 * fields_.size());
+  for (std::size_t k = 0; k < fields_.size(); ++k)
+    fields_[k].box = {boxes[4 * k], boxes[4 * k + 1], boxes[4 * k + 2], boxes[4 * k + 3]};
+  return true;
+}
+
+}  // namespace smpm

@@ -1,0 +1,120 @@
+// Named binary blocks of a run's state (the layout in state_io.hpp).
+#include "silentmpm/state_io.hpp"
+
+namespace smpm {
+
+namespace {
+constexpr char kMagic[10] = {'S', 'M', 'P', 'M', 'S', 'T', 'A', 'T', 'E', '\0'};
+constexpr std::uint32_t kLayout = 1;
+constexpr std::uint32_t kOrderMark = 0x01020304u;
+
+template <class T>
+void append(std::string& s, T v) {
+  s.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+}  // namespace
+
+std::uint64_t fnv1a64(const void* data, std::size_t n, std::uint64_t h) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) {
+    h ^= b[i];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+StateWriter::StateWriter() {
+  buf_.append(kMagic, sizeof kMagic);
+  append(buf_, kLayout);
+  append(buf_, kOrderMark);
+}
+
+void StateWriter::raw(const std::string& name, std::size_t elem, std::size_t count,
+                      const void* data) {
+  if (name == "end" || !names_.emplace(name, true).second)
+    throw std::logic_error("state block '" + name + "' written twice");
+  append(buf_, static_cast<std::uint32_t>(name.size()));
+  buf_ += name;
+  append(buf_, static_cast<std::uint32_t>(elem));
+  append(buf_, static_cast<std::uint64_t>(count));
+  if (count) buf_.append(static_cast<const char*>(data), elem * count);
+}
+
+std::string StateWriter::bytes() const {
+  std::string out = buf_;
+  append(out, static_cast<std::uint32_t>(3));
+  out += "end";
+  append(out, static_cast<std::uint32_t>(0));
+  append(out, static_cast<std::uint64_t>(0));
+  append(out, fnv1a64(out.data(), out.size()));
+  return out;
+}
+
+void StateReader::fail(const std::string& what) const {
+  throw StateError(file_ + ": " + what);
+}
+
+StateReader::StateReader(std::string bytes, std::string file)
+    : data_(std::move(bytes)), file_(std::move(file)) {
+  const std::size_t head = sizeof kMagic + 8;
+  if (data_.size() < head || std::memcmp(data_.data(), kMagic, sizeof kMagic) != 0)
+    fail("not a silentmpm checkpoint (no SMPMSTATE header)");
+  std::uint32_t layout, order;
+  std::memcpy(&layout, data_.data() + sizeof kMagic, 4);
+  std::memcpy(&order, data_.data() + sizeof kMagic + 4, 4);
+  if (order != kOrderMark) fail("written on a machine of another byte order");
+  if (layout != kLayout)
+    fail("checkpoint layout " + std::to_string(layout) + ", this build reads layout " +
+         std::to_string(kLayout));
+  std::size_t pos = head;
+  auto need = [&](std::size_t n) {
+    if (data_.size() - pos < n)
+      fail("truncated at byte " + std::to_string(pos) + " of " + std::to_string(data_.size()) +
+           " (the file was cut short: an interrupted copy or a full disk)");
+  };
+  for (;;) {
+    std::uint32_t len, elem;
+    std::uint64_t count;
+    need(4);
+    std::memcpy(&len, data_.data() + pos, 4);
+    pos += 4;
+    if (len > 256) fail("corrupt block table at byte " + std::to_string(pos - 4));
+    need(len + 12);
+    const std::string name = data_.substr(pos, len);
+    pos += len;
+    std::memcpy(&elem, data_.data() + pos, 4);
+    std::memcpy(&count, data_.data() + pos + 4, 8);
+    pos += 12;
+    if (name == "end") break;
+    if (elem == 0 || count > (data_.size() - pos) / elem)
+      fail("truncated in block '" + name + "' (the file was cut short)");
+    blocks_[name] = Block{elem, static_cast<std::size_t>(count), pos};
+    pos += elem * count;
+  }
+  need(8);
+  std::uint64_t sum;
+  std::memcpy(&sum, data_.data() + pos, 8);
+  if (sum != fnv1a64(data_.data(), pos)) fail("checksum mismatch (the file is corrupt)");
+  if (pos + 8 != data_.size()) fail("trailing bytes after the end mark (the file is corrupt)");
+}
+
+const StateReader::Block& StateReader::find(const std::string& name, std::size_t elem) const {
+  const auto it = blocks_.find(name);
+  if (it == blocks_.end()) fail("block '" + name + "' missing (a checkpoint of another kind of run)");
+  if (it->second.elem != elem)
+    fail("block '" + name + "' holds " + std::to_string(it->second.elem) + "-byte values, " +
+         std::to_string(elem) + " expected");
+  return it->second;
+}
+
+void StateReader::mismatch(const std::string& name, std::size_t got, std::size_t want) const {
+  fail("block '" + name + "' holds " + std::to_string(got) + " values, this case has " +
+       std::to_string(want) + " (a checkpoint of another case)");
+}
+
+std::string StateReader::get_string(const std::string& name) const {
+  const Block& b = find(name, 1);
+  return data_.substr(b.offset, b.count);
+}
+
+}  // namespace smpm
