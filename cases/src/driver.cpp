@@ -84,7 +84,8 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
            " (a checkpoint is read by the version that wrote it)");
   const std::string kind = r.get_string("run.kind");
   if (kind != region.kind())
-    r.fail("a checkpoint of an " + kind + " run, this case is an " + region.kind() + " run");
+    r.fail("a checkpoint of a run of kind \"" + kind + "\", this case is of kind \"" +
+           region.kind() + "\"");
   const std::uint64_t fp = r.get<std::uint64_t>("run.fingerprint");
   if (fp != c.fingerprint)
     r.fail("written for another case (" + r.get_string("run.case") + ", fingerprint " + hex(fp) +

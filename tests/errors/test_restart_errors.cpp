@@ -1,0 +1,158 @@
+// Checkpoints that cannot be used and faults around them: each is one error naming the file and
+// what is wrong, with the documented exit status (1: bad input; 2: the run failed), and the
+// output folder is left without anything that looks complete.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "silentmpm/case.hpp"
+#include "silentmpm/state_io.hpp"
+#include "test_restart_common.hpp"
+
+namespace smpm {
+namespace {
+
+using namespace restart_testing;
+
+// A finished plate run with a checkpoint at step 100 of 150: its case file and its folder.
+struct Source {
+  std::string file;
+  fs::path out, ck;
+};
+
+const Source& source() {
+  static const Source s = [] {
+    Source r;
+    json c = small_plate(1, 150);
+    c["output"]["checkpoint_every"] = 100;
+    r.file = write_case("ck_source", c);
+    r.out = scratch() / "ck_source_out";
+    r.ck = r.out / "checkpoint.smpm";
+    const Cli run = cli("run " + r.file + " --out " + r.out.string(), "ck_source");
+    EXPECT_EQ(run.code, 0) << run.err;
+    return r;
+  }();
+  return s;
+}
+
+std::string restart_args(const std::string& file, const fs::path& ck, const std::string& tag) {
+  return "run " + file + " --out " + (scratch() / ("ck_" + tag)).string() + " --restart " +
+         ck.string();
+}
+
+void expect_refused(const std::string& file, const fs::path& ck, const std::string& tag,
+                    const std::string& expect) {
+  const Cli r = cli(restart_args(file, ck, tag), tag);
+  EXPECT_EQ(r.code, 1) << tag << ": " << r.err;
+  EXPECT_NE(r.err.find(expect), std::string::npos) << tag << ": expected \"" << expect
+                                                   << "\" in:\n" << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << tag << ": one line:\n" << r.err;
+  EXPECT_FALSE(fs::exists(scratch() / ("ck_" + tag) / "summary.json")) << tag;
+}
+
+TEST(RestartErrors, UnusableCheckpointsAreRefused) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
+  const Source& s = source();
+  ASSERT_TRUE(fs::exists(s.ck));
+  const std::string bytes = read_file(s.ck);
+
+  expect_refused(s.file, scratch() / "nonexistent.smpm", "missing", "no such checkpoint file");
+  expect_refused(s.file, fs::path(s.file), "json", "not a silentmpm checkpoint");
+
+  const fs::path cut = scratch() / "cut.smpm";
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  expect_refused(s.file, cut, "truncated", "truncated");
+
+  std::string flipped = bytes;
+  flipped[flipped.size() / 3] ^= 0x10;
+  const fs::path bad = scratch() / "flipped.smpm";
+  std::ofstream(bad, std::ios::binary) << flipped;
+  expect_refused(s.file, bad, "corrupt", "checksum mismatch");
+
+  // Another case: one material value changed.
+  json other = small_plate(1, 150);
+  other["materials"]["tungsten"]["young"] = 400e9;
+  expect_refused(write_case("ck_other", other), s.ck, "other_case", "written for another case");
+
+  // What a restart may change: time.end, output.*, scheme.threads (here all three).
+  json longer = small_plate(1, 160);
+  longer["output"]["history_every"] = 2;
+  longer["scheme"]["threads"] = 2;
+  const Cli ok = cli(restart_args(write_case("ck_longer", longer), s.ck, "longer"), "longer");
+  EXPECT_EQ(ok.code, 0) << ok.err;
+
+  // Nothing left to run: the case ends before the checkpoint.
+  expect_refused(write_case("ck_shorter", small_plate(1, 80)), s.ck, "shorter",
+                 "nothing left to run");
+
+  // Another kind of run: an FEM case with an MPM checkpoint.
+  expect_refused(write_case("ck_fem", hybrid_case_testing::plate_case("fem")), s.ck, "fem",
+                 "a checkpoint of a run of kind \"mpm\", this case is of kind \"fem\"");
+
+  // Another version: a checkpoint written by "0.0.1".
+  StateWriter w;
+  w.put_string("run.version", "0.0.1");
+  const fs::path old = scratch() / "old.smpm";
+  std::ofstream(old, std::ios::binary) << w.bytes();
+  expect_refused(s.file, old, "version", "written by silentmpm 0.0.1");
+}
+
+// Bad checkpoint keys in the case file.
+TEST(RestartErrors, CheckpointKeys) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
+  const std::vector<std::pair<json, std::string>> bad = {
+      {{{"checkpoint_every", -5}}, "output.checkpoint_every: must be >= 0"},
+      {{{"checkpoint_time", -1e-6}}, "output.checkpoint_time: must be >= 0"},
+      {{{"checkpoint_every", 10}, {"checkpoint_time", 1e-6}},
+       "output.checkpoint_time: give checkpoint_every (steps) or checkpoint_time (seconds), not both"},
+      {{{"checkpoint_evry", 10}}, "checkpoint_every"},
+  };
+  int k = 0;
+  for (const auto& [out, expect] : bad) {
+    json c = small_plate(1, 20);
+    for (const auto& [key, v] : out.items()) c["output"][key] = v;
+    const std::string f = write_case("ck_key_" + std::to_string(k), c);
+    const Cli r = cli("check " + f, "ck_key_" + std::to_string(k++));
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_NE(r.err.find(expect), std::string::npos) << "expected \"" << expect << "\" in:\n" << r.err;
+  }
+}
+
+// Disk full while writing a checkpoint (its temporary file is a link to /dev/full): one error
+// naming the file and the cause, exit 2, RUN_INCOMPLETE saying why, no summary.json.
+TEST(RestartErrors, DiskFullWritingCheckpoint) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  json c = small_plate(1, 50);
+  c["output"]["checkpoint_every"] = 10;
+  const std::string f = write_case("ck_full", c);
+  const fs::path out = scratch() / "ck_full_out";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", out / "checkpoint.smpm.tmp");
+  const Cli r = cli("run " + f + " --out " + out.string(), "ck_full");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("checkpoint.smpm: cannot write: No space left on device"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_FALSE(fs::exists(out / "checkpoint.smpm"));
+  EXPECT_NE(read_file(out / "RUN_INCOMPLETE").find("No space left on device"), std::string::npos);
+}
+
+// A run that fails after it started (a particle leaves the grid) exits 2 and leaves
+// RUN_INCOMPLETE naming the cause instead of a summary.
+TEST(RestartErrors, RunFailureExitsTwoWithMarker) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
+  json c = small_plate(1, 400);
+  c["bodies"][0]["velocity"] = {3000.0, 0.0};  // flies out of the grid within the run
+  const std::string f = write_case("ck_fail", c);
+  const fs::path out = scratch() / "ck_fail_out";
+  const Cli r = cli("run " + f + " --out " + out.string(), "ck_fail");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("left the grid"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_NE(read_file(out / "RUN_INCOMPLETE").find("left the grid"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace smpm
