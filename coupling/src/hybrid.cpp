@@ -39,6 +39,8 @@ bool inside_quad(const double* qx, const double* qy, double x, double y, double 
 }  // namespace
 
 Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
+  // Energy enters the MPM region through the interface too: its own account bounds nothing.
+  mpm_.opt.energy_bound = 0;
   const Grid& g = mpm_.grid;
   const double h = g.h, tol = 1e-6 * h;
   if (mpm_.opt.shape != ShapeKind::Bilinear)

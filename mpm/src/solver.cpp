@@ -170,6 +170,12 @@ void Solver::finalize() {
   sort_particles();
   update_energies();
   energy.initial = energy.kinetic + energy.elastic;
+  double mc2 = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const double c = p.group[k] < materials.size() ? materials[p.group[k]].cd : 0.0;
+    mc2 += p.mass[k] * c * c;
+  }
+  energy_floor_ = 1e-12 * mc2;
 }
 
 // Order particles by (strip, material group, cell row) with a stable counting sort. Strips are
@@ -740,6 +746,7 @@ void Solver::g2p(bool remap, bool move) {
     if (remap && F.body >= 0) kernels::for_box(F.box, grid.nnx, nthreads_, [&](long i) {
       f.qx[i] = 0; f.qy[i] = 0;
     });
+    std::vector<double> ke(nstrips_, 0.0), v2(nstrips_, 0.0);
     auto body = [&](uint32_t b, uint32_t e, int g, int s) {
       RowSpan r;
       const double ir = inv_rho(g);
@@ -747,9 +754,15 @@ void Solver::g2p(bool remap, bool move) {
       else if (move) kernels::g2p<S, false, true>(grid, p, b, e, f, ir, flip, DT, r);
       else kernels::g2p<S, false, false>(grid, p, b, e, f, ir, flip, DT, r);
       if (move) merge_rows(s, r);
+      ke[s] += r.kinetic;
+      v2[s] = std::max(v2[s], r.speed2);
     };
     if (remap) scatter(F.ranges, body);
     else parallel(F.ranges, body);
+    for (int s = 0; s < nstrips_; ++s) {
+      step_kinetic_ += ke[s];
+      step_speed2_ = std::max(step_speed2_, v2[s]);
+    }
   }
 }
 
@@ -764,6 +777,7 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
     const double* gx = start_field ? f.vx : (remapped_field ? f.qx : f.vnx);
     const double* gy = start_field ? f.vy : (remapped_field ? f.qy : f.vny);
     std::vector<double> diss(nstrips_, 0.0);
+    std::vector<long> collapsed(nstrips_, 0);
     parallel(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
       if (b == e) return;
       RowSpan r;
@@ -782,9 +796,11 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
         case Model::J2Film: d = run(std::integral_constant<Model, Model::J2Film>()); break;
       }
       diss[s] += d;
+      collapsed[s] += r.collapsed;
       if (move) merge_rows(s, r);
     });
     for (double d : diss) energy.dissipated += d;
+    for (long c : collapsed) collapsed_ += c;
   }
 }
 
@@ -875,8 +891,70 @@ void Solver::step_with() {
   }
   t += dt;
   ++steps;
+  check_health();  // first: a blow-up, not the grid's size, is why particles fly off
   check_outside();
   call([&](StepHooks& h) { h.end_of_step(*this); });
+}
+
+// Health checks at the end of a step, from reductions the step's own passes made (no extra pass
+// unless one fails), in the order a blow-up shows them: no particle faster than a cell per step
+// (the transfer assumes a particle stays within its stencil); no particle volume collapsed or
+// inverted (J <= 0); the particles' kinetic energy (from g2p) within opt.energy_bound times the
+// energy put in (initial + |external work|, with a floor of 1e-12 sum(m c_d^2) for a run with
+// nothing put in). Nodal values would not do: a node holding a sliver of mass at a body's edge
+// takes a large velocity the particles hardly see.
+void Solver::check_health() {
+  const long collapsed = collapsed_;
+  const double ke = step_kinetic_, v2 = step_speed2_;
+  collapsed_ = 0;
+  step_kinetic_ = 0;
+  step_speed2_ = 0;
+  auto where = [&](std::ostringstream& o) { o << "at step " << steps << " (t = " << t << " s)"; };
+  auto particle = [&](std::ostringstream& o, std::size_t k) {
+    o << "particle " << p.id[k] << " of body " << p.body[k] << " at (" << p.x[k] << ", " << p.y[k]
+      << ")";
+  };
+  if (v2 * dt * dt > grid.h * grid.h) {
+    std::size_t k = 0;
+    for (std::size_t q = 1; q < p.size(); ++q)
+      if (p.vx[q] * p.vx[q] + p.vy[q] * p.vy[q] > p.vx[k] * p.vx[k] + p.vy[k] * p.vy[k]) k = q;
+    const double v = std::sqrt(v2);
+    std::ostringstream o;
+    o << "a particle moves more than a cell per step ";
+    where(o);
+    o << ": ";
+    particle(o, k);
+    o << " at |v| = " << v << " m/s, v dt = " << v * dt << " m > h = " << grid.h
+      << " m; the run is unstable (reduce time.cfl or time.dt)";
+    throw std::runtime_error(o.str());
+  }
+  if (collapsed > 0) {
+    std::size_t k = 0;
+    while (k < p.size() && p.vol[k] > 0 && std::isfinite(p.vol[k])) ++k;
+    std::ostringstream o;
+    o << "particle volume collapsed ";
+    where(o);
+    if (k < p.size()) {
+      o << ": ";
+      particle(o, k);
+      o << " has J = V/V0 = " << p.vol[k] / (p.mass[k] * inv_rho(p.group[k]));
+    }
+    o << " (" << collapsed << " particle(s) with J <= 0); the run is unstable or the deformation "
+         "too large for the grid (reduce time.cfl or time.dt, refine the grid)";
+    throw std::runtime_error(o.str());
+  }
+  if (opt.energy_bound > 0) {
+    const double put_in = energy.initial + std::abs(energy.external_work);
+    if (ke > opt.energy_bound * put_in + energy_floor_) {
+      std::ostringstream o;
+      o << "kinetic energy " << ke << " J exceeds " << opt.energy_bound
+        << " times the energy put in (" << put_in << " J: initial " << energy.initial
+        << ", external work " << energy.external_work << ") ";
+      where(o);
+      o << "; the run is unstable (reduce time.cfl or time.dt)";
+      throw std::runtime_error(o.str());
+    }
+  }
 }
 
 // ------------------------------------------------------------------------------------------

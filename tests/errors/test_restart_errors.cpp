@@ -145,6 +145,7 @@ TEST(RestartErrors, RunFailureExitsTwoWithMarker) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
   json c = small_plate(1, 400);
   c["bodies"][0]["velocity"] = {3000.0, 0.0};  // flies out of the grid within the run
+  c["boundaries"] = json::array();
   const std::string f = write_case("ck_fail", c);
   const fs::path out = scratch() / "ck_fail_out";
   const Cli r = cli("run " + f + " --out " + out.string(), "ck_fail");

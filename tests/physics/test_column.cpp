@@ -446,3 +446,66 @@ TEST(HealthCheck, NonFiniteStopsWithinOneStep) {
     }
   }
 }
+
+// ---- Health checks: a blow-up, a runaway node and a collapsed particle stop the run in the step
+// they happen, with a message naming the step, the cause and the particle ----
+TEST(HealthCheck, BlowUpStopsWithinOneStep) {
+  for (const Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF}) {
+    ColumnSpec c;
+    c.cells = 40;
+    c.scheme = sc;
+    c.fn = sin2_pulse(16 * c.h / 5918.5, 8 * c.h / 5918.5);
+    auto s = make_column(c);
+    for (int i = 0; i < 20; ++i) s->step();
+    // An energy runaway: one particle 200 times faster than the pulse's particle velocity (its
+    // kinetic energy alone is ~20 times what the load has put in), still far below a cell a step.
+    const std::size_t k = s->p.size() / 2;
+    double vmax = 0;
+    for (double v : s->p.vx) vmax = std::max(vmax, std::abs(v));
+    s->p.vx[k] = 200 * vmax;
+    const long before = s->steps;
+    try {
+      s->step();
+      FAIL() << "no error (" << scheme_name(sc) << ")";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("kinetic energy"), std::string::npos) << m;
+      EXPECT_NE(m.find("at step " + std::to_string(before + 1)), std::string::npos) << m;
+    }
+  }
+}
+
+TEST(HealthCheck, RunawayNodeAndCollapsedParticleStop) {
+  ColumnSpec c;
+  c.cells = 40;
+  c.fn = sin2_pulse(16 * c.h / 5918.5, 8 * c.h / 5918.5);
+  {
+    auto s = make_column(c);
+    for (int i = 0; i < 5; ++i) s->step();
+    s->opt.energy_bound = 0;  // the speed check alone
+    s->p.vx[s->p.size() / 2] = 2 * s->grid.h / s->dt * s->p.size();
+    try {
+      s->step();
+      FAIL() << "no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("a particle moves more than a cell per step at step 6"),
+                std::string::npos) << e.what();
+    }
+  }
+  {
+    auto s = make_column(c);
+    for (int i = 0; i < 5; ++i) s->step();
+    const std::size_t k = s->p.size() / 3;
+    s->p.vol[k] = -s->p.vol[k];  // an inverted particle
+    try {
+      s->step();
+      FAIL() << "no error";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("particle volume collapsed at step 6"), std::string::npos) << m;
+      EXPECT_NE(m.find("particle " + std::to_string(s->p.id[k]) + " of body 0"), std::string::npos)
+          << m;
+      EXPECT_NE(m.find("J = V/V0 = -"), std::string::npos) << m;
+    }
+  }
+}

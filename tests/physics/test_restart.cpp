@@ -55,8 +55,9 @@ long expect_restart_identical(const std::string& name, json c, const std::string
   for (const char* f : {"particles.xdmf", "fem.xdmf", "fem_00000.h5", "fem_00001.h5"})
     if (fs::exists(a / f)) {
       EXPECT_TRUE(fs::exists(b / f)) << name << " " << f;
-      if (std::string(f).find("xdmf") != std::string::npos)
+      if (std::string(f).find("xdmf") != std::string::npos) {
         EXPECT_TRUE(read_file(a / f) == read_file(b / f)) << name << ": " << f << " differs";
+      }
     }
   return full["restart"]["from_step"].get<long>();
 }

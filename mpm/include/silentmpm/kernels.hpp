@@ -62,6 +62,9 @@ struct RowSpan {
   int lo = std::numeric_limits<int>::max();
   int hi = std::numeric_limits<int>::min();
   int out = 0;
+  int collapsed = 0;  // stress update: particles whose volume is not positive (J <= 0) or finite
+  double kinetic = 0; // g2p: kinetic energy of the particles' new velocities
+  double speed2 = 0;  // g2p: largest squared particle speed
   void add(int r, bool outside) {
     lo = r < lo ? r : lo;
     hi = r > hi ? r : hi;
@@ -154,6 +157,9 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
     const double nvx = flip * (VX[k] + dvx) + pic * wx;
     const double nvy = flip * (VY[k] + dvy) + pic * wy;
     VX[k] = nvx; VY[k] = nvy;
+    const double v2 = nvx * nvx + nvy * nvy;  // health checks (Solver::check_health)
+    rows.kinetic += 0.5 * M[k] * v2;
+    rows.speed2 = v2 > rows.speed2 ? v2 : rows.speed2;
     if constexpr (REMAP) {
       const double mvx = M[k] * nvx, mvy = M[k] * nvy;
       for (int a = 0; a < Shape::kNodes; ++a) {
@@ -217,6 +223,7 @@ inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
                                 EP[k]);
     SXX[k] = sxx; SYY[k] = syy; SZZ[k] = szz; SXY[k] = sxy;
     V[k] *= (1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt;
+    rows.collapsed += !(V[k] > 0 && V[k] < std::numeric_limits<double>::infinity());
     diss += wp * V[k];
     if constexpr (MOVE) {
       X[k] += dt * wx;

@@ -13,7 +13,7 @@
 //                                                                           -> before_g2p
 //   g2p            particle velocities (FLIP/PIC); MUSL re-maps the momenta -> after_remap
 //   stress         velocity gradient -> strain increment -> material update; positions advance
-//   clock          t += dt; particles still on the grid?                   -> end_of_step
+//   clock          t += dt; particles still on the grid? health checks     -> end_of_step
 //
 // Velocity fields: the kernels (kernels.hpp) run over the particles of one field into that
 // field's nodal arrays. The ordinary step has one field, the grid's own arrays. Multi-field
@@ -52,6 +52,10 @@ struct SolverOptions {
   double mass_tolerance = 1e-12;  // nodes lighter than this fraction of the smallest particle mass are void
   int threads = 0;            // 0 = OpenMP default
   double gravity_x = 0, gravity_y = 0;  // body force per unit mass (m/s^2), on every node's mass
+  // Health check: stop when the kinetic energy exceeds this multiple of the energy put in
+  // (initial + |external work|); 0 turns it off (the hybrid does: energy also enters through
+  // its FE region).
+  double energy_bound = 10;
 };
 
 struct ProbeSample {
@@ -183,7 +187,13 @@ class Solver {
   void merge_rows(int strip, const RowSpan& r);
   void check_outside();
   [[noreturn]] void fail_nonfinite() const;
+  void check_health();
   long outside_ = -1;  // index of a particle that left the grid in the last pass
+  // Health-check reductions of the current step (check_health).
+  long collapsed_ = 0;         // particles with J <= 0 after the stress update
+  double step_kinetic_ = 0;    // particles' kinetic energy from g2p
+  double step_speed2_ = 0;     // largest squared particle speed from g2p
+  double energy_floor_ = 0;    // 1e-12 sum(m c_d^2): the energy bound's floor
 };
 
 }  // namespace smpm
