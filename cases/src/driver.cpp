@@ -146,6 +146,12 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
   if (!note.empty()) std::fprintf(stderr, "%s\n", note.c_str());
   SignalGuard signals;
   try {
+    // The marker is there while the run is: a run killed outright (SIGKILL, power loss) or
+    // unable to write its reason (a full disk) still leaves it; completion removes it.
+    mark_incomplete(dir, "running or killed: started " + std::string(resuming ? "from the checkpoint "
+                         "at step " + std::to_string(first) : "at step 0") + " of " +
+                         std::to_string(nsteps) + "; a complete run removes this file and writes "
+                         "summary.json");
     region.prepare(out_dir, resuming);
 
     const std::vector<std::string> cols = detail::history_columns(c.probes);
@@ -219,6 +225,8 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
     if (resuming)
       j["restart"] = {{"checkpoint", opt.restart}, {"from_step", first}};
     detail::write_summary(dir, j);
+    std::error_code ec;
+    fs::remove(dir / "RUN_INCOMPLETE", ec);
     return r;
   } catch (const RunInterrupted&) {
     throw;

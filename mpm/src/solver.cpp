@@ -391,10 +391,12 @@ void Solver::p2g(unsigned what) {
     }
     auto run = [&](auto what_c) {
       constexpr unsigned W = decltype(what_c)::value;
+      std::vector<char> negative(nstrips_, 0);
       scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
-        kernels::p2g<S, W>(grid, p, b, e, f, inv_rho(g),
-                           (W & kContact) ? &sbox[s] : nullptr);
+        negative[s] |= kernels::p2g<S, W>(grid, p, b, e, f, inv_rho(g),
+                                          (W & kContact) ? &sbox[s] : nullptr);
       });
+      for (char n : negative) collapsed_ += n;
     };
     using std::integral_constant;
     if (body && momentum && force) run(integral_constant<unsigned, kMomentum | kForce | kContact>());
@@ -777,7 +779,6 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
     const double* gx = start_field ? f.vx : (remapped_field ? f.qx : f.vnx);
     const double* gy = start_field ? f.vy : (remapped_field ? f.qy : f.vny);
     std::vector<double> diss(nstrips_, 0.0);
-    std::vector<long> collapsed(nstrips_, 0);
     parallel(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
       if (b == e) return;
       RowSpan r;
@@ -796,11 +797,9 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
         case Model::J2Film: d = run(std::integral_constant<Model, Model::J2Film>()); break;
       }
       diss[s] += d;
-      collapsed[s] += r.collapsed;
       if (move) merge_rows(s, r);
     });
     for (double d : diss) energy.dissipated += d;
-    for (long c : collapsed) collapsed_ += c;
   }
 }
 
@@ -898,8 +897,9 @@ void Solver::step_with() {
 
 // Health checks at the end of a step, from reductions the step's own passes made (no extra pass
 // unless one fails), in the order a blow-up shows them: no particle faster than a cell per step
-// (the transfer assumes a particle stays within its stencil); no particle volume collapsed or
-// inverted (J <= 0); the particles' kinetic energy (from g2p) within opt.energy_bound times the
+// (the transfer assumes a particle stays within its stencil); no particle volume inverted (J < 0,
+// seen by the internal-force p2g, which loads the volumes: a volume the stress update of step n
+// inverts stops step n + 1); the particles' kinetic energy (from g2p) within opt.energy_bound times the
 // energy put in (initial + |external work|, with a floor of 1e-12 sum(m c_d^2) for a run with
 // nothing put in). Nodal values would not do: a node holding a sliver of mass at a body's edge
 // takes a large velocity the particles hardly see.
@@ -929,8 +929,10 @@ void Solver::check_health() {
     throw std::runtime_error(o.str());
   }
   if (collapsed > 0) {
-    std::size_t k = 0;
-    while (k < p.size() && p.vol[k] > 0 && std::isfinite(p.vol[k])) ++k;
+    std::size_t k = p.size();
+    long n = 0;
+    for (std::size_t q = 0; q < p.size(); ++q)
+      if (!(p.vol[q] > 0) && n++ == 0) k = q;
     std::ostringstream o;
     o << "particle volume collapsed ";
     where(o);
@@ -939,7 +941,7 @@ void Solver::check_health() {
       particle(o, k);
       o << " has J = V/V0 = " << p.vol[k] / (p.mass[k] * inv_rho(p.group[k]));
     }
-    o << " (" << collapsed << " particle(s) with J <= 0); the run is unstable or the deformation "
+    o << " (" << n << " particle(s) with J <= 0); the run is unstable or the deformation "
          "too large for the grid (reduce time.cfl or time.dt, refine the grid)";
     throw std::runtime_error(o.str());
   }

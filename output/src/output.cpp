@@ -426,11 +426,13 @@ void SnapshotWriter::write_xdmf() const {
   if (!f)
     throw std::runtime_error("cannot open XDMF file '" + tmp + "' for writing: " +
                              std::strerror(errno));
-  const bool ok = std::fwrite(s.data(), 1, s.size(), f) == s.size();
+  const bool ok = std::fwrite(s.data(), 1, s.size(), f) == s.size() && std::fflush(f) == 0;
+  const int err = errno;
   const bool closed = std::fclose(f) == 0;
   if (!ok || !closed) {
+    const std::string why = std::strerror(ok ? errno : err);
     std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write XDMF file '" + tmp + "'");
+    throw std::runtime_error("cannot write XDMF file '" + tmp + "': " + why);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string err = std::strerror(errno);

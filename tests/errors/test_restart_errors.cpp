@@ -157,3 +157,42 @@ TEST(RestartErrors, RunFailureExitsTwoWithMarker) {
 
 }  // namespace
 }  // namespace smpm
+
+namespace smpm {
+namespace {
+
+using namespace restart_testing;
+
+// A disk that fills during the run (a 1 MB tmpfs; skipped where mounting is not allowed): the
+// snapshots, the history or a checkpoint fail to write, and the run stops with exit 2, an error
+// naming the file and no summary.json; RUN_INCOMPLETE, written when the run started, stays.
+TEST(RestartErrors, DiskFillsDuringTheRun) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
+  const fs::path mnt = scratch() / "small_disk";
+  fs::create_directories(mnt);
+  if (std::system(("mount -t tmpfs -o size=1M tmpfs \"" + mnt.string() + "\" 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs here";
+  struct Unmount {
+    fs::path p;
+    ~Unmount() { std::system(("umount \"" + p.string() + "\"").c_str()); }
+  } unmount{mnt};
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"snapshots", "--set output.snapshots=20"},
+      {"checkpoints", "--set output.snapshots=0 --set output.checkpoint_every=5"},
+  };
+  for (const auto& [tag, args] : runs) {
+    json c = small_plate(4, 120);
+    const std::string f = write_case("full_" + tag, c);
+    const fs::path out = mnt / tag;
+    const Cli r = cli("run " + f + " --out " + out.string() + " " + args, "full_" + tag);
+    EXPECT_EQ(r.code, 2) << tag << ": " << r.err;
+    EXPECT_NE(r.err.find(out.string()), std::string::npos) << tag << ": " << r.err;
+    EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << tag << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out / "summary.json")) << tag;
+    EXPECT_TRUE(fs::exists(out / "RUN_INCOMPLETE")) << tag;
+    fs::remove_all(out);
+  }
+}
+
+}  // namespace
+}  // namespace smpm

@@ -62,7 +62,6 @@ struct RowSpan {
   int lo = std::numeric_limits<int>::max();
   int hi = std::numeric_limits<int>::min();
   int out = 0;
-  int collapsed = 0;  // stress update: particles whose volume is not positive (J <= 0) or finite
   double kinetic = 0; // g2p: kinetic energy of the particles' new velocities
   double speed2 = 0;  // g2p: largest squared particle speed
   void add(int r, bool outside) {
@@ -77,8 +76,10 @@ namespace kernels {
 // Particle to grid over [b, e) (paper Eq. 15, 18): mass and momentum, and/or the internal force.
 // With kContact the node box the particles touch is grown in `box`.
 // inv_rho: 1 / density of the range's material (shapes that need the particle size).
+// Returns whether a particle of the range has a negative volume (J < 0; kForce passes only: the
+// health check reads it from the pass that loads the volumes anyway).
 template <class Shape, unsigned WHAT>
-inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
+inline bool p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
                 double inv_rho, NodeBox* box = nullptr) {
   const double ih = g.inv_h;
   const long nnx = g.nnx;
@@ -88,6 +89,7 @@ inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
   const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
   Shape sf;
   long nodes[Shape::kNodes];
+  bool negative = false;
   for (uint32_t k = b; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
@@ -118,12 +120,14 @@ inline void p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
     }
     if constexpr ((WHAT & kForce) != 0) {
       const double v = V[k], sxx = SXX[k], syy = SYY[k], sxy = SXY[k];
+      negative |= std::signbit(v);
       for (int a = 0; a < Shape::kNodes; ++a) {
         f.fx[nodes[a]] -= v * (sxx * sf.dNx[a] + sxy * sf.dNy[a]);
         f.fy[nodes[a]] -= v * (sxy * sf.dNx[a] + syy * sf.dNy[a]);
       }
     }
   }
+  return negative;
 }
 
 // Grid to particle over [b, e): velocities from the field's start (vx, vy) and updated (vnx, vny)
@@ -140,6 +144,7 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   double* X = p.x.data(); double* Y = p.y.data();
   double* VX = p.vx.data(); double* VY = p.vy.data();
   const double* M = p.mass.data();
+  double kinetic = 0, speed2 = 0;  // kept local: a reference could alias the particle arrays
   Shape sf;
   long nodes[Shape::kNodes];
   for (uint32_t k = b; k < e; ++k) {
@@ -158,8 +163,8 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
     const double nvy = flip * (VY[k] + dvy) + pic * wy;
     VX[k] = nvx; VY[k] = nvy;
     const double v2 = nvx * nvx + nvy * nvy;  // health checks (Solver::check_health)
-    rows.kinetic += 0.5 * M[k] * v2;
-    rows.speed2 = v2 > rows.speed2 ? v2 : rows.speed2;
+    kinetic += 0.5 * M[k] * v2;
+    speed2 = v2 > speed2 ? v2 : speed2;
     if constexpr (REMAP) {
       const double mvx = M[k] * nvx, mvy = M[k] * nvy;
       for (int a = 0; a < Shape::kNodes; ++a) {
@@ -173,6 +178,8 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
       rows.add(static_cast<int>(std::floor((Y[k] - y0) * ih)), !(X[k] >= x0 && X[k] < x1));
     }
   }
+  rows.kinetic += kinetic;
+  rows.speed2 = speed2 > rows.speed2 ? speed2 : rows.speed2;
 }
 
 // Stress update over [b, e) for one material group with model MODEL: velocity gradient from the
@@ -223,7 +230,6 @@ inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
                                 EP[k]);
     SXX[k] = sxx; SYY[k] = syy; SZZ[k] = szz; SXY[k] = sxy;
     V[k] *= (1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt;
-    rows.collapsed += !(V[k] > 0 && V[k] < std::numeric_limits<double>::infinity());
     diss += wp * V[k];
     if constexpr (MOVE) {
       X[k] += dt * wx;

@@ -190,7 +190,7 @@ class Solver {
   void check_health();
   long outside_ = -1;  // index of a particle that left the grid in the last pass
   // Health-check reductions of the current step (check_health).
-  long collapsed_ = 0;         // particles with J <= 0 after the stress update
+  long collapsed_ = 0;         // strips holding a particle with J < 0 (internal-force p2g)
   double step_kinetic_ = 0;    // particles' kinetic energy from g2p
   double step_speed2_ = 0;     // largest squared particle speed from g2p
   double energy_floor_ = 0;    // 1e-12 sum(m c_d^2): the energy bound's floor
