@@ -216,6 +216,7 @@ Geometry load_geometry(const std::string& file, double size,
   std::error_code ec;
   if (!fs::exists(file, ec)) throw GeometryError(file + ": cannot open file (it does not exist)");
   if (fs::is_directory(file, ec)) throw GeometryError(file + ": cannot open file (it is a directory)");
+  if (const std::string e = gmsh_input_problem(file); !e.empty()) throw GeometryError(file + ": " + e);
   {
     std::ifstream f(file, std::ios::binary);
     if (!f) throw GeometryError(file + ": cannot open file (not readable)");
@@ -269,6 +270,8 @@ Geometry load_geometry(const std::string& file, double size,
             [&] { gmsh::open(opened); });
   if (geo) {
     if (size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", size);
+    if (const std::string e = gmsh_mesh_size_problem(size, 1e7); !e.empty())
+      throw GeometryError(file + ": " + e);
     gmsh_call(session, file, "mesh the geometry", [&] { gmsh::model::mesh::generate(2); });
   }
 

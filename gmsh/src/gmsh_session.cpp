@@ -1,5 +1,8 @@
 #include "silentmpm/gmsh_session.hpp"
 
+#include <cstdio>
+#include <filesystem>
+
 #include <gmsh.h>
 
 #include <exception>
@@ -89,6 +92,41 @@ std::string GmshSession::load_error(const std::function<void()>& call) const {
   }
   if (err.empty()) err = first_logged_error();
   return err;
+}
+
+std::string gmsh_input_problem(const std::string& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(file, ec);
+  if (ec || !fs::exists(st)) return "cannot open file (it does not exist)";
+  if (fs::is_directory(st)) return "cannot open file (it is a directory)";
+  if (!fs::is_regular_file(st))
+    return "is not a regular file (a device, a pipe or a socket): give a gmsh .geo or .msh file";
+  const auto bytes = fs::file_size(file, ec);
+  constexpr std::uintmax_t kMax = 256u << 20;
+  if (!ec && bytes > kMax)
+    return "is " + std::to_string(bytes >> 20) + " MB; gmsh inputs over 256 MB are refused";
+  return {};
+}
+
+std::string gmsh_mesh_size_problem(double h, double max_cells) {
+  if (!(h > 0)) return {};
+  double x0, y0, z0, x1, y1, z1;
+  try {
+    gmsh::model::getBoundingBox(-1, -1, x0, y0, z0, x1, y1, z1);
+  } catch (...) {
+    return {};  // no entities: the meshing reports it
+  }
+  const double w = x1 - x0, hh = y1 - y0;
+  if (!(w > 0) || !(hh > 0)) return {};
+  const double cells = w * hh / (h * h);
+  if (cells <= max_cells) return {};
+  char b[256];
+  std::snprintf(b, sizeof b,
+                "a mesh of size %g would have about %.3g cells (bounding box %g x %g m); at most "
+                "%.3g are allowed: use a larger size",
+                h, cells, w, hh, max_cells);
+  return b;
 }
 
 }  // namespace smpm

@@ -41,4 +41,13 @@ class GmshSession {
   std::unique_lock<std::mutex> lock_;
 };
 
+// Pre-flight checks of a gmsh input, before anything is read or meshed ("" when fine):
+// the file must be a regular file (not a device such as /dev/zero, a pipe or a directory) of at
+// most 256 MB.
+std::string gmsh_input_problem(const std::string& file);
+// After gmsh::open, before meshing at element size h (h <= 0: the file's own sizes, not checked):
+// the cells a mesh of size h would have, estimated from the model's bounding box as area / h^2,
+// must not exceed max_cells. The message gives the estimate and the box.
+std::string gmsh_mesh_size_problem(double h, double max_cells);
+
 }  // namespace smpm
