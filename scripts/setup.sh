@@ -10,6 +10,7 @@ PKGS=(
   libhdf5-openmpi-dev             # HDF5 snapshots (the flavour deal.II links)
   libdeal.ii-dev gmsh libgmsh-dev # FEM far-field and geometry
   python3-matplotlib python3-numpy python3-h5py   # study figures
+  python3-meshio                  # tests: every XDMF output read back by a second reader
 )
 missing=()
 for p in "${PKGS[@]}"; do

@@ -48,12 +48,17 @@ struct Deal {
 
 // deal.II writes the XDMF time values with 6 digits, the particles' file with 10: a reader
 // then pairs an FE snapshot with the wrong particle one. Rewrite them as the particles' file
-// does (%.9e), in order, through a temporary file and a rename.
+// does (%.9e), in order, through a temporary file and a rename. The file is also declared
+// XDMF 3 (its elements are valid XDMF 3; readers such as meshio refuse version 2.0), as the
+// particles' file is.
 static void rewrite_xdmf_times(const std::string& path, const std::vector<double>& times) {
   std::ifstream in(path);
   std::stringstream buf;
   buf << in.rdbuf();
   std::string text = buf.str(), outtext;
+  const std::string v2 = "<Xdmf Version=\"2.0\"";
+  if (const std::size_t v = text.find(v2); v != std::string::npos)
+    text.replace(v, v2.size(), "<Xdmf Version=\"3.0\"");
   const std::string key = "<Time Value=\"";
   std::size_t pos = 0, k = 0;
   while (true) {

@@ -8,6 +8,7 @@
 //     id                       N uint32 (permanent particle id; particles are re-sorted)
 //     state                    N int32 (film model: 0 elastic, 1 plastic, 2 decohesion, 3 separated)
 //     normal_x normal_y jump_n jump_t ubar   N double (film model: critical plane and jump)
+//   /vertices_N                N int64 0 .. N-1: the Polyvertex connectivity of N particles
 // DIR/<base>.xdmf is an XDMF 3 temporal collection of Polyvertex grids that point into the .h5
 // by relative file name, so the output folder can be moved as a whole. It is rewritten (through
 // a temporary file and a rename) after every snapshot, so a partial run opens in ParaView.
@@ -161,6 +162,8 @@ std::string step_name(long step) {
   return buf;
 }
 
+std::string vertices_name(std::size_t n) { return "vertices_" + std::to_string(n); }
+
 std::string xml_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
@@ -263,7 +266,7 @@ int SnapshotWriter::resume(const std::string& dir, const std::string& base,
   if (H5Literate(f, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_name, &names) < 0)
     h5_fail("cannot list the snapshot groups", path);
   for (const auto& n : names) {
-    bool listed = false;
+    bool listed = n.rfind("vertices_", 0) == 0;  // connectivity, shared by the snapshots
     for (long st : steps) listed = listed || n == step_name(st);
     if (!listed && H5Ldelete(f, n.c_str(), H5P_DEFAULT) < 0)
       h5_fail("cannot remove the later snapshot '/" + n + "'", path);
@@ -359,6 +362,15 @@ void SnapshotWriter::write(const Particles& p, long step, double time) {
   film("jump_t", p.jump_t);
   film("ubar", p.ubar);
 
+  // The vertex connectivity 0 .. N-1 of the Polyvertex topology (XDMF 3 readers and meshio need
+  // it): one dataset per particle count, shared by the snapshots of that count.
+  const std::string vname = vertices_name(n);
+  if (H5Lexists(file, vname.c_str(), H5P_DEFAULT) <= 0) {
+    std::vector<int64_t> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<int64_t>(i);
+    write_dataset(file, vname.c_str(), H5T_STD_I64LE, H5T_NATIVE_INT64, v.data(), n, 1, path, "");
+  }
+
   if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
 
   if (slot < steps_.size()) {
@@ -391,7 +403,7 @@ void SnapshotWriter::write_xdmf() const {
   s += "  <Domain>\n";
   s += "    <Grid Name=\"" + xml_escape(base_) +
        "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  char buf[512];
+  char buf[2048];
   for (std::size_t k = 0; k < steps_.size(); ++k) {
     const std::size_t n = sizes_[k];
     if (n == 0) continue;  // an empty Polyvertex grid is not readable; the .h5 still has it
@@ -400,12 +412,16 @@ void SnapshotWriter::write_xdmf() const {
                   "      <Grid Name=\"%s\" GridType=\"Uniform\">\n"
                   "        <Time Value=\"%.9e\"/>\n"
                   "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
-                  "NodesPerElement=\"1\"/>\n"
+                  "NodesPerElement=\"1\">\n"
+                  "          <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
+                  "Format=\"HDF\">%s:/%s</DataItem>\n"
+                  "        </Topology>\n"
                   "        <Geometry GeometryType=\"XYZ\">\n"
                   "          <DataItem Dimensions=\"%zu 3\" NumberType=\"Float\" Precision=\"8\" "
                   "Format=\"HDF\">%s:/%s/xyz</DataItem>\n"
                   "        </Geometry>\n",
-                  g.c_str(), times_[k], n, n, h5.c_str(), g.c_str());
+                  g.c_str(), times_[k], n, n, h5.c_str(), vertices_name(n).c_str(), n, h5.c_str(),
+                  g.c_str());
     s += buf;
     for (const auto& f : kScalarFields) {
       std::snprintf(buf, sizeof buf,

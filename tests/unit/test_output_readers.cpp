@@ -1,0 +1,85 @@
+// Every XDMF output read back by a second reader, meshio (Debian's python3-meshio, installed by
+// scripts/setup.sh): a hybrid run's particles.xdmf (Polyvertex grids with their connectivity)
+// and fem.xdmf (declared XDMF 3) open, with the particle, node and cell counts of summary.json,
+// the same snapshot times in both files, and the particles' mass summing to the bodies' mass.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "silentmpm/case.hpp"
+#include "silentmpm/driver.hpp"
+#include "test_restart_common.hpp"
+
+namespace smpm {
+namespace {
+
+using namespace restart_testing;
+
+TEST(OutputReaders, MeshioReadsParticleAndFemSnapshots) {
+  if (std::system("/usr/bin/python3 -c 'import meshio' 2>/dev/null") != 0)
+    GTEST_SKIP() << "python3-meshio is not installed (scripts/setup.sh installs it)";
+  json c = hybrid_case_testing::plate_case("hybrid");
+  c["output"]["snapshots"] = 3;
+  const std::string file = write_case("readers_hybrid", c);
+  const fs::path out = scratch() / "readers_out";
+  fs::remove_all(out);
+  Case cs = load_case(file);
+  double mass = 0;
+  for (double m : cs.solver->p.mass) mass += m;
+  run_case(cs, out.string());
+  const json s = json::parse(read_file(out / "summary.json"));
+
+  const fs::path script = scratch() / "readers.py", result = scratch() / "readers.txt";
+  std::ofstream(script) << R"(import sys, meshio
+d = sys.argv[1]
+with open(sys.argv[2], 'w') as out:
+    for name in ('particles', 'fem'):
+        with meshio.xdmf.TimeSeriesReader(d + '/' + name + '.xdmf') as r:
+            pts, cells = r.read_points_cells()
+            out.write('%s %d %d %s %d\n' % (name, len(pts), sum(len(c.data) for c in cells),
+                                             cells[0].type, r.num_steps))
+            for k in range(r.num_steps):
+                t, pd, cd = r.read_data(k)
+                extra = pd['mass'].sum() if name == 'particles' else pd['displacement'].shape[1]
+                out.write('%s_step %.9e %.17g\n' % (name, t, extra))
+)";
+  ASSERT_EQ(std::system(("/usr/bin/python3 " + script.string() + " " + out.string() + " " +
+                         result.string()).c_str()),
+            0);
+  std::ifstream in(result);
+  std::string name, type;
+  long points = 0, ncells = 0, steps = 0;
+  in >> name >> points >> ncells >> type >> steps;
+  EXPECT_EQ(name, "particles");
+  EXPECT_EQ(points, s["particles"].get<long>());
+  EXPECT_EQ(ncells, points);
+  EXPECT_EQ(type, "vertex");
+  EXPECT_EQ(steps, s["outputs"]["snapshots"].get<long>());
+  std::vector<double> tp, tf;
+  for (long k = 0; k < steps; ++k) {
+    std::string tag;
+    double t, m;
+    in >> tag >> t >> m;
+    tp.push_back(t);
+    EXPECT_NEAR(m, mass, 1e-12 * mass) << "snapshot " << k;
+  }
+  long fsteps = 0;
+  in >> name >> points >> ncells >> type >> fsteps;
+  EXPECT_EQ(name, "fem");
+  EXPECT_EQ(points, s["fem"]["nodes"].get<long>());
+  EXPECT_EQ(ncells, s["fem"]["cells"].get<long>());
+  EXPECT_EQ(type, "quad");
+  EXPECT_EQ(fsteps, steps);
+  for (long k = 0; k < fsteps; ++k) {
+    std::string tag;
+    double t, comps;
+    in >> tag >> t >> comps;
+    tf.push_back(t);
+    EXPECT_EQ(comps, 3);  // displacement as a 3-vector (z = 0)
+  }
+  EXPECT_EQ(tp, tf) << "the particle and FE snapshots must carry the same times";
+}
+
+}  // namespace
+}  // namespace smpm
