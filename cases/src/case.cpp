@@ -15,6 +15,8 @@
 #include "silentmpm/case.hpp"
 #include "case_fem.hpp"
 #include "case_keys.hpp"
+#include <unistd.h>
+
 #include "case_util.hpp"
 #include "silentmpm/geometry.hpp"
 
@@ -853,6 +855,22 @@ class Builder {
     if (estimate > kMaxParticles)
       ctx_.fail("bodies", "too many particles (about " + fmt(estimate) + "; the limit is " +
                               fmt(kMaxParticles) + ")");
+    // Memory before allocating: the grid's 14 nodal arrays (and 13 more per body with
+    // multi-field contact) and the particle arrays with the film block, against the machine's
+    // physical memory.
+    {
+      const double nodes = (grid_.nx + 1.0) * (grid_.ny + 1.0);
+      const double per_node = 15 * 8.0 + (s_->contact.multi() ? 16 * 8.0 * bodies_.size() : 0.0);
+      const double per_particle = Particles::bytes_per_particle() + Particles::film_bytes_per_particle();
+      const double bytes = nodes * per_node + estimate * per_particle;
+      const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+      const double phys = pages > 0 && page > 0 ? static_cast<double>(pages) * page : 0.0;
+      if (phys > 0 && bytes > 0.8 * phys)
+        ctx_.fail("grid", "the run would need about " + fmt_down(bytes / 1e9) + " GB (" +
+                              fmt(nodes) + " grid nodes, about " + fmt(estimate) +
+                              " particles); this machine has " + fmt_down(phys / 1e9) +
+                              " GB of memory: use larger cells or a smaller grid");
+    }
     s_->grid.init(grid_.x0, grid_.y0, grid_.h, grid_.nx, grid_.ny);
     s_->materials = materials_;
     for (std::size_t i = 0; i < bodies_.size(); ++i) {

@@ -3,7 +3,10 @@
 // read or meshed (both used to hang: /dev/zero was read without end, 1e12 cells were meshed).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <chrono>
+#include <cmath>
 
 #include "silentmpm/case.hpp"
 #include "test_restart_common.hpp"
@@ -37,6 +40,24 @@ TEST(Preflight, DevicesAndHugeMeshesAreRefusedBeforeMeshing) {
   json mpm = small_plate(1, 10);
   mpm["geometry"] = {{"file", "/dev/zero"}};
   expect_fast_error(mpm, "geometry_device", "geometry.file: /dev/zero: is not a regular file");
+}
+
+// A grid and particles that would not fit in memory: refused before anything is allocated, with
+// the estimate (the grid is sized from this machine's memory; beyond what the case limits of
+// 2e8 cells and particles can ask for, the test is skipped).
+TEST(Preflight, RunLargerThanMemoryIsRefusedBeforeAllocating) {
+  const double phys = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * ::sysconf(_SC_PAGE_SIZE);
+  const double per_cell = 15 * 8.0 + 4 * 161.0;  // grid node + 4 particles with the film block
+  const double cells = 0.9 * phys / per_cell;
+  if (cells > 1.9e8) GTEST_SKIP() << "this machine has more memory than a case may ask for";
+  const long n = static_cast<long>(std::ceil(std::sqrt(cells)));
+  json c = small_plate(4, 10);
+  const double h = 1e-3;
+  c["grid"] = {{"origin", {0.0, 0.0}}, {"size", {n * h, n * h}}, {"cell", h}};
+  c["bodies"][0]["box"] = {0.0, 0.0, n * h, n * h};
+  c["boundaries"] = json::array();
+  c["probes"] = json::array();
+  expect_fast_error(c, "memory", "the run would need about");
 }
 
 }  // namespace
