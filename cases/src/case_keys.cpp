@@ -174,7 +174,10 @@ std::uint64_t case_fingerprint(const ojson& doc) {
   if (d.is_object()) {
     d.erase("output");
     if (d.contains("time") && d["time"].is_object()) d["time"].erase("end");
-    if (d.contains("scheme") && d["scheme"].is_object()) d["scheme"].erase("threads");
+    if (d.contains("scheme") && d["scheme"].is_object()) {
+      d["scheme"].erase("threads");
+      if (d["scheme"].empty()) d.erase("scheme");  // --threads on a case without "scheme"
+    }
   }
   const std::string text = d.dump();
   return fnv1a64(text.data(), text.size());

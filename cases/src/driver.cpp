@@ -56,12 +56,17 @@ class SignalGuard {
   struct sigaction old_int_ {}, old_term_ {};
 };
 
+// One buffer the size of the file (a checkpoint may be most of the memory: no stream copies).
 std::string read_whole(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw std::runtime_error(p.string() + ": cannot read it back");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  std::error_code ec;
+  const auto size = fs::file_size(p, ec);
+  std::FILE* f = ec ? nullptr : std::fopen(p.c_str(), "rb");
+  if (!f) throw std::runtime_error(p.string() + ": cannot read it");
+  std::string s(size, '\0');
+  const bool ok = std::fread(s.data(), 1, size, f) == size;
+  std::fclose(f);
+  if (!ok) throw std::runtime_error(p.string() + ": cannot read it");
+  return s;
 }
 
 std::string hex(std::uint64_t v) {
@@ -76,8 +81,7 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
                  std::string& history, std::string& note) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) throw StateError(file + ": no such checkpoint file");
-  const std::string bytes = read_whole(file);
-  StateReader r(bytes, file);
+  StateReader r(read_whole(file), file);
   const std::string version = r.get_string("run.version");
   if (version != SMPM_VERSION)
     r.fail("written by silentmpm " + version + ", this is " + SMPM_VERSION +
@@ -203,8 +207,9 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
         std::ostringstream why;
         why << "interrupted by " << name << " after step " << n << " of " << nsteps
             << " (t = " << region.time() << " s); checkpoint " << (dir / checkpoint_file_name()).string()
-            << "; continue with: silentmpm run " << c.source << " --out " << out_dir
-            << " --restart " << (dir / checkpoint_file_name()).string();
+            << "; continue with: silentmpm run '" << c.source << "' --out '" << out_dir
+            << "' --restart '" << (dir / checkpoint_file_name()).string()
+            << "' (and the same --set and --shape options as this run)";
         mark_incomplete(dir, why.str());
         throw RunInterrupted(why.str());
       }

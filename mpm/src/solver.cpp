@@ -932,16 +932,16 @@ void Solver::check_health() {
     std::size_t k = p.size();
     long n = 0;
     for (std::size_t q = 0; q < p.size(); ++q)
-      if (!(p.vol[q] > 0) && n++ == 0) k = q;
+      if (std::signbit(p.vol[q]) && n++ == 0) k = q;
     std::ostringstream o;
-    o << "particle volume collapsed ";
+    o << "particle volume inverted ";
     where(o);
     if (k < p.size()) {
       o << ": ";
       particle(o, k);
       o << " has J = V/V0 = " << p.vol[k] / (p.mass[k] * inv_rho(p.group[k]));
     }
-    o << " (" << n << " particle(s) with J <= 0); the run is unstable or the deformation "
+    o << " (" << n << " particle(s) with J < 0); the run is unstable or the deformation "
          "too large for the grid (reduce time.cfl or time.dt, refine the grid)";
     throw std::runtime_error(o.str());
   }

@@ -2,6 +2,7 @@
 // reads that an earlier step wrote. What setup computes from the case (grid, materials, layer
 // selections, dashpot and spring coefficients, damping) is rebuilt from the case file itself.
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "silentmpm/solver.hpp"
@@ -43,10 +44,6 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   std::vector<std::uint32_t> ranges;
   for (const auto& r : ranges_) ranges.insert(ranges.end(), {r[0], r[1]});
   w.put(pre + "ranges", ranges);
-  w.put(pre + "strip_lo", strip_lo_);
-  w.put(pre + "strip_hi", strip_hi_);
-  w.put(pre + "strip_out", strip_out_);
-  w.put(pre + "strips_ok", static_cast<std::uint8_t>(strips_ok_));
   std::vector<std::int32_t> boxes;
   for (const auto& F : fields_) boxes.insert(boxes.end(), F.box.begin(), F.box.end());
   w.put(pre + "field_boxes", boxes);
@@ -72,8 +69,18 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
   steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
   energy = r.get<Energies>(pre + "energy");
   contact.dissipated = r.get<double>(pre + "contact_dissipated");
-  for (uint32_t id : p.id)
-    if (id >= n) r.fail("particle id " + std::to_string(id) + " out of range (corrupt checkpoint)");
+  // What the step indexes with must be valid whatever the file says (a checksum guards against
+  // accidents, not edits): ids a permutation, groups and bodies in range, particles finite and
+  // on the grid.
+  const std::size_t G = std::max<std::size_t>(1, materials.size());
+  std::vector<uint8_t> seen(n, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (p.id[k] >= n || seen[p.id[k]]++)
+      r.fail("particle ids are not a permutation (corrupt checkpoint)");
+    if (p.group[k] >= G) r.fail("particle material group out of range (corrupt checkpoint)");
+    if (!std::isfinite(p.x[k]) || !std::isfinite(p.y[k]) || !grid.inside(p.x[k], p.y[k]))
+      r.fail("particle " + std::to_string(p.id[k]) + " is not on the grid (corrupt checkpoint)");
+  }
   where_.assign(n, 0);
   for (std::size_t k = 0; k < n; ++k) where_[p.id[k]] = static_cast<uint32_t>(k);
   auto reindex = [&](BoundaryLayer& L) {
@@ -90,23 +97,32 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
     sort_particles();
     return false;
   }
-  const std::size_t G = std::max<std::size_t>(1, materials.size());
+  // The ranges must tile [0, n) in order, each holding particles of its own group.
   std::vector<std::uint32_t> ranges;
   r.get(pre + "ranges", ranges, 2 * nstrips_ * G);
+  std::uint32_t next = 0;
   for (std::size_t k = 0; k < ranges_.size(); ++k) {
-    if (ranges[2 * k] > ranges[2 * k + 1] || ranges[2 * k + 1] > n)
-      r.fail("particle range out of bounds (corrupt checkpoint)");
+    if (ranges[2 * k] != next || ranges[2 * k + 1] < next || ranges[2 * k + 1] > n)
+      r.fail("particle ranges do not tile the particles (corrupt checkpoint)");
+    for (std::uint32_t q = ranges[2 * k]; q < ranges[2 * k + 1]; ++q)
+      if (p.group[q] != k % G) r.fail("particle ranges mix material groups (corrupt checkpoint)");
     ranges_[k] = {ranges[2 * k], ranges[2 * k + 1]};
+    next = ranges[2 * k + 1];
   }
-  r.get(pre + "strip_lo", strip_lo_, nstrips_);
-  r.get(pre + "strip_hi", strip_hi_, nstrips_);
-  r.get(pre + "strip_out", strip_out_, nstrips_);
-  strips_ok_ = r.get<std::uint8_t>(pre + "strips_ok") != 0;
+  if (next != n) r.fail("particle ranges do not tile the particles (corrupt checkpoint)");
+  // The strip rows and their conflict flag follow from the positions and the ranges exactly as
+  // the last step's moving pass left them (the same floor of the same coordinates).
+  refresh_strip_rows();
+  strips_ok_ = !strips_conflict();
   refresh_fields();
   std::vector<std::int32_t> boxes;
   r.get(pre + "field_boxes", boxes, 4 * fields_.size());
-  for (std::size_t k = 0; k < fields_.size(); ++k)
-    fields_[k].box = {boxes[4 * k], boxes[4 * k + 1], boxes[4 * k + 2], boxes[4 * k + 3]};
+  for (std::size_t k = 0; k < fields_.size(); ++k) {
+    NodeBox b{boxes[4 * k], boxes[4 * k + 1], boxes[4 * k + 2], boxes[4 * k + 3]};
+    if (!box_empty(b) && (b[0] < 0 || b[1] >= grid.nnx || b[2] < 0 || b[3] >= grid.nny))
+      r.fail("a node box lies outside the grid (corrupt checkpoint)");
+    fields_[k].box = b;
+  }
   return true;
 }
 

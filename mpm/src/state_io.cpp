@@ -40,8 +40,10 @@ void StateWriter::raw(const std::string& name, std::size_t elem, std::size_t cou
   if (count) buf_.append(static_cast<const char*>(data), elem * count);
 }
 
-std::string StateWriter::bytes() const {
-  std::string out = buf_;
+std::string StateWriter::bytes() {
+  std::string out = std::move(buf_);
+  buf_.clear();
+  names_.clear();
   append(out, static_cast<std::uint32_t>(3));
   out += "end";
   append(out, static_cast<std::uint32_t>(0));

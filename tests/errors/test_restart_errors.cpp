@@ -3,6 +3,7 @@
 // output folder is left without anything that looks complete.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
 
 #include "silentmpm/case.hpp"
@@ -88,6 +89,26 @@ TEST(RestartErrors, UnusableCheckpointsAreRefused) {
   // Another kind of run: an FEM case with an MPM checkpoint.
   expect_refused(write_case("ck_fem", hybrid_case_testing::plate_case("fem")), s.ck, "fem",
                  "a checkpoint of a run of kind \"mpm\", this case is of kind \"fem\"");
+
+  // Edited values behind a recomputed checksum: a material group out of range and a particle off
+  // the grid are refused, not indexed with.
+  auto edited = [&](const std::string& block, std::size_t offset, const void* v, std::size_t n,
+                    const std::string& tag) {
+    std::string b = bytes;
+    const std::size_t at = b.find(block);
+    EXPECT_NE(at, std::string::npos) << block;
+    std::memcpy(&b[at + block.size() + 12 + offset], v, n);  // after elem size and count
+    const std::uint64_t sum = fnv1a64(b.data(), b.size() - 8);
+    std::memcpy(&b[b.size() - 8], &sum, 8);
+    const fs::path f = scratch() / (tag + ".smpm");
+    std::ofstream(f, std::ios::binary) << b;
+    return f;
+  };
+  const std::uint16_t group = 200;
+  expect_refused(s.file, edited("mpm.p.group", 2 * 7, &group, 2, "group"), "group",
+                 "particle material group out of range");
+  const double far = 1e9;
+  expect_refused(s.file, edited("mpm.p.x", 8 * 5, &far, 8, "far"), "far", "is not on the grid");
 
   // Another version: a checkpoint written by "0.0.1".
   StateWriter w;

@@ -502,7 +502,7 @@ TEST(HealthCheck, RunawayNodeAndCollapsedParticleStop) {
       FAIL() << "no error";
     } catch (const std::runtime_error& e) {
       const std::string m = e.what();
-      EXPECT_NE(m.find("particle volume collapsed at step 6"), std::string::npos) << m;
+      EXPECT_NE(m.find("particle volume inverted at step 6"), std::string::npos) << m;
       EXPECT_NE(m.find("particle " + std::to_string(s->p.id[k]) + " of body 0"), std::string::npos)
           << m;
       EXPECT_NE(m.find("J = V/V0 = -"), std::string::npos) << m;

@@ -45,8 +45,9 @@ class StateWriter {
     raw(name, sizeof(T), 1, &value);
   }
   void put_string(const std::string& name, const std::string& s) { raw(name, 1, s.size(), s.data()); }
-  // The file's bytes: header, blocks, end mark and checksum.
-  std::string bytes() const;
+  // The file's bytes: header, blocks, end mark and checksum. Moves the buffer out (no copy of a
+  // state that may be most of the memory): the writer is empty afterwards.
+  std::string bytes();
 
  private:
   std::string buf_;
