@@ -11,6 +11,7 @@ PKGS=(
   libdeal.ii-dev gmsh libgmsh-dev # FEM far-field and geometry
   python3-matplotlib python3-numpy python3-h5py   # study figures
   python3-meshio                  # tests: every XDMF output read back by a second reader
+  clang libclang-rt-14-dev libomp-dev  # the fuzzed case loader (scripts/fuzz.sh)
 )
 missing=()
 for p in "${PKGS[@]}"; do

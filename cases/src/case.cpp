@@ -865,6 +865,12 @@ class Builder {
       const double bytes = nodes * per_node + estimate * per_particle;
       const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
       const double phys = pages > 0 && page > 0 ? static_cast<double>(pages) * page : 0.0;
+      const double cap = load_limits().memory_bytes;
+      if (cap > 0 && bytes > cap)
+        ctx_.fail("grid", "the run would need about " + fmt_down(bytes / 1e9) + " GB (" +
+                              fmt(nodes) + " grid nodes, about " + fmt(estimate) +
+                              " particles); the limit set is " + fmt_down(cap / 1e9) +
+                              " GB: use larger cells or a smaller grid");
       if (phys > 0 && bytes > 0.8 * phys)
         ctx_.fail("grid", "the run would need about " + fmt_down(bytes / 1e9) + " GB (" +
                               fmt(nodes) + " grid nodes, about " + fmt(estimate) +
@@ -1102,7 +1108,7 @@ class Builder {
     }
     o.done();
     try {
-      geo_ = std::make_unique<Geometry>(load_geometry(file, size, params));
+      geo_ = std::make_unique<Geometry>(load_geometry(file, size, params, load_limits().mesh_cells));
     } catch (const GeometryError& e) {
       o.fail("file", e.what());
     }
@@ -1243,13 +1249,24 @@ Case load_case(const std::string& path, const std::vector<std::string>& override
   std::ostringstream ss;
   ss << f.rdbuf();
   if (f.bad()) throw CaseError(path + ": cannot read file");
-  Ctx ctx{path, {}};
-  ojson doc = parse_text(ss.str(), path);
+  return load_case_text(ss.str(), path, overrides);
+}
+
+Case load_case_text(const std::string& text, const std::string& source,
+                    const std::vector<std::string>& overrides) {
+  Ctx ctx{source, {}};
+  ojson doc = parse_text(text, source);
   for (const auto& o : overrides) apply_override(ctx, doc, o);
   Case c = build_ordered(ctx, doc);
   c.fingerprint = detail::case_fingerprint(doc);
   return c;
 }
+
+namespace {
+LoadLimits g_limits;
+}
+void set_load_limits(const LoadLimits& limits) { g_limits = limits; }
+const LoadLimits& load_limits() { return g_limits; }
 
 Case build_case(const nlohmann::json& doc, const std::string& source) {
   Ctx ctx{source, {}};

@@ -153,7 +153,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   if (degree != 1 && degree != 2) f.fail("degree", "must be 1 or 2, got " + std::to_string(degree));
   spec.degree = static_cast<int>(degree);
   try {
-    spec.mesh = fem::load_mesh(mesh_file, size);
+    spec.mesh = fem::load_mesh(mesh_file, size, load_limits().mesh_cells);
   } catch (const fem::FemError& e) {
     f.fail(f.has("size") && std::string(e.what()).find("size") != std::string::npos ? "size" : "mesh",
            e.what());

@@ -4,8 +4,10 @@
 #include "silentmpm/state_io.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 
 #include "case_util.hpp"
 #include "silentmpm/case.hpp"
@@ -17,6 +19,55 @@ bool starts_with(const std::string& s, const std::string& p) {
   return s.size() >= p.size() && s.compare(0, p.size(), p) == 0;
 }
 }  // namespace
+
+}  // namespace smpm::detail
+
+namespace smpm {
+namespace {
+std::string one_line(const std::string& m) {
+  std::string s;
+  s.reserve(m.size());
+  for (const char ch : m) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '\n') s += "\\n";
+    else if (c == '\t') s += "\\t";
+    else if (c == '\r') s += "\\r";
+    else if (c < 0x20 || c == 0x7f) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\x%02x", c);
+      s += b;
+    } else {
+      s += ch;
+    }
+  }
+  // Words (runs without spaces) over 200 characters: the first 80 and the count left out.
+  std::string out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const std::size_t j = std::min(s.find(' ', i), s.size());
+    if (j - i > 200) {
+      // The word's last character stays when it is punctuation (the ':' after a key).
+      const char last = s[j - 1];
+      const bool keep = std::ispunct(static_cast<unsigned char>(last)) != 0;
+      out += s.substr(i, 80) + "...(+" + std::to_string(j - i - 80 - keep) + " characters)";
+      if (keep) out += last;
+    } else
+      out.append(s, i, j - i);
+    if (j < s.size()) out += ' ';
+    i = j + 1;
+  }
+  if (out.size() > 2000)
+    out = out.substr(0, 1500) + " ...(" + std::to_string(out.size() - 1800) +
+          " characters left out)... " + out.substr(out.size() - 300);
+  return out;
+}
+}  // namespace
+
+CaseError::CaseError(const std::string& what) : std::runtime_error(one_line(what)) {}
+
+}  // namespace smpm
+
+namespace smpm::detail {
 
 void Ctx::fail(const std::string& path, const std::string& what) const {
   std::string m = source + ": " + (path.empty() ? "" : path + ": ") + what;

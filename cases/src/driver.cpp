@@ -95,6 +95,10 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
     r.fail("written for another case (" + r.get_string("run.case") + ", fingerprint " + hex(fp) +
            "; this case " + hex(c.fingerprint) + "): only output.*, time.end and scheme.threads "
            "may change between a run and its restart");
+  if (r.has("run.failed"))
+    r.fail("the state of a step that failed (" + r.get_string("run.failed") + "), kept for "
+           "inspection; restart from the last checkpoint of the run (" + checkpoint_file_name() +
+           ") instead");
   history = r.get_string("run.history");
   const long step = static_cast<long>(r.get<std::int64_t>("run.step"));
   const int threads = r.get<std::int32_t>("run.threads");
@@ -107,10 +111,13 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
   return step;
 }
 
+// A checkpoint (DIR/checkpoint.smpm); with `failed` (the failure's message) the state of a failed
+// step instead (DIR/failed.smpm), which a restart refuses.
 void write_checkpoint(const Case& c, const detail::Region& region, const fs::path& dir,
-                      HistoryWriter& hist) {
+                      HistoryWriter& hist, const std::string& failed = "") {
   hist.flush();
   StateWriter w;
+  if (!failed.empty()) w.put_string("run.failed", failed);
   w.put_string("run.version", SMPM_VERSION);
   w.put_string("run.kind", region.kind());
   w.put_string("run.case", c.source);
@@ -119,7 +126,33 @@ void write_checkpoint(const Case& c, const detail::Region& region, const fs::pat
   w.put("run.threads", static_cast<std::int32_t>(region.threads()));
   w.put_string("run.history", read_whole(dir / "history.csv"));
   region.save(w);
-  detail::write_file_atomically(dir / checkpoint_file_name(), w.bytes());
+  detail::write_file_atomically(
+      dir / (failed.empty() ? checkpoint_file_name() : failed_state_file_name()), w.bytes());
+}
+
+// After a step failed: its state, for inspection, as DIR/failed.smpm and (when the run writes
+// snapshots) a last snapshot. Returns what was written, to append to the failure's message;
+// a write that fails too is only named (the step's failure is the error to report).
+std::string keep_failed_state(const Case& c, detail::Region& region, const fs::path& dir,
+                              const std::string& out_dir, HistoryWriter& hist, bool snapshots,
+                              const std::string& failure) {
+  std::string kept;
+  try {
+    write_checkpoint(c, region, dir, hist, failure);
+    kept = (dir / failed_state_file_name()).string();
+  } catch (const std::exception& e) {
+    kept = std::string("not written: ") + e.what();
+  }
+  std::string msg = "; the failed step's state: " + kept;
+  if (snapshots) {
+    try {
+      region.write_snapshot(out_dir);
+      msg += ", and the last snapshot";
+    } catch (const std::exception& e) {
+      msg += std::string(", snapshot not written: ") + e.what();
+    }
+  }
+  return msg;
 }
 
 // DIR/RUN_INCOMPLETE: why the run stopped and how far it came (no summary.json is written).
@@ -195,7 +228,14 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
     for (long n = first + 1; n <= nsteps; ++n) {
       const double t_before = region.time();
       const auto t0 = Clock::now();
-      region.step();
+      try {
+        region.step();
+      } catch (const HybridError&) {
+        throw;
+      } catch (const std::exception& e) {
+        throw RunFailure(e.what() + keep_failed_state(c, region, dir, out_dir, hist, snap_every != 0,
+                                                      e.what()));
+      }
       step_seconds += seconds_since(t0);
       if (n % hist_every == 0 || n == nsteps) record();
       if (snap_every && (n % snap_every == 0 || n == nsteps)) region.write_snapshot(out_dir);

@@ -28,7 +28,8 @@ fs::path prepare_output_dir(const std::string& out_dir, bool resuming) {
   // A run owns these names: remove what an earlier run left, so that no stale file sits beside
   // the new ones (a rerun with fewer or no snapshots). summary.json first: its presence marks a
   // complete run. Nothing else in the folder is touched.
-  std::vector<const char*> owned = {"summary.json", "RUN_INCOMPLETE", "history.csv", "probes.csv"};
+  std::vector<const char*> owned = {"summary.json", "RUN_INCOMPLETE", "history.csv", "probes.csv",
+                                    "failed.smpm"};
   // A restart keeps the snapshots (trimmed to the checkpoint later) and the checkpoint it read
   // until it writes its own.
   if (!resuming) owned.insert(owned.end(), {"particles.h5", "particles.xdmf", "checkpoint.smpm"});

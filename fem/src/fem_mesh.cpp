@@ -62,10 +62,7 @@ static int find_tag(const std::vector<PhysicalGroup>& gs, const std::string& s) 
 int Mesh::surface_tag(const std::string& s) const { return find_tag(surfaces, s); }
 int Mesh::curve_tag(const std::string& s) const { return find_tag(curves, s); }
 
-// The most cells a mesh may have (a Q1 far field of 1e7 cells takes about 10 GB).
-constexpr double kMaxCells = 1e7;
-
-Mesh load_mesh(const std::string& file, double size) {
+Mesh load_mesh(const std::string& file, double size, double max_cells) {
   std::error_code ec;
   if (!fs::exists(file, ec)) throw FemError(file + ": mesh file not found");
   if (fs::is_directory(file, ec)) throw FemError(file + ": is a directory, not a mesh file");
@@ -102,7 +99,7 @@ Mesh load_mesh(const std::string& file, double size) {
       std::vector<double> h_now;
       gmsh::onelab::getNumber(kSizeParameter, h_now);
       if (!h_now.empty())
-        if (const std::string e = gmsh_mesh_size_problem(h_now[0], kMaxCells); !e.empty()) fail(e);
+        if (const std::string e = gmsh_mesh_size_problem(h_now[0], max_cells); !e.empty()) fail(e);
     }
     gmsh::option::setNumber("Mesh.RecombineAll", 1);
     if (const std::string e = gs.call_error([] { gmsh::model::mesh::generate(2); }); !e.empty())

@@ -211,7 +211,8 @@ void curve_mids(const Geometry& g, Geometry::Curve& c,
 }  // namespace
 
 Geometry load_geometry(const std::string& file, double size,
-                       const std::vector<std::pair<std::string, double>>& parameters) {
+                       const std::vector<std::pair<std::string, double>>& parameters,
+                       double max_cells) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(file, ec)) throw GeometryError(file + ": cannot open file (it does not exist)");
@@ -270,7 +271,7 @@ Geometry load_geometry(const std::string& file, double size,
             [&] { gmsh::open(opened); });
   if (geo) {
     if (size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", size);
-    if (const std::string e = gmsh_mesh_size_problem(size, 1e7); !e.empty())
+    if (const std::string e = gmsh_mesh_size_problem(size, max_cells); !e.empty())
       throw GeometryError(file + ": " + e);
     gmsh_call(session, file, "mesh the geometry", [&] { gmsh::model::mesh::generate(2); });
   }
@@ -315,7 +316,8 @@ Geometry load_geometry(const std::string& file, double size,
   // Surfaces first, so an error names the body's surface before its curves.
   std::stable_sort(groups.begin(), groups.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
-  for (const auto& [dim, tag] : groups) {
+  for (const auto& group : groups) {
+    const int dim = group.first, tag = group.second;  // named copies: lambdas below capture dim
     if (dim != 1 && dim != 2) continue;
     std::string name;
     gmsh::model::getPhysicalName(dim, tag, name);

@@ -275,6 +275,23 @@ double Solver::inv_rho(int g) const {
   return g < static_cast<int>(materials.size()) ? 1.0 / materials[g].rho : 0.0;
 }
 
+// V/m above which a particle of group g is stretched past the stability limit: with constant
+// moduli and the current density rho0 / J its dilatational speed is c_d sqrt(J), so dt stays
+// below h / (c_d sqrt(J)) while J <= (h / (c_d dt))^2 = 1 / CFL^2, i.e. V/m <= 1 / (CFL^2 rho0).
+// The check allows 10 % over that (kStretchMargin): at CFL 1 a particle's elastic strain alone
+// crosses 1 / CFL^2, and runs at CFL 1 stay stable through it (SilentStability.* in the column
+// tests); a particle 10 % past is stretched by far more than elasticity. Off (infinite) for the
+// film model, whose decohered particles carry no stress and may open freely.
+double Solver::stretch_limit(int g) const {
+  constexpr double kStretchMargin = 1.1;
+  if (g >= static_cast<int>(materials.size())) return std::numeric_limits<double>::infinity();
+  const Material& m = materials[g];
+  if (m.model == Model::J2Film || !(m.cd > 0) || !(dt > 0))
+    return std::numeric_limits<double>::infinity();
+  const double r = grid.h / (m.cd * dt);
+  return kStretchMargin * r * r / m.rho;
+}
+
 template <class Fn>
 void Solver::call(Fn&& fn) {
   if (contact.multi()) fn(contact);
@@ -391,12 +408,15 @@ void Solver::p2g(unsigned what) {
     }
     auto run = [&](auto what_c) {
       constexpr unsigned W = decltype(what_c)::value;
-      std::vector<char> negative(nstrips_, 0);
+      std::vector<unsigned> flags(nstrips_, 0);
       scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
-        negative[s] |= kernels::p2g<S, W>(grid, p, b, e, f, inv_rho(g),
-                                          (W & kContact) ? &sbox[s] : nullptr);
+        flags[s] |= kernels::p2g<S, W>(grid, p, b, e, f, inv_rho(g),
+                                       (W & kContact) ? &sbox[s] : nullptr, stretch_limit(g));
       });
-      for (char n : negative) collapsed_ += n;
+      for (unsigned n : flags) {
+        collapsed_ += (n & kernels::kInverted) != 0;
+        stretched_ += (n & kernels::kStretched) != 0;
+      }
     };
     using std::integral_constant;
     if (body && momentum && force) run(integral_constant<unsigned, kMomentum | kForce | kContact>());
@@ -899,14 +919,17 @@ void Solver::step_with() {
 // unless one fails), in the order a blow-up shows them: no particle faster than a cell per step
 // (the transfer assumes a particle stays within its stencil); no particle volume inverted (J < 0,
 // seen by the internal-force p2g, which loads the volumes: a volume the stress update of step n
-// inverts stops step n + 1); the particles' kinetic energy (from g2p) within opt.energy_bound times the
+// inverts stops step n + 1); no particle stretched so far (J large) that its wave speed
+// c_d sqrt(J) puts dt above the stability limit (the same p2g; see stretch_limit); the
+// particles' kinetic energy (from g2p) within opt.energy_bound times the
 // energy put in (initial + |external work|, with a floor of 1e-12 sum(m c_d^2) for a run with
 // nothing put in). Nodal values would not do: a node holding a sliver of mass at a body's edge
 // takes a large velocity the particles hardly see.
 void Solver::check_health() {
-  const long collapsed = collapsed_;
+  const long collapsed = collapsed_, stretched = stretched_;
   const double ke = step_kinetic_, v2 = step_speed2_;
   collapsed_ = 0;
+  stretched_ = 0;
   step_kinetic_ = 0;
   step_speed2_ = 0;
   auto where = [&](std::ostringstream& o) { o << "at step " << steps << " (t = " << t << " s)"; };
@@ -943,6 +966,29 @@ void Solver::check_health() {
     }
     o << " (" << n << " particle(s) with J < 0); the run is unstable or the deformation "
          "too large for the grid (reduce time.cfl or time.dt, refine the grid)";
+    throw std::runtime_error(o.str());
+  }
+  if (stretched > 0) {
+    // The particle most over its limit; its J and the wave speed and stability limit it has.
+    std::size_t k = p.size();
+    double worst = 1;
+    for (std::size_t q = 0; q < p.size(); ++q) {
+      const double r = p.vol[q] / (stretch_limit(p.group[q]) * p.mass[q]);
+      if (r > worst) worst = r, k = q;
+    }
+    std::ostringstream o;
+    o << "time step above the stability limit ";
+    where(o);
+    if (k < p.size()) {
+      const Material& m = materials[p.group[k]];
+      const double J = p.vol[k] / (p.mass[k] * inv_rho(p.group[k]));
+      o << ": ";
+      particle(o, k);
+      o << " has expanded to J = V/V0 = " << J << ", so its wave speed c_d sqrt(J) is "
+        << m.cd * std::sqrt(J) << " m/s and the limit h / (c_d sqrt(J)) is "
+        << grid.h / (m.cd * std::sqrt(J)) << " s, more than 10 % below dt = " << dt << " s";
+    }
+    o << " (reduce time.cfl or time.dt)";
     throw std::runtime_error(o.str());
   }
   if (opt.energy_bound > 0) {

@@ -74,7 +74,9 @@ std::vector<Bad> bad_cases() {
       {"probe_in_no_body", [](ojson& j) { j["probes"][0]["at"] = {0.005, 0.0085}; },
        "probes[0].at: (0.005, 0.0085) is in no body: no particle within a cell of it"},
       {"very_long_unknown_key", [](ojson& j) { j[std::string(100000, 'x')] = 1; },
-       "unknown key"},
+       ": " + std::string(80, 'x') + "...(+99920 characters): unknown key"},
+      {"key_with_a_newline", [](ojson& j) { j["mate\nrials"] = 1; },
+       ": mate\\nrials: unknown key"},
       {"number_overflow", nullptr, "time.end: number 1e999 is out of the range of a double",
        R"({"grid": {"size": [1, 1], "cell": 0.1}, "time": {"end": 1e999, "cfl": 0.5}})"},
       {"number_overflow_in_array", nullptr,
@@ -227,6 +229,9 @@ TEST_P(CaseErrors, NamesTheKeyPath) {
                                                       << msg;
     EXPECT_NE(msg.find(b.expect), std::string::npos)
         << "expected \"" << b.expect << "\" in\n  " << msg;
+    // One readable line, whatever the input.
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_LE(msg.size(), 2000u + file.string().size()) << msg;
   }
 }
 

@@ -161,19 +161,33 @@ TEST(RestartErrors, DiskFullWritingCheckpoint) {
 }
 
 // A run that fails after it started (a particle leaves the grid) exits 2 and leaves
-// RUN_INCOMPLETE naming the cause instead of a summary.
+// RUN_INCOMPLETE naming the cause instead of a summary, and the failed step's state for
+// inspection: failed.smpm (a checkpoint that a restart refuses, naming the failure and the
+// checkpoint to use) and a last snapshot.
 TEST(RestartErrors, RunFailureExitsTwoWithMarker) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
   json c = small_plate(1, 400);
   c["bodies"][0]["velocity"] = {3000.0, 0.0};  // flies out of the grid within the run
   c["boundaries"] = json::array();
+  c["output"]["snapshots"] = 4;
   const std::string f = write_case("ck_fail", c);
   const fs::path out = scratch() / "ck_fail_out";
   const Cli r = cli("run " + f + " --out " + out.string(), "ck_fail");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("left the grid"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the failed step's state: " + (out / "failed.smpm").string() +
+                       ", and the last snapshot"),
+            std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out / "summary.json"));
   EXPECT_NE(read_file(out / "RUN_INCOMPLETE").find("left the grid"), std::string::npos);
+  ASSERT_TRUE(fs::exists(out / "failed.smpm"));
+  const Cli again = cli("run " + f + " --out " + (scratch() / "ck_fail_again").string() +
+                        " --restart " + (out / "failed.smpm").string(), "ck_fail_again");
+  EXPECT_EQ(again.code, 1) << again.err;
+  EXPECT_NE(again.err.find("failed.smpm"), std::string::npos) << again.err;
+  EXPECT_NE(again.err.find("the state of a step that failed (particle"), std::string::npos) << again.err;
+  EXPECT_NE(again.err.find("restart from the last checkpoint of the run (checkpoint.smpm)"),
+            std::string::npos) << again.err;
 }
 
 }  // namespace

@@ -509,3 +509,38 @@ TEST(HealthCheck, RunawayNodeAndCollapsedParticleStop) {
     }
   }
 }
+
+// The stability limit as particles stretch: with constant moduli and the current density
+// rho0 / J the wave speed is c_d sqrt(J), so dt = cfl h / c_d stays stable while J <= 1 / cfl^2
+// (docs/physics.md, section 1); the check allows 10 % over it. A particle stretched to
+// 1.01 x 1.1 / cfl^2 stops the next step naming it, its J and the limit; one at 0.99 x 1.1 /
+// cfl^2 passes.
+TEST(HealthCheck, StretchedParticleStopsAtTheStabilityLimit) {
+  ColumnSpec c;
+  c.cells = 40;
+  c.fn = sin2_pulse(16 * c.h / 5918.5, 8 * c.h / 5918.5);
+  const double j_limit = 1.1 / (c.cfl * c.cfl);
+  for (const double factor : {0.99, 1.01}) {
+    auto s = make_column(c);
+    for (int i = 0; i < 5; ++i) s->step();
+    const std::size_t k = s->p.size() / 2;
+    const double v0 = s->p.mass[k] / s->materials[s->p.group[k]].rho;
+    s->p.vol[k] = factor * j_limit * v0;
+    if (factor < 1) {
+      EXPECT_NO_THROW(s->step()) << "J = " << factor << " / cfl^2";
+      continue;
+    }
+    try {
+      s->step();
+      FAIL() << "no error at J = " << factor << " / cfl^2";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("time step above the stability limit at step 6"), std::string::npos) << m;
+      EXPECT_NE(m.find("particle " + std::to_string(s->p.id[k]) + " of body 0"), std::string::npos)
+          << m;
+      char j[64];
+      std::snprintf(j, sizeof j, "J = V/V0 = %g,", factor * j_limit);
+      EXPECT_NE(m.find(j), std::string::npos) << m;
+    }
+  }
+}

@@ -17,8 +17,11 @@
 
 namespace smpm {
 
+// The message is made one readable line: control characters (a newline in a key) are escaped,
+// a word of more than 200 characters is cut to its first 80, and a message of more than 2 000
+// characters to its first 1 500 and last 300, each cut saying how much it left out.
 struct CaseError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  explicit CaseError(const std::string& what);
 };
 
 // Probe quantities: "sxx", "syy", "szz", "sxy", "J2", "vx", "vy".
@@ -74,6 +77,20 @@ struct Case {
 // string if it is not valid JSON) applied before validation; array elements by index
 // ("bodies.0.particles_per_cell=4").
 Case load_case(const std::string& path, const std::vector<std::string>& overrides = {});
+// Same from the text of a case file; `source` names it in messages, and relative paths in it
+// are taken from source's folder (the working directory when source has none).
+Case load_case_text(const std::string& text, const std::string& source,
+                    const std::vector<std::string>& overrides = {});
+
+// Pre-flight limits of the loader, process-wide. memory_bytes: the most an MPM grid with its
+// particles may need (0: 80 % of the machine's physical memory); mesh_cells: the most cells a
+// gmsh geometry or FE mesh may be meshed into. The fuzz harness lowers both.
+struct LoadLimits {
+  double memory_bytes = 0;
+  double mesh_cells = 1e7;
+};
+void set_load_limits(const LoadLimits& limits);
+const LoadLimits& load_limits();
 
 // " (did you mean \"check\"?)" when one of the candidates is close to word, else "" (the
 // suggestion every case error gives, for the command line's use too).

@@ -17,7 +17,10 @@ struct RunResult {
 };
 
 // A run that started and then failed (instability, a particle leaving the grid, an I/O error):
-// the command exits 2. DIR/RUN_INCOMPLETE says why; the last checkpoint, if any, is kept.
+// the command exits 2. DIR/RUN_INCOMPLETE says why; the last checkpoint, if any, is kept. A step
+// that fails (a health check, a particle leaving the grid) also leaves its state for inspection:
+// DIR/failed.smpm (a checkpoint of the failed step) and, when the case writes snapshots, a last
+// snapshot of it.
 struct RunFailure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -39,7 +42,8 @@ struct RunOptions {
 // (before the output folder is touched), RunFailure and RunInterrupted as above.
 RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt = {});
 
-// The checkpoint file's name in the output folder.
+// The checkpoint file's name in the output folder, and that of the state of a failed step.
 inline const char* checkpoint_file_name() { return "checkpoint.smpm"; }
+inline const char* failed_state_file_name() { return "failed.smpm"; }
 
 }  // namespace smpm

@@ -61,8 +61,9 @@ struct Mesh {
   int curve_tag(const std::string& name_or_tag) const;
 };
 
-// Reads or meshes `file` (".geo" or ".msh"). Throws FemError naming the file.
-Mesh load_mesh(const std::string& file, double size);
+// Reads or meshes `file` (".geo" or ".msh"); a .geo whose size would give more than max_cells
+// cells (estimated before meshing) is refused. Throws FemError naming the file.
+Mesh load_mesh(const std::string& file, double size, double max_cells = 1e7);
 
 // ---- model -------------------------------------------------------------------------------------
 struct Boundary {

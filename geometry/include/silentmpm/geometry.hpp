@@ -78,9 +78,11 @@ struct Geometry {
 // `parameters` set other numbers of a .geo before it is read (gmsh -setnumber; the .geo declares
 // them with DefineConstant so that the given value wins).
 // Throws GeometryError "<file>: ..." for an unreadable, empty or unparsable file, a file without
-// physical surfaces, second-order or unsupported elements, or a geometry outside the z = 0 plane.
+// physical surfaces, second-order or unsupported elements, or a geometry outside the z = 0 plane,
+// and a size that would give more than max_cells cells (estimated before meshing).
 Geometry load_geometry(const std::string& file, double size,
-                       const std::vector<std::pair<std::string, double>>& parameters = {});
+                       const std::vector<std::pair<std::string, double>>& parameters = {},
+                       double max_cells = 1e7);
 
 // Lattice seeding of surface `s` into solver `sol` (grid already initialised, materials set):
 // points grid.x0 + (i + 1/2) h / n, grid.y0 + (j + 1/2) h / n inside an element, volume

@@ -76,11 +76,14 @@ namespace kernels {
 // Particle to grid over [b, e) (paper Eq. 15, 18): mass and momentum, and/or the internal force.
 // With kContact the node box the particles touch is grown in `box`.
 // inv_rho: 1 / density of the range's material (shapes that need the particle size).
-// Returns whether a particle of the range has a negative volume (J < 0; kForce passes only: the
-// health check reads it from the pass that loads the volumes anyway).
+// Returns, for the health check, from the pass that loads the volumes anyway (kForce passes
+// only): kInverted when a particle of the range has a negative volume (J < 0), kStretched when
+// one has V > stretch_limit * m (its wave speed c_d sqrt(J) puts dt above the stability limit).
+constexpr unsigned kInverted = 1, kStretched = 2;
 template <class Shape, unsigned WHAT>
-inline bool p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
-                double inv_rho, NodeBox* box = nullptr) {
+inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
+                    double inv_rho, NodeBox* box = nullptr,
+                    double stretch_limit = std::numeric_limits<double>::infinity()) {
   const double ih = g.inv_h;
   const long nnx = g.nnx;
   const double* X = p.x.data(); const double* Y = p.y.data();
@@ -89,7 +92,7 @@ inline bool p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
   const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
   Shape sf;
   long nodes[Shape::kNodes];
-  bool negative = false;
+  bool negative = false, stretched = false;
   for (uint32_t k = b; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
@@ -121,13 +124,14 @@ inline bool p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const
     if constexpr ((WHAT & kForce) != 0) {
       const double v = V[k], sxx = SXX[k], syy = SYY[k], sxy = SXY[k];
       negative |= std::signbit(v);
+      stretched |= v > stretch_limit * M[k];
       for (int a = 0; a < Shape::kNodes; ++a) {
         f.fx[nodes[a]] -= v * (sxx * sf.dNx[a] + sxy * sf.dNy[a]);
         f.fy[nodes[a]] -= v * (sxy * sf.dNx[a] + syy * sf.dNy[a]);
       }
     }
   }
-  return negative;
+  return (negative ? kInverted : 0u) | (stretched ? kStretched : 0u);
 }
 
 // Grid to particle over [b, e): velocities from the field's start (vx, vy) and updated (vnx, vny)

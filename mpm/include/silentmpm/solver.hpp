@@ -171,6 +171,7 @@ class Solver {
   template <class Fn> void parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void call(Fn&& fn);
   double inv_rho(int group) const;  // 1 / density of a group's material (0 if none)
+  double stretch_limit(int group) const;  // V/m past which dt is above the stability limit
   // The step and its stages, on the shape S of opt.shape.
   template <class S> void step_with();
   template <class S>
@@ -191,6 +192,7 @@ class Solver {
   long outside_ = -1;  // index of a particle that left the grid in the last pass
   // Health-check reductions of the current step (check_health).
   long collapsed_ = 0;         // strips holding a particle with J < 0 (internal-force p2g)
+  long stretched_ = 0;         // strips holding a particle stretched past the stability limit
   double step_kinetic_ = 0;    // particles' kinetic energy from g2p
   double step_speed2_ = 0;     // largest squared particle speed from g2p
   double energy_floor_ = 0;    // 1e-12 sum(m c_d^2): the energy bound's floor
