@@ -137,7 +137,9 @@ void Solver::finalize() {
   for (const auto& c : constraints)
     for (uint32_t n : c.nodes) grid.fix[n] |= c.mask;
   // Dashpot coefficients from the material of each layer particle.
+  has_springs_ = false;
   for (auto& s : silents) {
+    has_springs_ = has_springs_ || s.springs();
     s.zn.resize(s.layer.idx.size());
     s.zt.resize(s.layer.idx.size());
     for (std::size_t k = 0; k < s.layer.idx.size(); ++k) {
@@ -881,6 +883,13 @@ void Solver::step_with() {
   call([&](StepHooks& h) { h.after_momentum(*this); });
   if (sc == Scheme::USF) {
     start_velocities();
+    // Kelvin-Voigt springs advance with the centre-of-mass start velocity (apply_loads); with
+    // body fields the grid's own arrays hold that field, whose velocity grid_update computes
+    // only later: compute it now (the same values grid_update will find).
+    if (!body_of_group_.empty() && has_springs_)
+      kernels::nodal_velocity(grid, NodeBox{0, grid.nnx - 1, 0, grid.nny - 1}, grid.m.data(),
+                              grid.fix.data(), grid.px.data(), grid.py.data(), grid.vx.data(),
+                              grid.vy.data(), mass_floor_, nthreads_);
     update_stress<S>(false, true, false);
     p2g<S>(kForce);
   }

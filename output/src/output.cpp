@@ -227,6 +227,7 @@ void SnapshotWriter::open(const std::string& dir, const std::string& base) {
             "writable?)",
             path);
   file_ = f;
+  xdmf_end_ = -1;  // the first snapshot writes the XDMF whole
 }
 
 namespace {
@@ -376,12 +377,13 @@ void SnapshotWriter::write(const Particles& p, long step, double time) {
   if (slot < steps_.size()) {
     times_[slot] = time;
     sizes_[slot] = n;
+    write_xdmf();
   } else {
     steps_.push_back(step);
     times_.push_back(time);
     sizes_.push_back(n);
+    append_xdmf();
   }
-  write_xdmf();
 }
 
 void SnapshotWriter::close() {
@@ -391,11 +393,15 @@ void SnapshotWriter::close() {
   if (H5Fclose(f) < 0) h5_fail("cannot close", dir_ + "/" + base_ + ".h5");
 }
 
-void SnapshotWriter::write_xdmf() const {
-  const std::string path = dir_ + "/" + base_ + ".xdmf";
-  const std::string tmp = path + ".tmp";
-  const std::string h5 = xml_escape(base_ + ".h5");  // relative: the folder moves as a whole
+// The XDMF text: head, one grid per snapshot, tail. The file is written whole once (open,
+// resume, a snapshot replaced) and then grows by one grid per snapshot, written over the tail
+// together with a new tail: a snapshot costs the same at the thousandth as at the first, and the
+// file on disk is a complete document after every snapshot.
+namespace {
+const char* const kXdmfTail = "    </Grid>\n  </Domain>\n</Xdmf>\n";
+}
 
+std::string SnapshotWriter::xdmf_head() const {
   std::string s;
   s += "<?xml version=\"1.0\" ?>\n";
   s += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
@@ -403,41 +409,54 @@ void SnapshotWriter::write_xdmf() const {
   s += "  <Domain>\n";
   s += "    <Grid Name=\"" + xml_escape(base_) +
        "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  char buf[2048];
-  for (std::size_t k = 0; k < steps_.size(); ++k) {
-    const std::size_t n = sizes_[k];
-    if (n == 0) continue;  // an empty Polyvertex grid is not readable; the .h5 still has it
-    const std::string g = step_name(steps_[k]);
-    std::snprintf(buf, sizeof buf,
-                  "      <Grid Name=\"%s\" GridType=\"Uniform\">\n"
-                  "        <Time Value=\"%.9e\"/>\n"
-                  "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
-                  "NodesPerElement=\"1\">\n"
-                  "          <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
-                  "Format=\"HDF\">%s:/%s</DataItem>\n"
-                  "        </Topology>\n"
-                  "        <Geometry GeometryType=\"XYZ\">\n"
-                  "          <DataItem Dimensions=\"%zu 3\" NumberType=\"Float\" Precision=\"8\" "
-                  "Format=\"HDF\">%s:/%s/xyz</DataItem>\n"
-                  "        </Geometry>\n",
-                  g.c_str(), times_[k], n, n, h5.c_str(), vertices_name(n).c_str(), n, h5.c_str(),
-                  g.c_str());
-    s += buf;
-    for (const auto& f : kScalarFields) {
-      std::snprintf(buf, sizeof buf,
-                    "        <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-                    "          <DataItem Dimensions=\"%zu\" NumberType=\"%s\" Precision=\"%d\" "
-                    "Format=\"HDF\">%s:/%s/%s</DataItem>\n"
-                    "        </Attribute>\n",
-                    f.name, n, f.number_type, f.precision, h5.c_str(), g.c_str(), f.name);
-      s += buf;
-    }
-    s += "      </Grid>\n";
-  }
-  s += "    </Grid>\n";
-  s += "  </Domain>\n";
-  s += "</Xdmf>\n";
+  return s;
+}
 
+std::string SnapshotWriter::xdmf_grid(std::size_t k) const {
+  const std::size_t n = sizes_[k];
+  if (n == 0) return {};  // an empty Polyvertex grid is not readable; the .h5 still has it
+  const std::string h5 = xml_escape(base_ + ".h5");  // relative: the folder moves as a whole
+  const std::string g = step_name(steps_[k]);
+  std::string s;
+  char buf[2048];
+  std::snprintf(buf, sizeof buf,
+                "      <Grid Name=\"%s\" GridType=\"Uniform\">\n"
+                "        <Time Value=\"%.9e\"/>\n"
+                "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+                "NodesPerElement=\"1\">\n"
+                "          <DataItem Dimensions=\"%zu 1\" NumberType=\"Int\" Precision=\"8\" "
+                "Format=\"HDF\">%s:/%s</DataItem>\n"
+                "        </Topology>\n"
+                "        <Geometry GeometryType=\"XYZ\">\n"
+                "          <DataItem Dimensions=\"%zu 3\" NumberType=\"Float\" Precision=\"8\" "
+                "Format=\"HDF\">%s:/%s/xyz</DataItem>\n"
+                "        </Geometry>\n",
+                g.c_str(), times_[k], n, n, h5.c_str(), vertices_name(n).c_str(), n, h5.c_str(),
+                g.c_str());
+  s += buf;
+  for (const auto& f : kScalarFields) {
+    std::snprintf(buf, sizeof buf,
+                  "        <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Node\">\n"
+                  "          <DataItem Dimensions=\"%zu\" NumberType=\"%s\" Precision=\"%d\" "
+                  "Format=\"HDF\">%s:/%s/%s</DataItem>\n"
+                  "        </Attribute>\n",
+                  f.name, n, f.number_type, f.precision, h5.c_str(), g.c_str(), f.name);
+    s += buf;
+  }
+  s += "      </Grid>\n";
+  return s;
+}
+
+std::string SnapshotWriter::xdmf_text() const {
+  std::string s = xdmf_head();
+  for (std::size_t k = 0; k < steps_.size(); ++k) s += xdmf_grid(k);
+  return s + kXdmfTail;
+}
+
+void SnapshotWriter::write_xdmf() {
+  const std::string path = dir_ + "/" + base_ + ".xdmf";
+  const std::string tmp = path + ".tmp";
+  const std::string s = xdmf_text();
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f)
     throw std::runtime_error("cannot open XDMF file '" + tmp + "' for writing: " +
@@ -448,13 +467,35 @@ void SnapshotWriter::write_xdmf() const {
   if (!ok || !closed) {
     const std::string why = std::strerror(ok ? errno : err);
     std::remove(tmp.c_str());
+    xdmf_end_ = -1;
     throw std::runtime_error("cannot write XDMF file '" + tmp + "': " + why);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const std::string err = std::strerror(errno);
     std::remove(tmp.c_str());
+    xdmf_end_ = -1;
     throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + err);
   }
+  xdmf_end_ = static_cast<long long>(s.size() - std::strlen(kXdmfTail));
+}
+
+void SnapshotWriter::append_xdmf() {
+  if (xdmf_end_ < 0) return write_xdmf();
+  const std::string path = dir_ + "/" + base_ + ".xdmf";
+  const std::string grid = xdmf_grid(steps_.size() - 1);
+  const std::string s = grid + kXdmfTail;
+  std::FILE* f = std::fopen(path.c_str(), "r+b");
+  if (!f) return write_xdmf();  // removed meanwhile: write it whole again
+  const bool ok = std::fseek(f, static_cast<long>(xdmf_end_), SEEK_SET) == 0 &&
+                  std::fwrite(s.data(), 1, s.size(), f) == s.size() && std::fflush(f) == 0;
+  const int err = errno;
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed) {
+    xdmf_end_ = -1;  // the next snapshot rewrites the file whole
+    throw std::runtime_error("cannot write XDMF file '" + path + "': " +
+                             std::strerror(ok ? errno : err));
+  }
+  xdmf_end_ += static_cast<long long>(grid.size());
 }
 
 }  // namespace smpm

@@ -83,6 +83,21 @@ TEST(Restart, MpmMultiFieldContactWithFrictionBitIdentical) {
   expect_restart_identical("impact", c, "checkpoint_every", 150);
 }
 
+// USF with one velocity field per body and a Kelvin-Voigt boundary: the springs advance with
+// the start-of-step velocity of the step they are in (computed for the centre-of-mass field too,
+// not left from the step before), so a restart, whose grid starts empty, continues identically.
+// The wave reaches the spring (the target's far end, 0.12 m) near step 400; the last checkpoint
+// is at step 450.
+TEST(Restart, MpmMultiFieldUsfSpringsBitIdentical) {
+  json c = contact_testing::impact_case();
+  c["scheme"]["update"] = "USF";
+  c["time"]["end"] = 3.2e-5;
+  c["boundaries"].push_back({{"type", "kelvin_voigt"}, {"body", "target"}, {"side", "right"},
+                             {"delta", 0.03}});
+  const long from = expect_restart_identical("impact_usf_kv", c, "checkpoint_every", 150);
+  EXPECT_GE(from, 450);
+}
+
 // The film: J2 softening, bifurcation and decohesion state carried by the particles. The
 // checkpoint falls after the onset of plasticity (the history's dissipated energy is non-zero
 // there), so the restored film state is exercised.

@@ -314,6 +314,35 @@ TEST(OutputSnapshot, XdmfIsRewrittenAfterEverySnapshot) {
   w.close();
 }
 
+// The XDMF grows by one grid per snapshot, written over the closing tags with new ones: after
+// every snapshot the file is the whole document, byte for byte what a full rewrite would write
+// (xdmf_text()); a snapshot of a step already written replaces it (a full rewrite), and the next
+// snapshots append again. The bytes written per snapshot do not depend on how many came before.
+TEST(OutputSnapshot, XdmfGrowsByOneGridPerSnapshot) {
+  TempDir dir("snapgrow");
+  SnapshotWriter w;
+  w.open(dir.path.string(), "run");
+  std::vector<std::size_t> sizes;
+  for (int k = 0; k < 40; ++k) {
+    w.write(small_set(3 + k % 4, 0.0), 10 * k, 1e-6 * k);
+    const std::string disk = slurp(dir.str("run.xdmf"));
+    ASSERT_EQ(disk, w.xdmf_text()) << "after snapshot " << k;
+    sizes.push_back(disk.size());
+  }
+  // Each later snapshot adds the same number of bytes as the one 4 before it (same particle
+  // count, same field list): the cost of a snapshot is flat in the number of snapshots.
+  for (std::size_t k = 5; k < sizes.size(); ++k)
+    EXPECT_EQ(sizes[k] - sizes[k - 1], sizes[k - 4] - sizes[k - 5]) << k;
+  w.write(small_set(7, 0.0), 200, 2e-5);  // step 200 again: replaced
+  EXPECT_EQ(slurp(dir.str("run.xdmf")), w.xdmf_text());
+  EXPECT_EQ(w.count(), 40);
+  w.write(small_set(3, 0.0), 400, 4e-5);
+  EXPECT_EQ(slurp(dir.str("run.xdmf")), w.xdmf_text());
+  EXPECT_EQ(w.count(), 41);
+  EXPECT_FALSE(fs::exists(dir.str("run.xdmf.tmp")));
+  w.close();
+}
+
 TEST(OutputSnapshot, MissingDirectoryThrows) {
   SnapshotWriter w;
   const std::string bad = "/nonexistent_dir_smpm/out";

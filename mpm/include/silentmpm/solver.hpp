@@ -190,6 +190,7 @@ class Solver {
   [[noreturn]] void fail_nonfinite() const;
   void check_health();
   long outside_ = -1;  // index of a particle that left the grid in the last pass
+  bool has_springs_ = false;  // a silent boundary carries Kelvin-Voigt springs (finalize)
   // Health-check reductions of the current step (check_health).
   long collapsed_ = 0;         // strips holding a particle with J < 0 (internal-force p2g)
   long stretched_ = 0;         // strips holding a particle stretched past the stability limit

@@ -68,7 +68,15 @@ class SnapshotWriter {
   std::vector<double> times_;
   std::vector<long> steps_;
   std::vector<std::size_t> sizes_;
-  void write_xdmf() const;
+  long long xdmf_end_ = -1;  // offset of the XDMF tail on disk (-1: write the file whole next)
+  std::string xdmf_head() const;
+  std::string xdmf_grid(std::size_t k) const;
+  void write_xdmf();
+  void append_xdmf();
+
+ public:
+  // The XDMF document as it stands (the file on disk holds exactly this after each snapshot).
+  std::string xdmf_text() const;
 };
 
 }  // namespace smpm
