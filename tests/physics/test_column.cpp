@@ -401,7 +401,9 @@ TEST(KelvinVoigt, ColumnUnderGravity) {
 TEST(DampingLayer, ReflectionMatchesContinuum) {
   const Material m = tungsten();
   double last = 1;
-  for (auto [end, dc] : {std::pair{End::Fixed, 10}, {End::Fixed, 20}, {End::Silent, 10}}) {
+  for (const auto& end_cells : {std::pair{End::Fixed, 10}, {End::Fixed, 20}, {End::Silent, 10}}) {
+    const End end = end_cells.first;  // named copies: the lambda below captures end
+    const int dc = end_cells.second;
     ColumnSpec c;
     c.cells = 100;
     c.end = end;

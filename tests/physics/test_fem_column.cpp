@@ -390,7 +390,9 @@ TEST(FemColumn, KelvinVoigtUnderGravity) {
 // account (its work is absorbed) exact to round-off.
 TEST(FemColumn, DampingLayerMatchesContinuum) {
   const Material m = tungsten();
-  for (auto [end, dc] : {std::pair{End::Fixed, 10}, {End::Fixed, 20}, {End::Dashpot, 10}}) {
+  for (const auto& end_cells : {std::pair{End::Fixed, 10}, {End::Fixed, 20}, {End::Dashpot, 10}}) {
+    const End end = end_cells.first;  // named copies: the lambda below captures end
+    const int dc = end_cells.second;
     Column c;
     c.end = end;
     c.damp_cells = dc;
