@@ -16,7 +16,7 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$b" -DSILENTMPM_FUZZ=ON -DCMAKE_BUILD_
 cmake --build "$b" -j2 --target fuzz_case
 mkdir -p "$b/corpus" "$b/findings"
 cd "$root"  # the seeds name their meshes from the repository root
-export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp"  # gmsh's own leaks
+export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp"  # third-party leaks
 export UBSAN_OPTIONS="print_stacktrace=1"
 echo "fuzz.sh: fuzzing the case loader for $secs s (seed $seed)"
 set +e

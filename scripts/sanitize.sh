@@ -15,7 +15,7 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$b" -DSILENTMPM_SANITIZE=ON -DCMAKE_BU
 targets=(silentmpm)
 for l in $labels; do targets+=("smpm_tests_$l"); done
 cmake --build "$b" -j2 --target "${targets[@]}"
-export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp"  # gmsh's own leaks
+export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp:fast_unwind_on_malloc=0"  # third-party leaks
 export UBSAN_OPTIONS="print_stacktrace=1"
 export ASAN_OPTIONS="detect_stack_use_after_return=1"
 cd "$b"
