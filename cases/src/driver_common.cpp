@@ -46,11 +46,15 @@ void remove_fem_snapshots(const std::string& out_dir, int keep) {
   const fs::path dir(out_dir);
   std::error_code ec;
   fs::remove(dir / "fem.xdmf", ec);
-  for (const auto& e : fs::directory_iterator(dir, ec)) {  // FEM snapshots fem_NNNNN.h5
+  // FEM snapshots fem_NNNNN.h5: five digits or more (numbers past 99999 take six).
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string n = e.path().filename().string();
-    if (n.size() == 12 && n.compare(0, 4, "fem_") == 0 && n.compare(9, 3, ".h5") == 0 &&
-        std::all_of(n.begin() + 4, n.begin() + 9, [](char c) { return c >= '0' && c <= '9'; }) &&
-        std::stoi(n.substr(4, 5)) >= keep)
+    if (n.size() < 12 || n.size() > 16 || n.compare(0, 4, "fem_") != 0 ||
+        n.compare(n.size() - 3, 3, ".h5") != 0)
+      continue;
+    const std::string digits = n.substr(4, n.size() - 7);
+    if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+        std::stol(digits) >= keep)
       fs::remove(e.path(), ec);
   }
 }

@@ -39,7 +39,16 @@ TEST(FemCase, RunsThroughTheDriver) {
   Case k = build_case(c, "column.json");
   const fs::path out = temp_dir() / "fem_case_run";
   fs::remove_all(out);
+  // FE snapshots of an earlier run in the folder (numbered with 5 digits or more) are removed;
+  // other files are not touched.
+  fs::create_directories(out);
+  for (const char* f : {"fem_00009.h5", "fem_100000.h5", "fem_123.h5", "fem_notes.h5"})
+    std::ofstream(out / f) << "earlier";
   const RunResult r = run_case(k, out.string());
+  EXPECT_FALSE(fs::exists(out / "fem_00009.h5"));
+  EXPECT_FALSE(fs::exists(out / "fem_100000.h5"));
+  EXPECT_TRUE(fs::exists(out / "fem_123.h5"));
+  EXPECT_TRUE(fs::exists(out / "fem_notes.h5"));
   EXPECT_EQ(r.dofs, 2u * 121u * 3u);
   EXPECT_GT(r.dof_updates_per_second, 0);
 
