@@ -39,12 +39,16 @@ std::vector<std::string> group_list(const std::vector<fem::PhysicalGroup>& gs) {
 }
 
 // A physical group given as a name or a tag (string or integer).
-int group_ref(const Ctx& ctx, const ojson& v, const std::string& path, const fem::Mesh& mesh,
+// Without a mesh (the pass that checks the keys before meshing) only the type is checked and -1
+// returned.
+int group_ref(const Ctx& ctx, const ojson& v, const std::string& path, const fem::Mesh* m,
               bool surface) {
   std::string key;
   if (v.is_number_integer()) key = std::to_string(v.get<long>());
   else if (v.is_string()) key = v.get<std::string>();
   else ctx.fail(path, "expected a group name or tag, got " + a_type(v));
+  if (!m) return -1;
+  const fem::Mesh& mesh = *m;
   const int tag = surface ? mesh.surface_tag(key) : mesh.curve_tag(key);
   if (tag < 0)
     ctx.fail(path, "no physical " + std::string(surface ? "surface" : "curve") + " \"" + key +
@@ -152,6 +156,159 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   const long degree = f.integer("degree", 1);
   if (degree != 1 && degree != 2) f.fail("degree", "must be 1 or 2, got " + std::to_string(degree));
   spec.degree = static_cast<int>(degree);
+  // probes: every key before meshing (solver null), then placed in the solver.
+  auto read_probes = [&](const ojson& p, fem::Solver* solver) {
+    if (!p.is_array()) top.fail("probes", "expected an array, got " + a_type(p));
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      Obj o(ctx, p[i], index_path("probes", i), kFem);
+      o.allow({"name", "at", "fields"});
+      ProbeSpec pr;
+      pr.name = o.str("name");
+      static const std::regex ok("[A-Za-z0-9_]+");
+      if (!std::regex_match(pr.name, ok))
+        o.fail("name", "must be letters, digits and _ only, got \"" + pr.name + "\"");
+      if (std::count(names.begin(), names.end(), pr.name))
+        o.fail("name", "probe name \"" + pr.name + "\" is used twice");
+      names.push_back(pr.name);
+      const auto at = o.nums("at", 2);
+      pr.x = at[0];
+      pr.y = at[1];
+      if (solver && solver->add_probe(pr.x, pr.y) < 0) {
+        const auto bb = solver->bounds();
+        o.fail("at", "outside the FEM mesh (bounding box [" + fmt(bb[0]) + ", " + fmt(bb[2]) +
+                         "] x [" + fmt(bb[1]) + ", " + fmt(bb[3]) + "]): (" + fmt(pr.x) + ", " +
+                         fmt(pr.y) + ")");
+      }
+      pr.fields = fem_probe_fields(o, kFemFields);
+      if (solver) c.probes.push_back(std::move(pr));
+    }
+  };
+
+  // regions, gravity and boundaries: read once before meshing without the mesh (every key,
+  // type and value checked, so that a mistake there does not wait for the mesher), then with it.
+  auto read_model = [&](fem::Spec& spec, const fem::Mesh* mesh) {
+    // regions: physical surface (name or tag) -> material name; every surface needs one.
+    const ojson& regs = f.need("regions");
+    if (!regs.is_object() || regs.empty())
+      f.fail("regions", "expected an object {physical surface: material name, ...}, got " +
+                            (regs.is_object() ? std::string("an empty object") : a_type(regs)));
+    std::set<std::string> used_mats;
+    for (const auto& it : regs.items()) {
+      const std::string path = f.at("regions") + "." + it.key();
+      const int tag = group_ref(ctx, ojson(it.key()), path, mesh, true);
+      if (mesh && spec.region_material.count(tag))
+        ctx.fail(path, "physical surface " + std::to_string(tag) + " given twice");
+      if (!it.value().is_string())
+        ctx.fail(path, "expected a material name, got " + a_type(it.value()));
+      const std::string mname = it.value().get<std::string>();
+      auto mi = std::find(mat_names.begin(), mat_names.end(), mname);
+      if (mi == mat_names.end())
+        ctx.fail(path, "no material named \"" + mname + "\"; defined: " + join(mat_names));
+      const Material& m = materials[mi - mat_names.begin()];
+      if (m.model != Model::Elastic)
+        ctx.fail(path, "material \"" + mname + "\" has model \"" + model_name(m.model) +
+                           "\"; the FEM far-field is linear elastic (use \"elastic\")");
+      spec.region_material[tag] = static_cast<int>(mi - mat_names.begin());
+    }
+    for (const auto& g : mesh ? mesh->surfaces : std::vector<fem::PhysicalGroup>())
+      if (!spec.region_material.count(g.tag))
+        f.fail("regions", "physical surface " + std::to_string(g.tag) +
+                              (g.name.empty() ? "" : " \"" + g.name + "\"") + " of " + mesh_file +
+                              " has no material");
+    spec.materials = materials;
+    if (top.has("gravity")) {  // a body force per unit mass on every FE node's mass (m/s^2)
+      const auto g = top.nums("gravity", 2);
+      spec.gravity_x = g[0];
+      spec.gravity_y = g[1];
+    }
+
+    // boundaries
+    if (const ojson* b = f.find("boundaries")) {
+      if (!b->is_array()) f.fail("boundaries", "expected an array, got " + a_type(*b));
+      for (std::size_t i = 0; i < b->size(); ++i) {
+        const std::string path = index_path(f.at("boundaries"), i);
+        Obj o(ctx, (*b)[i], path, kFem);
+        const std::string type =
+            o.choice("type", {"dashpot", "kelvin_voigt", "damping_layer", "traction", "fixed", "roller"});
+        const std::string where = "for a " + type + " boundary";
+        if (type == "dashpot") o.allow({"type", "name", "curve", "a", "b"}, where);
+        if (type == "kelvin_voigt")
+          o.allow({"type", "name", "curve", "a", "b", "delta", "alpha_n", "alpha_t"}, where);
+        if (type == "traction")
+          o.allow({"type", "name", "curve", "normal", "tangential", "vector", "time"}, where);
+        if (type == "fixed") o.allow({"type", "name", "curve"}, where);
+        if (type == "damping_layer") o.allow({"type", "name", "curve", "width", "r0", "power"}, where);
+        if (type == "roller") o.allow({"type", "name", "curve", "component"}, where);
+        fem::Boundary bc;
+        bc.name = o.has("name") ? o.str("name") : type + std::to_string(i);
+        const ojson& cv = o.need("curve");
+        if (cv.is_array()) {
+          if (cv.empty()) o.fail("curve", "must name at least one physical curve");
+          for (std::size_t k = 0; k < cv.size(); ++k)
+            bc.curves.push_back(group_ref(ctx, cv[k], index_path(o.at("curve"), k), mesh, false));
+        } else {
+          bc.curves.push_back(group_ref(ctx, cv, o.at("curve"), mesh, false));
+        }
+        if (type == "dashpot" || type == "kelvin_voigt") {
+          bc.kind = fem::Boundary::Kind::Dashpot;
+          bc.a = o.num("a", 1.0);
+          o.ge("a", bc.a, 0);
+          bc.b = o.num("b", 1.0);
+          o.ge("b", bc.b, 0);
+          if (type == "kelvin_voigt") {  // the springs' stiffness enters the critical time step
+            bc.delta = o.num("delta");
+            o.gt("delta", bc.delta, 0);
+            bc.alpha_n = o.num("alpha_n", 1.0);
+            o.ge("alpha_n", bc.alpha_n, 0);
+            bc.alpha_t = o.num("alpha_t", 1.0);
+            o.ge("alpha_t", bc.alpha_t, 0);
+          }
+          for (const auto& other : spec.boundaries)
+            if (mesh && other.kind == fem::Boundary::Kind::Dashpot)
+              for (int cc : bc.curves)
+                if (std::count(other.curves.begin(), other.curves.end(), cc))
+                  o.fail("curve", "physical curve " + std::to_string(cc) + " already has a dashpot (\"" +
+                                      other.name + "\")");
+        } else if (type == "traction") {
+          bc.kind = fem::Boundary::Kind::Traction;
+          const bool scalar = o.has("normal") || o.has("tangential");
+          if (scalar && o.has("vector")) o.fail("vector", "give either normal/tangential or vector, not both");
+          if (!scalar && !o.has("vector"))
+            o.fail("", "missing the traction: give normal and/or tangential, or vector");
+          if (scalar) {
+            bc.normal = o.num("normal", 0.0);
+            bc.tangential = o.num("tangential", 0.0);
+          } else {
+            const auto v = o.nums("vector", 2);
+            bc.vx = v[0];
+            bc.vy = v[1];
+          }
+          if (const ojson* tf = o.find("time")) bc.fn = parse_time_function_at(ctx, *tf, o.at("time"));
+        } else if (type == "damping_layer") {
+          bc.kind = fem::Boundary::Kind::Damping;
+          bc.width = o.num("width");
+          o.gt("width", bc.width, 0);
+          bc.r0 = o.num("r0", 1e-3);
+          if (!(bc.r0 > 0 && bc.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(bc.r0));
+          bc.power = o.num("power", 2.0);
+          o.ge("power", bc.power, 0);
+        } else if (type == "fixed") {
+          bc.kind = fem::Boundary::Kind::Fixed;
+        } else {
+          bc.kind = fem::Boundary::Kind::Roller;
+          bc.component = o.choice("component", {"x", "y"}) == "x" ? 0 : 1;
+        }
+        spec.boundaries.push_back(std::move(bc));
+      }
+    }
+  };
+  {
+    fem::Spec keys_only;
+    read_model(keys_only, nullptr);
+  }
+  // probes: the same (read below, placed once the solver exists).
+  if (const ojson* p = top.find("probes")) read_probes(*p, nullptr);
   try {
     spec.mesh = fem::load_mesh(mesh_file, size, load_limits().mesh_cells);
   } catch (const fem::FemError& e) {
@@ -159,121 +316,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
            e.what());
   }
 
-  // regions: physical surface (name or tag) -> material name; every surface needs one.
-  const ojson& regs = f.need("regions");
-  if (!regs.is_object() || regs.empty())
-    f.fail("regions", "expected an object {physical surface: material name, ...}, got " +
-                          (regs.is_object() ? std::string("an empty object") : a_type(regs)));
-  std::set<std::string> used_mats;
-  for (const auto& it : regs.items()) {
-    const std::string path = f.at("regions") + "." + it.key();
-    const int tag = group_ref(ctx, ojson(it.key()), path, spec.mesh, true);
-    if (spec.region_material.count(tag))
-      ctx.fail(path, "physical surface " + std::to_string(tag) + " given twice");
-    if (!it.value().is_string())
-      ctx.fail(path, "expected a material name, got " + a_type(it.value()));
-    const std::string mname = it.value().get<std::string>();
-    auto mi = std::find(mat_names.begin(), mat_names.end(), mname);
-    if (mi == mat_names.end())
-      ctx.fail(path, "no material named \"" + mname + "\"; defined: " + join(mat_names));
-    const Material& m = materials[mi - mat_names.begin()];
-    if (m.model != Model::Elastic)
-      ctx.fail(path, "material \"" + mname + "\" has model \"" + model_name(m.model) +
-                         "\"; the FEM far-field is linear elastic (use \"elastic\")");
-    spec.region_material[tag] = static_cast<int>(mi - mat_names.begin());
-  }
-  for (const auto& g : spec.mesh.surfaces)
-    if (!spec.region_material.count(g.tag))
-      f.fail("regions", "physical surface " + std::to_string(g.tag) +
-                            (g.name.empty() ? "" : " \"" + g.name + "\"") + " of " + mesh_file +
-                            " has no material");
-  spec.materials = materials;
-  if (top.has("gravity")) {  // a body force per unit mass on every FE node's mass (m/s^2)
-    const auto g = top.nums("gravity", 2);
-    spec.gravity_x = g[0];
-    spec.gravity_y = g[1];
-  }
-
-  // boundaries
-  if (const ojson* b = f.find("boundaries")) {
-    if (!b->is_array()) f.fail("boundaries", "expected an array, got " + a_type(*b));
-    for (std::size_t i = 0; i < b->size(); ++i) {
-      const std::string path = index_path(f.at("boundaries"), i);
-      Obj o(ctx, (*b)[i], path, kFem);
-      const std::string type =
-          o.choice("type", {"dashpot", "kelvin_voigt", "damping_layer", "traction", "fixed", "roller"});
-      const std::string where = "for a " + type + " boundary";
-      if (type == "dashpot") o.allow({"type", "name", "curve", "a", "b"}, where);
-      if (type == "kelvin_voigt")
-        o.allow({"type", "name", "curve", "a", "b", "delta", "alpha_n", "alpha_t"}, where);
-      if (type == "traction")
-        o.allow({"type", "name", "curve", "normal", "tangential", "vector", "time"}, where);
-      if (type == "fixed") o.allow({"type", "name", "curve"}, where);
-      if (type == "damping_layer") o.allow({"type", "name", "curve", "width", "r0", "power"}, where);
-      if (type == "roller") o.allow({"type", "name", "curve", "component"}, where);
-      fem::Boundary bc;
-      bc.name = o.has("name") ? o.str("name") : type + std::to_string(i);
-      const ojson& cv = o.need("curve");
-      if (cv.is_array()) {
-        if (cv.empty()) o.fail("curve", "must name at least one physical curve");
-        for (std::size_t k = 0; k < cv.size(); ++k)
-          bc.curves.push_back(group_ref(ctx, cv[k], index_path(o.at("curve"), k), spec.mesh, false));
-      } else {
-        bc.curves.push_back(group_ref(ctx, cv, o.at("curve"), spec.mesh, false));
-      }
-      if (type == "dashpot" || type == "kelvin_voigt") {
-        bc.kind = fem::Boundary::Kind::Dashpot;
-        bc.a = o.num("a", 1.0);
-        o.ge("a", bc.a, 0);
-        bc.b = o.num("b", 1.0);
-        o.ge("b", bc.b, 0);
-        if (type == "kelvin_voigt") {  // the springs' stiffness enters the critical time step
-          bc.delta = o.num("delta");
-          o.gt("delta", bc.delta, 0);
-          bc.alpha_n = o.num("alpha_n", 1.0);
-          o.ge("alpha_n", bc.alpha_n, 0);
-          bc.alpha_t = o.num("alpha_t", 1.0);
-          o.ge("alpha_t", bc.alpha_t, 0);
-        }
-        for (const auto& other : spec.boundaries)
-          if (other.kind == fem::Boundary::Kind::Dashpot)
-            for (int cc : bc.curves)
-              if (std::count(other.curves.begin(), other.curves.end(), cc))
-                o.fail("curve", "physical curve " + std::to_string(cc) + " already has a dashpot (\"" +
-                                    other.name + "\")");
-      } else if (type == "traction") {
-        bc.kind = fem::Boundary::Kind::Traction;
-        const bool scalar = o.has("normal") || o.has("tangential");
-        if (scalar && o.has("vector")) o.fail("vector", "give either normal/tangential or vector, not both");
-        if (!scalar && !o.has("vector"))
-          o.fail("", "missing the traction: give normal and/or tangential, or vector");
-        if (scalar) {
-          bc.normal = o.num("normal", 0.0);
-          bc.tangential = o.num("tangential", 0.0);
-        } else {
-          const auto v = o.nums("vector", 2);
-          bc.vx = v[0];
-          bc.vy = v[1];
-        }
-        if (const ojson* tf = o.find("time")) bc.fn = parse_time_function_at(ctx, *tf, o.at("time"));
-      } else if (type == "damping_layer") {
-        bc.kind = fem::Boundary::Kind::Damping;
-        bc.width = o.num("width");
-        o.gt("width", bc.width, 0);
-        bc.r0 = o.num("r0", 1e-3);
-        if (!(bc.r0 > 0 && bc.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(bc.r0));
-        bc.power = o.num("power", 2.0);
-        o.ge("power", bc.power, 0);
-      } else if (type == "fixed") {
-        bc.kind = fem::Boundary::Kind::Fixed;
-      } else {
-        bc.kind = fem::Boundary::Kind::Roller;
-        bc.component = o.choice("component", {"x", "y"}) == "x" ? 0 : 1;
-      }
-      spec.boundaries.push_back(std::move(bc));
-    }
-  }
-
+  read_model(spec, &spec.mesh);
   try {
     c.fem = std::make_unique<fem::Solver>(spec);
   } catch (const fem::FemError& e) {
@@ -295,31 +338,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   s.t = 0;
 
   // probes
-  if (const ojson* p = top.find("probes")) {
-    if (!p->is_array()) top.fail("probes", "expected an array, got " + a_type(*p));
-    for (std::size_t i = 0; i < p->size(); ++i) {
-      Obj o(ctx, (*p)[i], index_path("probes", i), kFem);
-      o.allow({"name", "at", "fields"});
-      ProbeSpec pr;
-      pr.name = o.str("name");
-      static const std::regex ok("[A-Za-z0-9_]+");
-      if (!std::regex_match(pr.name, ok))
-        o.fail("name", "must be letters, digits and _ only, got \"" + pr.name + "\"");
-      for (const auto& q : c.probes)
-        if (q.name == pr.name) o.fail("name", "probe name \"" + pr.name + "\" is used twice");
-      const auto at = o.nums("at", 2);
-      pr.x = at[0];
-      pr.y = at[1];
-      if (s.add_probe(pr.x, pr.y) < 0) {
-        const auto bb = s.bounds();
-        o.fail("at", "outside the FEM mesh (bounding box [" + fmt(bb[0]) + ", " + fmt(bb[2]) +
-                         "] x [" + fmt(bb[1]) + ", " + fmt(bb[3]) + "]): (" + fmt(pr.x) + ", " +
-                         fmt(pr.y) + ")");
-      }
-      pr.fields = fem_probe_fields(o, kFemFields);
-      c.probes.push_back(std::move(pr));
-    }
-  }
+  if (const ojson* p = top.find("probes")) read_probes(*p, &s);
   c.notes = s.describe();
   return c;
 }

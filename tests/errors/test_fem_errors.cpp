@@ -215,6 +215,21 @@ TEST(FemErrors, BadInputs) {
   c["fem"]["boundaries"][0] = {{"type", "damping_layer"}, {"curve", "right"}, {"width", 0.01},
                                {"r0", 0}};
   EXPECT_ERROR(error_of(c), "fem.boundaries[0].r0", "must be in (0, 1)");
+
+  // The boundaries, regions and probes are checked before the mesh is read or meshed: with a
+  // mesh file that does not exist, their mistakes are what is reported.
+  c = good_case();
+  c["fem"]["mesh"] = "/nonexistent/plate.geo";
+  c["fem"]["boundaries"][0]["a"] = "one";
+  EXPECT_ERROR(error_of(c), "fem.boundaries[0].a", "expected a number");
+  c = good_case();
+  c["fem"]["mesh"] = "/nonexistent/plate.geo";
+  c["fem"]["regions"] = {{"body", "tungstne"}};
+  EXPECT_ERROR(error_of(c), "fem.regions.body", "no material named \"tungstne\"");
+  c = good_case();
+  c["fem"]["mesh"] = "/nonexistent/plate.geo";
+  c["probes"][0]["fields"] = {"sxx", "dvi"};
+  EXPECT_ERROR(error_of(c), "probes[0].fields[1]", "div");
 }
 
 // Through the CLI: non-zero exit, one line on stderr naming the key path.
