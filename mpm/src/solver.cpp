@@ -995,7 +995,8 @@ void Solver::check_health() {
       particle(o, k);
       o << " has expanded to J = V/V0 = " << J << ", so its wave speed c_d sqrt(J) is "
         << m.cd * std::sqrt(J) << " m/s and the limit h / (c_d sqrt(J)) is "
-        << grid.h / (m.cd * std::sqrt(J)) << " s, more than 10 % below dt = " << dt << " s";
+        << grid.h / (m.cd * std::sqrt(J)) << " s < dt / sqrt(1.1) = " << dt / std::sqrt(1.1)
+        << " s (J more than 10 % past 1 / CFL^2)";
     }
     o << " (reduce time.cfl or time.dt)";
     throw std::runtime_error(o.str());
