@@ -519,7 +519,11 @@ Edge box_edge(const BodySpec& b, const std::string& side) {
 
 class Builder {
  public:
-  Builder(const Ctx& ctx, const ojson& doc) : ctx_(ctx), doc_(doc) {}
+  // A checking builder (`checking` true) reads every key, with a gmsh geometry's physical groups
+  // but without meshing it or seeding particles, and stops before the particles would be needed:
+  // a case with a geometry is read so first, and its mistakes are reported before the mesh is made.
+  Builder(const Ctx& ctx, const ojson& doc, bool checking = false)
+      : ctx_(ctx), doc_(doc), checking_(checking) {}
 
   Case build() {
     if (!doc_.is_object())
@@ -529,6 +533,7 @@ class Builder {
       return doc_.contains("bodies") || doc_.contains("grid")
                  ? detail::build_hybrid_case(ctx_, doc_)  // case_hybrid.cpp
                  : detail::build_fem_case(ctx_, doc_);
+    if (!checking_ && doc_.contains("geometry")) Builder(ctx_, doc_, true).build();
     Obj top(ctx_, doc_, "");
     top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes", "geometry",
                "output", "contact", "gravity"});
@@ -567,10 +572,11 @@ class Builder {
     if (bnd && !bnd->is_array()) top.fail("boundaries", "expected an array, got " + a_type(*bnd));
     top.done();
 
-    seed();
+    if (!checking_) seed();
     if (bnd)
       for (std::size_t i = 0; i < bnd->size(); ++i)
         parse_boundary(Obj(ctx_, (*bnd)[i], index_path("boundaries", i)), i, c);
+    if (checking_) return c;  // no solver: the keys are read
 
     s_->finalize();
     // A point probe must see particles (of its body, when it names one): else it would record
@@ -601,6 +607,7 @@ class Builder {
  private:
   const Ctx& ctx_;
   const ojson& doc_;
+  const bool checking_;  // read the keys only (see the constructor)
   GridSpec grid_;
   std::unique_ptr<Solver> s_ = std::make_unique<Solver>();
   std::vector<Material> materials_;
@@ -806,6 +813,7 @@ class Builder {
     }
     const bool reverse = o.boolean("reverse", false);
     o.done();
+    if (checking_) return {};  // the points need the mesh
     CurvePoints cp;
     try {
       cp = curve_points(*geo_, C, static_cast<int>(count), spacing, reverse);
@@ -945,6 +953,7 @@ class Builder {
       y1 = vertical ? b.y1 : line;
       what = side + " edge of body \"" + b.name + "\"";
     }
+    if (checking_) return {};  // no grid yet
     auto nodes = s_->nodes_in_box(x0, y0, x1, y1);
     if (nodes.empty()) o.fail("", "selects no node (" + what + ")");
     return nodes;
@@ -962,6 +971,7 @@ class Builder {
     if (!(width <= e.extent * (1 + 1e-12)))
       o.fail("width", "must be <= the size of body \"" + b.name + "\" normal to its " + side +
                           " side (" + fmt(e.extent) + "), got " + fmt(width));
+    if (checking_) return {};  // no particles yet
     BoundaryLayer layer = s_->select_layer(name, bi, e.ex0, e.ey0, e.ex1, e.ey1, e.nx, e.ny, width);
     what = side + " side of body \"" + b.name + "\", width " + fmt(width);
     if (layer.ids.empty()) o.fail("", "selects no particle (" + what + ")");
@@ -1108,7 +1118,8 @@ class Builder {
     }
     o.done();
     try {
-      geo_ = std::make_unique<Geometry>(load_geometry(file, size, params, load_limits().mesh_cells));
+      geo_ = std::make_unique<Geometry>(checking_ ? load_geometry_groups(file, size, params)
+                                                  : load_geometry(file, size, params, load_limits().mesh_cells));
     } catch (const GeometryError& e) {
       o.fail("file", e.what());
     }
@@ -1140,6 +1151,7 @@ class Builder {
   std::vector<double> body_surface(Obj& o, BodySpec& b) {
     if (o.has("box")) o.fail("surface", "give either box or surface, not both");
     b.surface = geometry_group(o, "surface", true);
+    if (checking_) return {grid_.x0, grid_.y0, grid_.x1(), grid_.y1()};  // no mesh yet
     const auto& S = geo_->surfaces[b.surface];
     const auto e = geo_->bounds(S);
     const double tol = 1e-6 * grid_.h;
@@ -1164,6 +1176,7 @@ class Builder {
   // Fixed / roller on a curve: the grid nodes within h/2 of it.
   std::vector<uint32_t> curve_nodes(Obj& o) {
     const int ci = geometry_group(o, "curve", false);
+    if (checking_) return {};
     const auto& C = geo_->curves[ci];
     auto nodes = nodes_near_curve(*s_, *geo_, C, 0.5 * grid_.h);
     if (nodes.empty())
@@ -1184,6 +1197,7 @@ class Builder {
     const auto& C = geo_->curves[ci];
     const double width = o.num("width", grid_.h);
     o.gt("width", width, 0);
+    if (checking_) return {};  // no particles yet
     BodyRegion region;
     if (b.surface >= 0) region.surface = &geo_->surfaces[b.surface];
     region.x0 = b.x0, region.y0 = b.y0, region.x1 = b.x1, region.y1 = b.y1;
@@ -1222,9 +1236,9 @@ class Builder {
   }
 };
 
-Case build_ordered(const Ctx& ctx, const ojson& doc) {
+Case build_ordered(const Ctx& ctx, const ojson& doc, bool checking = false) {
   try {
-    return Builder(ctx, doc).build();
+    return Builder(ctx, doc, checking).build();
   } catch (const CaseError&) {
     throw;
   } catch (const std::bad_alloc&) {
@@ -1280,6 +1294,7 @@ Case build_case(const nlohmann::json& doc, const std::string& source) {
 // time-function keys; a hybrid builds its MPM region with this parser).
 namespace detail {
 Case build_mpm_case(const Ctx& ctx, const ojson& doc) { return build_ordered(ctx, doc); }
+void check_mpm_case(const Ctx& ctx, const ojson& doc) { build_ordered(ctx, doc, true); }
 Material parse_material_at(const Ctx& ctx, const std::string& name, const ojson& j) {
   return parse_material(ctx, name, j);
 }

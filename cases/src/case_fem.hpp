@@ -22,6 +22,8 @@ std::vector<std::string> fem_probe_fields(Obj& o, const std::vector<std::string>
 
 // Hybrid cases (both "bodies" and "fem"): case_hybrid.cpp.
 Case build_mpm_case(const Ctx& ctx, const ojson& doc);  // case.cpp
+// Reads every key of an MPM document without meshing its geometry or seeding particles (case.cpp).
+void check_mpm_case(const Ctx& ctx, const ojson& doc);
 Case build_hybrid_case(const Ctx& ctx, const ojson& doc);
 
 }  // namespace smpm::detail

@@ -49,6 +49,15 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
       top.fail(k, "missing required key (a case with both \"bodies\" and \"fem\" is an MPM-FEM "
                   "hybrid and needs grid, bodies, time, materials and fem)");
 
+  // The MPM region's keys but its probes first, before either region is meshed (which probes
+  // are the MPM region's depends on the FE mesh).
+  {
+    ojson dk = doc;
+    dk.erase("fem");
+    dk.erase("probes");
+    check_mpm_case(mpm_context(ctx, {}), dk);
+  }
+
   // FEM region: the FEM parser on the FEM keys (no probes yet).
   ojson dfe = ojson::object();
   for (const char* k : {"title", "time", "materials", "fem", "output", "gravity"})

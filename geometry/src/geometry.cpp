@@ -208,11 +208,10 @@ void curve_mids(const Geometry& g, Geometry::Curve& c,
   }
 }
 
-}  // namespace
-
-Geometry load_geometry(const std::string& file, double size,
-                       const std::vector<std::pair<std::string, double>>& parameters,
-                       double max_cells) {
+// load_geometry() and, with mesh false, load_geometry_groups().
+Geometry load(const std::string& file, double size,
+              const std::vector<std::pair<std::string, double>>& parameters, double max_cells,
+              bool mesh) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::exists(file, ec)) throw GeometryError(file + ": cannot open file (it does not exist)");
@@ -269,7 +268,7 @@ Geometry load_geometry(const std::string& file, double size,
 
   gmsh_call(session, file, geo ? "read the geometry" : "read the mesh",
             [&] { gmsh::open(opened); });
-  if (geo) {
+  if (geo && mesh) {
     if (size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", size);
     if (const std::string e = gmsh_mesh_size_problem(size, max_cells); !e.empty())
       throw GeometryError(file + ": " + e);
@@ -286,6 +285,18 @@ Geometry load_geometry(const std::string& file, double size,
   if (!any)
     throw GeometryError(file + ": defines no physical surface or physical curve (name the bodies "
                                "and boundaries with Physical Surface / Physical Curve)");
+  if (!mesh) {  // the groups' tags and names only
+    for (const auto& [dim, tag] : groups) {
+      std::string name;
+      gmsh::model::getPhysicalName(dim, tag, name);
+      if (dim == 2) g.surfaces.push_back({tag, name, {}});
+      if (dim == 1) g.curves.push_back({tag, name, {}, {}});
+    }
+    auto by_tag = [](const auto& a, const auto& b) { return a.tag < b.tag; };
+    std::sort(g.surfaces.begin(), g.surfaces.end(), by_tag);
+    std::sort(g.curves.begin(), g.curves.end(), by_tag);
+    return g;
+  }
 
   // Nodes.
   std::vector<std::size_t> node_tags;
@@ -381,6 +392,19 @@ Geometry load_geometry(const std::string& file, double size,
   std::sort(g.surfaces.begin(), g.surfaces.end(), by_tag);
   std::sort(g.curves.begin(), g.curves.end(), by_tag);
   return g;
+}
+
+}  // namespace
+
+Geometry load_geometry(const std::string& file, double size,
+                       const std::vector<std::pair<std::string, double>>& parameters,
+                       double max_cells) {
+  return load(file, size, parameters, max_cells, true);
+}
+
+Geometry load_geometry_groups(const std::string& file, double size,
+                              const std::vector<std::pair<std::string, double>>& parameters) {
+  return load(file, size, parameters, 0, false);
 }
 
 }  // namespace smpm

@@ -42,14 +42,15 @@ Physical Curve("right", 12) = {2}; Physical Curve("lid_bottom", 15) = {5};
 
 std::string case_json(const std::string& geo_file, const std::string& body,
                       const std::string& boundaries = "", const std::string& grid_size = "[0.03, 0.02]",
-                      const std::string& geometry_extra = "") {
+                      const std::string& geometry_extra = "", const std::string& probes = "") {
   return R"({
   "grid": { "origin": [-0.004, -0.004], "size": )" + grid_size + R"(, "cell": 0.001 },
   "time": { "end": 1e-6, "cfl": 0.3 },
   "materials": { "w": { "model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000 } },
   "geometry": { "file": ")" + geo_file + "\"" + geometry_extra + R"( },
   "bodies": [ )" + body + R"( ],
-  "boundaries": [ )" + boundaries + R"( ]
+  "boundaries": [ )" + boundaries + R"( ],
+  "probes": [ )" + probes + R"( ]
 })";
 }
 
@@ -112,6 +113,41 @@ std::vector<Bad> bad_cases() {
                {"bodies[0].surface", "either box or surface"}});
   v.push_back({"bad_size", "rect_h.geo", kRect, case_json("rect_h.geo", kBody, "", "[0.03, 0.02]", R"(, "size": -1)"),
                {"geometry.size", "must be > 0"}});
+  // Every key is read before the mesh is made: with a size whose mesh would exceed the cell
+  // limit (checked just before meshing), a mistake in a body, boundary or probe is still the one
+  // reported. The last entry is the control: the same geometry without a mistake.
+  const std::string tiny = R"(, "size": 1e-7)";
+  v.push_back({"body_key_before_mesh", "rect_i.geo", kRect,
+               case_json("rect_i.geo", R"({ "name": "plate", "material": "w", "surface": 1, "particles_per_cel": 4 })",
+                         "", "[0.03, 0.02]", tiny),
+               {"bodies[0].particles_per_cel", "unknown key", "particles_per_cell"}});
+  v.push_back({"surface_before_mesh", "rect_j.geo", kRect,
+               case_json("rect_j.geo", R"({ "name": "plate", "material": "w", "surface": "plat" })",
+                         "", "[0.03, 0.02]", tiny),
+               {"bodies[0].surface", "no physical surface named \"plat\"", "1 \"plate\""}});
+  v.push_back({"boundary_key_before_mesh", "rect_k.geo", kRect,
+               case_json("rect_k.geo", kBody, R"({ "type": "silent", "body": "plate", "curve": 12, "widht": 0.001 })",
+                         "[0.03, 0.02]", tiny),
+               {"boundaries[0].widht", "unknown key"}});
+  v.push_back({"boundary_curve_before_mesh", "rect_l.geo", kRect,
+               case_json("rect_l.geo", kBody, R"({ "type": "fixed", "curve": "rigth" })", "[0.03, 0.02]", tiny),
+               {"boundaries[0].curve", "no physical curve named \"rigth\"", "12 \"right\""}});
+  v.push_back({"boundary_value_before_mesh", "rect_m.geo", kRect,
+               case_json("rect_m.geo", kBody, R"({ "type": "silent", "body": "plate", "curve": 12, "a": -1 })",
+                         "[0.03, 0.02]", tiny),
+               {"boundaries[0].a", ">= 0"}});
+  v.push_back({"probe_key_before_mesh", "rect_n.geo", kRect,
+               case_json("rect_n.geo", kBody, "", "[0.03, 0.02]", tiny,
+                         R"({ "name": "top", "curve": 14, "count": 5, "spacing": 0.001 })"),
+               {"probes[0]", "either count or spacing"}});
+  v.push_back({"probe_curve_before_mesh", "rect_o.geo", kRect,
+               case_json("rect_o.geo", kBody, "", "[0.03, 0.02]", tiny,
+                         R"({ "name": "top", "curve": 99, "count": 5 })"),
+               {"probes[0].curve", "no physical curve 99"}});
+  v.push_back({"mesh_too_large", "rect_p.geo", kRect,
+               case_json("rect_p.geo", kBody, R"({ "type": "silent", "body": "plate", "curve": 12 })",
+                         "[0.03, 0.02]", tiny, R"({ "name": "top", "curve": 14, "count": 5 })"),
+               {"geometry.file", "rect_p.geo", "would have about 2e+10 cells"}});
   // No geometry key at all.
   v.push_back({"no_geometry", "", "", R"({
   "grid": { "size": [0.03, 0.02], "cell": 0.001 }, "time": { "end": 1e-6, "cfl": 0.3 },

@@ -61,6 +61,14 @@ TEST(HybridCase, ErrorsNameTheKey) {
   c["probes"].push_back({{"name", "C"}, {"curve", 12}, {"count", 3}});
   EXPECT_NE(case_error(c).find("h.json: probes[2].curve: needs the top-level key \"geometry\""),
             std::string::npos) << case_error(c);
+  // The MPM region's keys are read before the FE mesh: a mistake in a body is reported even
+  // when the FE mesh file does not exist (the control: that file alone is the error).
+  c = plate_case("hybrid");
+  c["fem"]["mesh"] = (dir() / "no_such_mesh.geo").string();
+  EXPECT_NE(case_error(c).find("h.json: fem.mesh"), std::string::npos) << case_error(c);
+  c["bodies"][0]["colour"] = "red";
+  EXPECT_NE(case_error(c).find("h.json: bodies[0].colour: unknown key"), std::string::npos)
+      << case_error(c);
   c = plate_case("hybrid");
   c["extra"] = 1;
   EXPECT_NE(case_error(c).find("h.json: extra: unknown key in a hybrid"), std::string::npos)

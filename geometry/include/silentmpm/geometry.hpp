@@ -84,6 +84,12 @@ Geometry load_geometry(const std::string& file, double size,
                        const std::vector<std::pair<std::string, double>>& parameters = {},
                        double max_cells = 1e7);
 
+// The physical groups of the same file, without meshing a .geo: each surface and curve with its
+// tag and name and no elements (a case's references to them are checked with this before the
+// mesh is made). Throws as load_geometry() does for a file that cannot be read or names no group.
+Geometry load_geometry_groups(const std::string& file, double size,
+                              const std::vector<std::pair<std::string, double>>& parameters = {});
+
 // Lattice seeding of surface `s` into solver `sol` (grid already initialised, materials set):
 // points grid.x0 + (i + 1/2) h / n, grid.y0 + (j + 1/2) h / n inside an element, volume
 // (h / n)^2, mass rho (h / n)^2. Returns the number of particles added. Throws GeometryError if
