@@ -230,7 +230,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
         const std::string path = index_path(f.at("boundaries"), i);
         Obj o(ctx, (*b)[i], path, kFem);
         const std::string type =
-            o.choice("type", {"dashpot", "kelvin_voigt", "damping_layer", "traction", "fixed", "roller"});
+            o.choice("type", {"dashpot", "kelvin_voigt", "damping_layer", "pml", "traction", "fixed", "roller"});
         const std::string where = "for a " + type + " boundary";
         if (type == "dashpot") o.allow({"type", "name", "curve", "a", "b"}, where);
         if (type == "kelvin_voigt")
@@ -239,6 +239,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
           o.allow({"type", "name", "curve", "normal", "tangential", "vector", "time"}, where);
         if (type == "fixed") o.allow({"type", "name", "curve"}, where);
         if (type == "damping_layer") o.allow({"type", "name", "curve", "width", "r0", "power"}, where);
+        if (type == "pml") o.allow({"type", "name", "curve", "width", "r0", "power", "alpha"}, where);
         if (type == "roller") o.allow({"type", "name", "curve", "component"}, where);
         fem::Boundary bc;
         bc.name = o.has("name") ? o.str("name") : type + std::to_string(i);
@@ -285,14 +286,18 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
             bc.vy = v[1];
           }
           if (const ojson* tf = o.find("time")) bc.fn = parse_time_function_at(ctx, *tf, o.at("time"));
-        } else if (type == "damping_layer") {
-          bc.kind = fem::Boundary::Kind::Damping;
+        } else if (type == "damping_layer" || type == "pml") {
+          bc.kind = type == "pml" ? fem::Boundary::Kind::Pml : fem::Boundary::Kind::Damping;
           bc.width = o.num("width");
           o.gt("width", bc.width, 0);
           bc.r0 = o.num("r0", 1e-3);
           if (!(bc.r0 > 0 && bc.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(bc.r0));
           bc.power = o.num("power", 2.0);
           o.ge("power", bc.power, 0);
+          if (type == "pml") {
+            bc.alpha = o.num("alpha", 0.0);
+            o.ge("alpha", bc.alpha, 0);
+          }
         } else if (type == "fixed") {
           bc.kind = fem::Boundary::Kind::Fixed;
         } else {

@@ -43,6 +43,32 @@ struct Solver::Impl {
   // Dashpot blocks C per dashpot node (their trapezoidal update: dashpot.hpp).
   std::vector<Solver::DashpotBlock> dash;
 
+  // Perfectly matched layers (built in fem_setup.cpp, stepped in fem_kernels.cpp;
+  // docs/physics.md section 9.3). Cells that reach into a layer keep their quadrature data and
+  // four memory variables per quadrature point (the stretched parts of the x and y derivatives
+  // of u_x and u_y); nodes inside a layer keep two per component (the mass term's convolutions).
+  struct Pml {
+    double alpha = 0;                        // frequency shift (1/s)
+    int nb = 0, nq = 0;                      // nodes and quadrature points per cell
+    std::vector<std::uint32_t> cell_nodes;   // nb per cell
+    std::vector<double> grad;                // per cell, point, node: dN/dx, dN/dy
+    std::vector<double> lam2mu, mu;          // per cell
+    std::vector<double> jxw, dx, dy;         // per cell and point
+    std::vector<double> xi;                  // 4 per cell and point
+    std::vector<std::uint32_t> node;         // nodes with d_x + d_y > 0
+    std::vector<double> m_sum, m_prod;       // m_i (d_x + d_y), m_i d_x d_y
+    std::vector<double> zeta;                // 4 per node: the memories I1 (x, y), I2 (x, y)
+    std::vector<std::uint32_t> touched;      // every node of a layer cell
+    // Recursive-convolution coefficients (e, ca, cb) for dt_coef: per cell and point for
+    // alpha + d_x and alpha + d_y, and for alpha.
+    double dt_coef = 0;
+    std::vector<double> cx, cy;
+    double e_a = 1, ca_a = 0, cb_a = 0;
+    bool active() const { return !touched.empty(); }
+  };
+  Pml pml;
+  std::vector<double> dash_force;  // 2 per dashpot block: the PML's explicit forces (else 0)
+
   // Traction loads: f_ext(t) = sum_l fn_l(t) F_l, F_l sparse over its nodes.
   struct Load {
     TimeFunction fn;

@@ -135,6 +135,102 @@ void Solver::set_dt(double h) {
 }
 
 namespace {
+// psi(t + dt) = e psi(t) + ca g(t) + cb g(t + dt): the exact solution of psi' = -beta psi + g
+// over one step with g linear in between (recursive convolution with exp(-beta t)).
+void convolution_coefficients(double beta, double dt, double& e, double& ca, double& cb) {
+  const double x = beta * dt;
+  e = std::exp(-x);
+  if (x < 1e-3) {  // the series, free of cancellation
+    ca = dt * (0.5 - x / 3 + x * x / 8 - x * x * x / 30);
+    cb = dt * (0.5 - x / 6 + x * x / 24 - x * x * x / 120);
+  } else {
+    ca = dt * (1 - e * (1 + x)) / (x * x);
+    cb = dt * (1 - e) / x - ca;
+  }
+}
+
+// The explicit forces of the perfectly matched layers at u^n into m.dash_force (docs/physics.md
+// section 9.3), advancing their memory variables to t_n. Per quadrature point of a layer cell:
+// the x-derivative part of the stiffness carries s_y / s_x = 1 + (d_y - d_x) / (i omega +
+// alpha + d_x), the y-derivative part s_x / s_y; the convolutions of du/dx with exp(-(alpha +
+// d_x) t) and of du/dy with exp(-(alpha + d_y) t) are the memories. Per layer node the mass
+// term m (s_x s_y)(i omega)^2 u less its damping part m (d_x + d_y) v (in the dashpot block):
+// -m [(d_x + d_y)(-alpha u + alpha^2 I1) + d_x d_y (u - 2 alpha I1 + alpha^2 I2)], with I1 the
+// convolution of u and I2 that of I1 with exp(-alpha t).
+void pml_forces(Solver::Impl& m, double dt) {
+  Solver::Impl::Pml& P = m.pml;
+  const std::size_t nqp = P.jxw.size();
+  if (P.dt_coef != dt) {
+    P.cx.resize(3 * nqp);
+    P.cy.resize(3 * nqp);
+    for (std::size_t k = 0; k < nqp; ++k) {
+      convolution_coefficients(P.alpha + P.dx[k], dt, P.cx[3 * k], P.cx[3 * k + 1], P.cx[3 * k + 2]);
+      convolution_coefficients(P.alpha + P.dy[k], dt, P.cy[3 * k], P.cy[3 * k + 1], P.cy[3 * k + 2]);
+    }
+    convolution_coefficients(P.alpha, dt, P.e_a, P.ca_a, P.cb_a);
+    P.dt_coef = dt;
+  }
+  double* __restrict f = m.dash_force.data();
+  const std::int32_t* __restrict dn = m.dash_of_node.data();
+  const double* __restrict u = m.u.data();
+  for (const std::uint32_t nd : P.touched) f[2 * dn[nd]] = f[2 * dn[nd] + 1] = 0.0;
+  const int nb = P.nb, nq = P.nq;
+  const std::size_t ncell = P.lam2mu.size();
+  for (std::size_t c = 0; c < ncell; ++c) {
+    const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
+    double ux[9], uy[9], fx[9] = {0}, fy[9] = {0};
+    for (int a = 0; a < nb; ++a) {
+      ux[a] = u[2 * cn[a]];
+      uy[a] = u[2 * cn[a] + 1];
+    }
+    const double L = P.lam2mu[c], mu = P.mu[c];
+    for (int q = 0; q < nq; ++q) {
+      const std::size_t k = c * nq + q;
+      const double* g = P.grad.data() + 2 * k * nb;
+      double gxx = 0, gxy = 0, gyx = 0, gyy = 0;  // du_x/dx, du_y/dx, du_x/dy, du_y/dy
+      for (int a = 0; a < nb; ++a) {
+        gxx += g[2 * a] * ux[a];
+        gxy += g[2 * a] * uy[a];
+        gyx += g[2 * a + 1] * ux[a];
+        gyy += g[2 * a + 1] * uy[a];
+      }
+      double* xi = P.xi.data() + 4 * k;
+      const double* cx = P.cx.data() + 3 * k;
+      const double* cy = P.cy.data() + 3 * k;
+      const double pxx = xi[0] + cx[2] * gxx, pxy = xi[1] + cx[2] * gxy;
+      const double pyx = xi[2] + cy[2] * gyx, pyy = xi[3] + cy[2] * gyy;
+      xi[0] = cx[0] * pxx + cx[1] * gxx;
+      xi[1] = cx[0] * pxy + cx[1] * gxy;
+      xi[2] = cy[0] * pyx + cy[1] * gyx;
+      xi[3] = cy[0] * pyy + cy[1] * gyy;
+      const double kx = (P.dy[k] - P.dx[k]) * P.jxw[k];  // and -kx for the y part
+      const double sxx = kx * L * pxx, sxy = kx * mu * pxy, syx = -kx * mu * pyx, syy = -kx * L * pyy;
+      for (int a = 0; a < nb; ++a) {
+        fx[a] -= sxx * g[2 * a] + syx * g[2 * a + 1];
+        fy[a] -= sxy * g[2 * a] + syy * g[2 * a + 1];
+      }
+    }
+    for (int a = 0; a < nb; ++a) {
+      f[2 * dn[cn[a]]] += fx[a];
+      f[2 * dn[cn[a]] + 1] += fy[a];
+    }
+  }
+  const double al = P.alpha;
+  for (std::size_t j = 0; j < P.node.size(); ++j) {
+    const std::uint32_t i = P.node[j];
+    double* z = P.zeta.data() + 4 * j;
+    for (int c = 0; c < 2; ++c) {
+      const double uu = u[2 * i + c];
+      const double i1 = z[c] + P.cb_a * uu;
+      const double i2 = z[2 + c] + P.cb_a * i1;
+      z[c] = P.e_a * i1 + P.ca_a * uu;
+      z[2 + c] = P.e_a * i2 + P.ca_a * i1;
+      f[2 * dn[i] + c] -= P.m_sum[j] * (al * al * i1 - al * uu) +
+                          P.m_prod[j] * (uu - 2 * al * i1 + al * al * i2);
+    }
+  }
+}
+
 // The explicit update of every node with skip == nullptr or skip[i] < 0: v+ = v + dt f / m, the
 // trapezoidal solve at a node with a dashpot block (dashpot.hpp), constraints; then u += dt v+.
 // Adds the work of f_ext (with the mid-step velocity) and the energy the dashpots absorb.
@@ -152,6 +248,8 @@ void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __re
   const double gx = m.spec.gravity_x, gy = m.spec.gravity_y;
   const bool gravity = gx != 0 || gy != 0;
   double work = 0, absorbed = 0;
+  if (m.pml.active()) pml_forces(m, dt);
+  const double* __restrict pf = m.dash_force.data();
 #pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
     if (parallel)
   for (std::int64_t i = 0; i < n; ++i) {
@@ -168,9 +266,11 @@ void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __re
       vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy * im[i];
     } else {
       const Solver::DashpotBlock& c = D[dn[i]];
-      dashpot_velocity(ms[i], c.cxx, c.cxy, c.cyy, vx0, vy0, fx, fy, dt, mask[i], vx, vy);
+      const double px = pf[2 * dn[i]], py = pf[2 * dn[i] + 1];  // a PML's forces (else 0)
+      dashpot_velocity(ms[i], c.cxx, c.cxy, c.cyy, vx0, vy0, fx + px, fy + py, dt, mask[i], vx, vy);
       const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
-      absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
+      absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by) -
+                        px * bx - py * by);
     }
     work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
     if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
@@ -275,6 +375,10 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   w.put(pre + "ku", m.ku);
   w.put(pre + "ku_valid", static_cast<std::uint8_t>(m.ku_valid));
   w.put(pre + "snapshot_times", snapshot_times());
+  if (m.pml.active()) {
+    w.put(pre + "pml_xi", m.pml.xi);
+    w.put(pre + "pml_zeta", m.pml.zeta);
+  }
 }
 
 void Solver::load_state(const StateReader& r, const std::string& pre) {
@@ -292,6 +396,10 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   energy = r.get<Energies>(pre + "energy");
   r.get(pre + "snapshot_times", m.snapshot_times);
   m.snapshots = static_cast<int>(m.snapshot_times.size());
+  if (m.pml.active()) {
+    r.get(pre + "pml_xi", m.pml.xi, m.pml.xi.size());
+    r.get(pre + "pml_zeta", m.pml.zeta, m.pml.zeta.size());
+  }
 }
 
 }  // namespace smpm::fem

@@ -172,6 +172,155 @@ class StressPostprocessor : public DataPostprocessor<2> {
 
 }  // namespace
 
+namespace {
+
+// A boundary face of a PML's curves: its ends, the centre of its cell, c_d there, its curve.
+struct PmlFace {
+  double x0, y0, x1, y1, cx, cy, cd;
+  int curve;
+};
+
+std::string num6(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// One layer: the band of depth `width` inside the line x = c (axis 0) or y = c (axis 1), on the
+// side `side` (-1: the mesh lies at coordinates below c), with d = d0 s^power.
+struct PmlBand {
+  int axis = 0;
+  double c = 0, width = 0, d0 = 0, power = 2;
+  int side = -1;
+  double at(double x, double y) const {
+    const double p = axis == 0 ? x : y;
+    const double s = (p - (c - side * width)) * side / width;  // 0 at the inner edge, 1 at c
+    if (!(s > 0)) return 0.0;
+    return d0 * std::pow(std::min(s, 1.0), power);
+  }
+};
+
+// The PMLs of `spec` (faces of their curves in `faces`): checks each is one straight edge along
+// an axis, then keeps every cell with a quadrature point inside a layer (its shape gradients,
+// weights and d_x, d_y there), the nodal terms, and a dashpot block for every node of those cells.
+void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
+               const std::vector<std::vector<PmlFace>>& faces,
+               std::map<std::uint32_t, std::array<double, 3>>& cblocks) {
+  const std::string& file = spec.mesh.file;
+  std::vector<PmlBand> bands;
+  bool first = true;
+  for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
+    const Boundary& bc = spec.boundaries[b];
+    if (bc.kind != Boundary::Kind::Pml || faces[b].empty()) continue;
+    if (first) m.pml.alpha = bc.alpha;
+    else if (bc.alpha != m.pml.alpha)
+      throw FemError("FEM: boundary \"" + bc.name + "\": every pml of a model must have the same "
+                     "alpha (" + num6(m.pml.alpha) + " and " + num6(bc.alpha) + " 1/s given)");
+    first = false;
+    const double span = std::hypot(m.box[2] - m.box[0], m.box[3] - m.box[1]);
+    const double tol = 1e-9 * span;
+    const PmlFace& f0 = faces[b].front();
+    const int axis = std::fabs(f0.x1 - f0.x0) <= tol ? 0 : std::fabs(f0.y1 - f0.y0) <= tol ? 1 : -1;
+    const double c = axis == 0 ? f0.x0 : f0.y0;
+    for (const PmlFace& f : faces[b]) {
+      const bool ok = axis == 0   ? std::fabs(f.x0 - c) <= tol && std::fabs(f.x1 - c) <= tol
+                      : axis == 1 ? std::fabs(f.y0 - c) <= tol && std::fabs(f.y1 - c) <= tol
+                                  : false;
+      if (!ok) {
+        const PhysicalGroup* g = spec.mesh.curve(f.curve);
+        throw FemError(file + ": boundary \"" + bc.name + "\": a pml needs its curves to form one "
+                       "straight edge parallel to the x or the y axis; physical curve " +
+                       std::to_string(f.curve) +
+                       (g && !g->name.empty() ? " (\"" + g->name + "\")" : std::string()) +
+                       " has a face from (" + num6(f.x0) + ", " + num6(f.y0) + ") to (" +
+                       num6(f.x1) + ", " + num6(f.y1) + ")");
+      }
+    }
+    PmlBand band;
+    band.axis = axis;
+    band.c = c;
+    band.width = bc.width;
+    band.power = bc.power;
+    band.side = (axis == 0 ? f0.cx : f0.cy) < c ? 1 : -1;
+    const double extent = axis == 0 ? m.box[2] - m.box[0] : m.box[3] - m.box[1];
+    if (bc.width > extent * (1 + 1e-12))
+      throw FemError(file + ": boundary \"" + bc.name + "\": the pml is " + num6(bc.width) +
+                     " m thick, more than the mesh's extent across it (" + num6(extent) + " m)");
+    double cd = 0;
+    for (const PmlFace& f : faces[b]) cd = std::max(cd, f.cd);
+    band.d0 = -(bc.power + 1) * cd * std::log(bc.r0) / (2 * bc.width);
+    bands.push_back(band);
+  }
+  if (bands.empty()) return;
+  auto dxy = [&](double x, double y, double& dx, double& dy) {
+    dx = dy = 0;
+    for (const auto& bd : bands) (bd.axis == 0 ? dx : dy) += bd.at(x, y);
+  };
+
+  Solver::Impl::Pml& P = m.pml;
+  const FiniteElement<2>& fe = *d.fe;
+  const unsigned dpc = fe.n_dofs_per_cell();
+  const QGauss<2> q(m.degree + 1);
+  FEValues<2> fv(d.mapping, fe, q, update_gradients | update_JxW_values | update_quadrature_points);
+  std::vector<types::global_dof_index> ld(dpc);
+  P.nb = static_cast<int>(dpc / 2);
+  P.nq = static_cast<int>(q.size());
+  std::set<std::uint32_t> touched;
+  for (const auto& cell : d.dofh.active_cell_iterators()) {
+    fv.reinit(cell);
+    std::vector<double> dx(q.size()), dy(q.size());
+    bool inside = false;
+    for (unsigned k = 0; k < q.size(); ++k) {
+      const auto p = fv.quadrature_point(k);
+      dxy(p[0], p[1], dx[k], dy[k]);
+      inside = inside || dx[k] > 0 || dy[k] > 0;
+    }
+    if (!inside) continue;
+    const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
+    cell->get_dof_indices(ld);
+    std::vector<unsigned> comp0;  // the x dof of each node, in the cell's order
+    for (unsigned i = 0; i < dpc; ++i)
+      if (fe.system_to_component_index(i).first == 0) comp0.push_back(i);
+    for (unsigned i : comp0) {
+      const auto node = static_cast<std::uint32_t>(ld[i] / 2);
+      P.cell_nodes.push_back(node);
+      touched.insert(node);
+    }
+    for (unsigned k = 0; k < q.size(); ++k) {
+      for (unsigned i : comp0) {
+        const Tensor<1, 2> g = fv.shape_grad(i, k);
+        P.grad.push_back(g[0]);
+        P.grad.push_back(g[1]);
+      }
+      P.jxw.push_back(fv.JxW(k));
+      P.dx.push_back(dx[k]);
+      P.dy.push_back(dy[k]);
+    }
+    P.lam2mu.push_back(mat.lambda + 2 * mat.mu);
+    P.mu.push_back(mat.mu);
+  }
+  P.xi.assign(4 * P.jxw.size(), 0.0);
+  double lam = 0;
+  for (const std::uint32_t node : touched) {
+    P.touched.push_back(node);
+    auto& c = cblocks[node];  // a block for every node of a layer cell (zero where d = 0)
+    double dx, dy;
+    dxy(m.x[node], m.y[node], dx, dy);
+    if (!(dx + dy > 0)) continue;
+    c[0] += m.mass[node] * (dx + dy);
+    c[2] += m.mass[node] * (dx + dy);
+    P.node.push_back(node);
+    P.m_sum.push_back(m.mass[node] * (dx + dy));
+    P.m_prod.push_back(m.mass[node] * dx * dy);
+    lam = std::max(lam, dx * dy);
+  }
+  P.zeta.assign(4 * P.node.size(), 0.0);
+  // The corner term m d_x d_y u is a spring of stiffness d_x d_y per unit mass.
+  if (lam > 0 && m.crit_dt > 0) m.crit_dt = 2.0 / std::sqrt(4.0 / (m.crit_dt * m.crit_dt) + lam);
+}
+
+}  // namespace
+
 Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
   // No MPI here: the serial triangulation, dofs and matrices do not use it, and MPI_Init (it
   // starts OpenMPI's orted) costs ~0.04 s CPU and ~0.35 s wall; write_snapshot starts it.
@@ -408,6 +557,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
     // Damping layers: the boundary segments of their curves and the c_d next to them.
     std::vector<std::vector<std::array<double, 4>>> dseg(spec.boundaries.size());
     std::vector<double> dcd(spec.boundaries.size(), 0.0);
+    std::vector<std::vector<PmlFace>> pml_faces(spec.boundaries.size());
     for (const auto& cell : d.dofh.active_cell_iterators()) {
       const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
       for (const auto f : cell->face_indices()) {
@@ -415,6 +565,12 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
         const int id = static_cast<int>(cell->face(f)->boundary_id());
         for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
           const Boundary& bc = spec.boundaries[b];
+          if (bc.kind == Boundary::Kind::Pml &&
+              std::find(bc.curves.begin(), bc.curves.end(), id) != bc.curves.end()) {
+            const auto v0 = cell->face(f)->vertex(0), v1 = cell->face(f)->vertex(1);
+            const auto cc = cell->center();
+            pml_faces[b].push_back({v0[0], v0[1], v1[0], v1[1], cc[0], cc[1], mat.cd, id});
+          }
           if (bc.kind != Boundary::Kind::Damping) continue;
           if (std::find(bc.curves.begin(), bc.curves.end(), id) == bc.curves.end()) continue;
           const auto v0 = cell->face(f)->vertex(0), v1 = cell->face(f)->vertex(1);
@@ -493,6 +649,11 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
         c[2] += alpha * m.mass[i];
       }
     }
+    // Perfectly matched layers: the cells that reach into a layer, and the nodal damping
+    // m_i (d_x + d_y) in the dashpot blocks (every node of such a cell gets a block, through
+    // which the layer's other forces enter).
+    setup_pml(m, d, spec, pml_faces, cblocks);
+
     // Springs into the stiffness's diagonal blocks. With M lumped, the largest eigenvalue of
     // M^-1 (K + S) is at most that of M^-1 K plus max_i lambda_max(S_i) / m_i: the critical
     // time step shrinks accordingly.
@@ -515,6 +676,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
       m.dash_of_node[node] = static_cast<std::int32_t>(m.dash.size());
       m.dash.push_back({node, c[0], c[1], c[2]});
     }
+    m.dash_force.assign(2 * m.dash.size(), 0.0);
     for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
       if (spec.boundaries[b].kind != Boundary::Kind::Traction) continue;
       Impl::Load l;
@@ -697,6 +859,10 @@ std::vector<std::string> Solver::describe() const {
       case Boundary::Kind::Fixed: s += "fixed"; break;
       case Boundary::Kind::Damping:
         s += "damping layer " + fmt(bc.width) + " m thick, r0 = " + fmt(bc.r0) + ", power " + fmt(bc.power);
+        break;
+      case Boundary::Kind::Pml:
+        s += "perfectly matched layer " + fmt(bc.width) + " m thick, r0 = " + fmt(bc.r0) +
+             ", power " + fmt(bc.power) + ", alpha " + fmt(bc.alpha) + " 1/s";
         break;
       case Boundary::Kind::Roller: s += std::string("roller, ") + (bc.component ? "y" : "x") + " held"; break;
       case Boundary::Kind::Traction:

@@ -3,7 +3,8 @@
 // traces OUT/trace_<P|SV>_<angle>.csv.
 //
 //   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N] [--shape bilinear|gimp|bspline]
-//           [--boundary lk|kv|damping] [--delta CELLS] [--band CELLS] [--r0 R]  (the right side of run A)
+//           [--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S]
+//           (the right side of run A)
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
                          "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
-                         "[--boundary lk|kv|damping] [--delta CELLS] [--band CELLS] [--r0 R]\n");
+                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -50,8 +51,9 @@ int main(int argc, char** argv) {
       base.threads = std::atoi(argv[i + 1]);
     } else if (a == "--boundary") {
       base.boundary = argv[i + 1];
-      if (base.boundary != "lk" && base.boundary != "kv" && base.boundary != "damping") {
-        std::fprintf(stderr, "oblique: --boundary must be lk, kv or damping\n");
+      if (base.boundary != "lk" && base.boundary != "kv" && base.boundary != "damping" &&
+          base.boundary != "pml") {
+        std::fprintf(stderr, "oblique: --boundary must be lk, kv, damping or pml\n");
         return 1;
       }
     } else if (a == "--delta") {
@@ -60,6 +62,8 @@ int main(int argc, char** argv) {
       base.band = std::atof(argv[i + 1]);
     } else if (a == "--r0") {
       base.r0 = std::atof(argv[i + 1]);
+    } else if (a == "--alpha") {
+      base.alpha = std::atof(argv[i + 1]);
     } else if (a == "--shape") {
       const std::string v = argv[i + 1];
       if (v == "bilinear") base.shape = ShapeKind::Bilinear;
@@ -89,6 +93,15 @@ int main(int argc, char** argv) {
     if (base.boundary == "damping") {
       j["damping_band_cells"] = base.band;
       j["damping_r0"] = base.r0;
+    }
+    if (base.boundary == "pml") {
+      if (method != "fem") {
+        std::fprintf(stderr, "oblique: --boundary pml is for the FEM method\n");
+        return 1;
+      }
+      j["pml_cells"] = base.band;
+      j["pml_r0"] = base.r0;
+      j["pml_alpha"] = base.alpha;
     }
     j["nu"] = base.nu;
     j["pulse_fwhm_cells"] = base.fwhm;

@@ -47,9 +47,11 @@ struct Setup {
   int taper = 60;          // cos^2 taper beyond it (cells)
   smpm::ShapeKind shape = smpm::ShapeKind::Bilinear;  // MPM grid shape functions
   // The right side of run A: "lk" (dashpots), "kv" (dashpots and springs with `delta` cells),
-  // "damping" (a graded damping band of `band` cells with r0 and power 2, then the dashpots).
+  // "damping" (a graded damping band of `band` cells with r0 and power 2, then the dashpots),
+  // "pml" (FEM: a perfectly matched layer of `band` cells with r0, power 2 and alpha, then the
+  // dashpots).
   std::string boundary = "lk";
-  double delta = 40, band = 10, r0 = 1e-3;
+  double delta = 40, band = 10, r0 = 1e-3, alpha = 0;
 };
 
 struct Result {
@@ -199,9 +201,10 @@ inline Result measure(const Setup& su) {
       b.name = "right";
       if (su.boundary == "kv") b.delta = su.delta * h;
       s.boundaries.push_back(b);
-      if (su.boundary == "damping") {
+      if (su.boundary == "damping" || su.boundary == "pml") {
         fem::Boundary d;
-        d.kind = fem::Boundary::Kind::Damping;
+        d.kind = su.boundary == "pml" ? fem::Boundary::Kind::Pml : fem::Boundary::Kind::Damping;
+        d.alpha = su.alpha;
         d.curves = {12};
         d.name = "band";
         d.width = su.band * h;

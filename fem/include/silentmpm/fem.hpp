@@ -67,7 +67,7 @@ Mesh load_mesh(const std::string& file, double size, double max_cells = 1e7);
 
 // ---- model -------------------------------------------------------------------------------------
 struct Boundary {
-  enum class Kind { Dashpot, Traction, Fixed, Roller, Damping };
+  enum class Kind { Dashpot, Traction, Fixed, Roller, Damping, Pml };
   Kind kind = Kind::Fixed;
   std::string name;
   std::vector<int> curves;     // physical curve tags (boundary ids)
@@ -88,6 +88,13 @@ struct Boundary {
   // -(power + 1) c_d ln(r0) / width (c_d of the material next to the curves); nodal blocks
   // C_i = alpha(x_i) m_i I beside the dashpots (docs/physics.md section 9.2).
   double width = 0, r0 = 1e-3, power = 2;
+  // Pml: a perfectly matched layer of thickness `width` inside the curves, which must form one
+  // straight edge parallel to the x or the y axis. Complex coordinate stretching normal to the
+  // edge, s = 1 + d / (alpha + i omega), d = d0 s^power (s the depth into the layer over width,
+  // 0 at its inner edge), d0 = -(power + 1) c_d ln(r0) / (2 width) with c_d of the material next
+  // to the curves, alpha the frequency shift (1/s; the same for every PML of a model). Layers on
+  // two edges overlap in the corner, where both stretchings apply (docs/physics.md section 9.3).
+  double alpha = 0;
 };
 
 struct Spec {
