@@ -119,6 +119,32 @@ TEST(FemErrors, BadMeshes) {
 
 TEST(FemErrors, BadInputs) {
   json c = good_case();
+  // A perfectly matched layer: its keys, then what only the mesh can tell.
+  c["fem"]["boundaries"].push_back({{"type", "pml"}, {"curve", "top"}, {"width", 0.002}});
+  EXPECT_EQ(error_of(c), "");
+  c["fem"]["boundaries"][2]["r0"] = 1.5;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].r0", "(0, 1)");
+  c["fem"]["boundaries"][2].erase("r0");
+  c["fem"]["boundaries"][2]["alpha"] = -1;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].alpha", ">= 0");
+  c["fem"]["boundaries"][2].erase("alpha");
+  c["fem"]["boundaries"][2]["a"] = 1;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].a", "unknown key", "for a pml boundary");
+  c["fem"]["boundaries"][2].erase("a");
+  c["fem"]["boundaries"][2].erase("width");
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].width", "missing required key");
+  c["fem"]["boundaries"][2]["width"] = 0.02;
+  EXPECT_ERROR(error_of(c), "case.json: fem", "boundary \"pml2\"", "0.02 m thick",
+               "extent across it (0.01 m)");
+  c["fem"]["boundaries"][2]["width"] = 0.002;
+  c["fem"]["boundaries"][2]["curve"] = {"top", "right"};
+  EXPECT_ERROR(error_of(c), "boundary \"pml2\"", "one straight edge parallel to the x or the y axis",
+               "physical curve 12 (\"right\")");
+  c["fem"]["boundaries"][2]["curve"] = "top";
+  c["fem"]["boundaries"].push_back({{"type", "pml"}, {"curve", "bottom"}, {"width", 0.002}, {"alpha", 1e5}});
+  EXPECT_ERROR(error_of(c), "boundary \"pml3\"", "the same alpha");
+
+  c = good_case();
   c["fem"]["regions"] = {{"nosuch", "tungsten"}};
   EXPECT_ERROR(error_of(c), "case.json: fem.regions.nosuch", "no physical surface \"nosuch\"",
                "1 \"body\"");
