@@ -57,7 +57,7 @@ struct Solver::Impl {
     std::vector<double> xi;                  // 4 per cell and point
     std::vector<std::uint32_t> node;         // nodes with d_x + d_y > 0
     std::vector<double> m_sum, m_prod;       // m_i (d_x + d_y), m_i d_x d_y
-    std::vector<double> zeta;                // 4 per node: the memories I1 (x, y), I2 (x, y)
+    std::vector<double> zeta;                // 4 per node: the memories I1, I2 of u_x, then of u_y
     std::vector<std::uint32_t> touched;      // every node of a layer cell
     // Recursive-convolution coefficients (e, ca, cb) for dt_coef: per cell and point for
     // alpha + d_x and alpha + d_y, and for alpha.

@@ -135,20 +135,6 @@ void Solver::set_dt(double h) {
 }
 
 namespace {
-// psi(t + dt) = e psi(t) + ca g(t) + cb g(t + dt): the exact solution of psi' = -beta psi + g
-// over one step with g linear in between (recursive convolution with exp(-beta t)).
-void convolution_coefficients(double beta, double dt, double& e, double& ca, double& cb) {
-  const double x = beta * dt;
-  e = std::exp(-x);
-  if (x < 1e-3) {  // the series, free of cancellation
-    ca = dt * (0.5 - x / 3 + x * x / 8 - x * x * x / 30);
-    cb = dt * (0.5 - x / 6 + x * x / 24 - x * x * x / 120);
-  } else {
-    ca = dt * (1 - e * (1 + x)) / (x * x);
-    cb = dt * (1 - e) / x - ca;
-  }
-}
-
 // The explicit forces of the perfectly matched layers at u^n into m.dash_force (docs/physics.md
 // section 9.3), advancing their memory variables to t_n. Per quadrature point of a layer cell:
 // the x-derivative part of the stiffness carries s_y / s_x = 1 + (d_y - d_x) / (i omega +
@@ -215,19 +201,11 @@ void pml_forces(Solver::Impl& m, double dt) {
       f[2 * dn[cn[a]] + 1] += fy[a];
     }
   }
-  const double al = P.alpha;
   for (std::size_t j = 0; j < P.node.size(); ++j) {
     const std::uint32_t i = P.node[j];
-    double* z = P.zeta.data() + 4 * j;
-    for (int c = 0; c < 2; ++c) {
-      const double uu = u[2 * i + c];
-      const double i1 = z[c] + P.cb_a * uu;
-      const double i2 = z[2 + c] + P.cb_a * i1;
-      z[c] = P.e_a * i1 + P.ca_a * uu;
-      z[2 + c] = P.e_a * i2 + P.ca_a * i1;
-      f[2 * dn[i] + c] -= P.m_sum[j] * (al * al * i1 - al * uu) +
-                          P.m_prod[j] * (uu - 2 * al * i1 + al * al * i2);
-    }
+    for (int c = 0; c < 2; ++c)  // zeta: 2 memories per component
+      f[2 * dn[i] + c] += pml_mass_term(P.m_sum[j], P.m_prod[j], P.alpha, u[2 * i + c],
+                                        P.zeta.data() + 4 * j + 2 * c, P.e_a, P.ca_a, P.cb_a);
   }
 }
 

@@ -4,6 +4,7 @@
 // solved for the free components only (mask bit 0: x held, bit 1: y held; a held component is
 // zero). Unconditionally stable for the dashpot. Used by the MPM grid update (silent layers in
 // the nodal form) and by the hybrid step (FE dashpots, at shared and FE-only nodes alike).
+#include <cmath>
 #include <cstdint>
 
 namespace smpm {
@@ -38,6 +39,35 @@ inline void dashpot_velocity(double m, double cxx, double cxy, double cyy, doubl
     case 2: ax = rx / A; break;  // y held
     default: break;
   }
+}
+
+// Perfectly matched layers (docs/physics.md section 9.3), shared by the FE far field and the
+// particles. psi(t + dt) = e psi(t) + ca g(t) + cb g(t + dt) is the exact solution of
+// psi' = -beta psi + g over one step with g linear in between (recursive convolution with
+// exp(-beta t)).
+inline void convolution_coefficients(double beta, double dt, double& e, double& ca, double& cb) {
+  const double x = beta * dt;
+  e = std::exp(-x);
+  if (x < 1e-3) {  // the series, free of cancellation
+    ca = dt * (0.5 - x / 3 + x * x / 8 - x * x * x / 30);
+    cb = dt * (0.5 - x / 6 + x * x / 24 - x * x * x / 120);
+  } else {
+    ca = dt * (1 - e * (1 + x)) / (x * x);
+    cb = dt * (1 - e) / x - ca;
+  }
+}
+
+// The mass term of a layer point's component u (less its damping part m (d_x + d_y) v, which
+// goes through a dashpot block), per unit of its mass: -[(d_x + d_y)(-alpha u + alpha^2 I1) +
+// d_x d_y (u - 2 alpha I1 + alpha^2 I2)], I1 the convolution of u and I2 that of I1 with
+// exp(-alpha t). z[0], z[1] carry the two memories between steps; (e, ca, cb) are alpha's
+// coefficients.
+inline double pml_mass_term(double sum, double prod, double alpha, double u, double* z, double e,
+                            double ca, double cb) {
+  const double i1 = z[0] + cb * u, i2 = z[1] + cb * i1;
+  z[0] = e * i1 + ca * u;
+  z[1] = e * i2 + ca * i1;
+  return -(sum * (alpha * alpha * i1 - alpha * u) + prod * (u - 2 * alpha * i1 + alpha * alpha * i2));
 }
 
 }  // namespace smpm
