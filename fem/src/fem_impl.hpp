@@ -50,10 +50,14 @@ struct Solver::Impl {
   struct Pml {
     double alpha = 0;                        // frequency shift (1/s)
     int nb = 0, nq = 0;                      // nodes and quadrature points per cell
+    // Cells in colour order (no two cells of a colour share a node): colour k holds cells
+    // [colour_start[k], colour_start[k + 1]).
+    std::vector<std::uint32_t> colour_start;
     std::vector<std::uint32_t> cell_nodes;   // nb per cell
-    std::vector<double> grad;                // per cell, point, node: dN/dx, dN/dy
-    std::vector<double> lam2mu, mu;          // per cell
-    std::vector<double> jxw, dx, dy;         // per cell and point
+    std::vector<std::uint32_t> shape;        // per cell: its table in grad
+    std::vector<double> grad;                // per shape, point, node: dN/dx, dN/dy
+    // Per cell and point: (d_y - d_x) JxW (lambda + 2 mu), (d_y - d_x) JxW mu, d_x, d_y.
+    std::vector<double> kl, km, dx, dy;
     std::vector<double> xi;                  // 4 per cell and point
     std::vector<std::uint32_t> node;         // nodes with d_x + d_y > 0
     std::vector<double> m_sum, m_prod;       // m_i (d_x + d_y), m_i d_x d_y

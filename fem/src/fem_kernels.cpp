@@ -145,7 +145,7 @@ namespace {
 // convolution of u and I2 that of I1 with exp(-alpha t).
 void pml_forces(Solver::Impl& m, double dt) {
   Solver::Impl::Pml& P = m.pml;
-  const std::size_t nqp = P.jxw.size();
+  const std::size_t nqp = P.kl.size();
   if (P.dt_coef != dt) {
     P.cx.resize(3 * nqp);
     P.cy.resize(3 * nqp);
@@ -161,44 +161,47 @@ void pml_forces(Solver::Impl& m, double dt) {
   const double* __restrict u = m.u.data();
   for (const std::uint32_t nd : P.touched) f[2 * dn[nd]] = f[2 * dn[nd] + 1] = 0.0;
   const int nb = P.nb, nq = P.nq;
-  const std::size_t ncell = P.lam2mu.size();
-  for (std::size_t c = 0; c < ncell; ++c) {
-    const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
-    double ux[9], uy[9], fx[9] = {0}, fy[9] = {0};
-    for (int a = 0; a < nb; ++a) {
-      ux[a] = u[2 * cn[a]];
-      uy[a] = u[2 * cn[a] + 1];
-    }
-    const double L = P.lam2mu[c], mu = P.mu[c];
-    for (int q = 0; q < nq; ++q) {
-      const std::size_t k = c * nq + q;
-      const double* g = P.grad.data() + 2 * k * nb;
-      double gxx = 0, gxy = 0, gyx = 0, gyy = 0;  // du_x/dx, du_y/dx, du_x/dy, du_y/dy
+  for (std::size_t colour = 0; colour + 1 < P.colour_start.size(); ++colour) {
+    const std::int64_t c0 = P.colour_start[colour], c1 = P.colour_start[colour + 1];
+#pragma omp parallel for schedule(static) num_threads(m.threads) if (c1 - c0 >= 2000)
+    for (std::int64_t c = c0; c < c1; ++c) {
+      const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
+      const double* gs = P.grad.data() + static_cast<std::size_t>(P.shape[c]) * nq * nb * 2;
+      double ux[9], uy[9], fx[9] = {0}, fy[9] = {0};
       for (int a = 0; a < nb; ++a) {
-        gxx += g[2 * a] * ux[a];
-        gxy += g[2 * a] * uy[a];
-        gyx += g[2 * a + 1] * ux[a];
-        gyy += g[2 * a + 1] * uy[a];
+        ux[a] = u[2 * cn[a]];
+        uy[a] = u[2 * cn[a] + 1];
       }
-      double* xi = P.xi.data() + 4 * k;
-      const double* cx = P.cx.data() + 3 * k;
-      const double* cy = P.cy.data() + 3 * k;
-      const double pxx = xi[0] + cx[2] * gxx, pxy = xi[1] + cx[2] * gxy;
-      const double pyx = xi[2] + cy[2] * gyx, pyy = xi[3] + cy[2] * gyy;
-      xi[0] = cx[0] * pxx + cx[1] * gxx;
-      xi[1] = cx[0] * pxy + cx[1] * gxy;
-      xi[2] = cy[0] * pyx + cy[1] * gyx;
-      xi[3] = cy[0] * pyy + cy[1] * gyy;
-      const double kx = (P.dy[k] - P.dx[k]) * P.jxw[k];  // and -kx for the y part
-      const double sxx = kx * L * pxx, sxy = kx * mu * pxy, syx = -kx * mu * pyx, syy = -kx * L * pyy;
+      for (int q = 0; q < nq; ++q) {
+        const std::size_t k = c * nq + q;
+        const double* g = gs + 2 * q * nb;
+        double gxx = 0, gxy = 0, gyx = 0, gyy = 0;  // du_x/dx, du_y/dx, du_x/dy, du_y/dy
+        for (int a = 0; a < nb; ++a) {
+          gxx += g[2 * a] * ux[a];
+          gxy += g[2 * a] * uy[a];
+          gyx += g[2 * a + 1] * ux[a];
+          gyy += g[2 * a + 1] * uy[a];
+        }
+        double* xi = P.xi.data() + 4 * k;
+        const double* cx = P.cx.data() + 3 * k;
+        const double* cy = P.cy.data() + 3 * k;
+        const double pxx = xi[0] + cx[2] * gxx, pxy = xi[1] + cx[2] * gxy;
+        const double pyx = xi[2] + cy[2] * gyx, pyy = xi[3] + cy[2] * gyy;
+        xi[0] = cx[0] * pxx + cx[1] * gxx;
+        xi[1] = cx[0] * pxy + cx[1] * gxy;
+        xi[2] = cy[0] * pyx + cy[1] * gyx;
+        xi[3] = cy[0] * pyy + cy[1] * gyy;
+        // The x part carries d_y - d_x, the y part d_x - d_y.
+        const double sxx = P.kl[k] * pxx, sxy = P.km[k] * pxy, syx = -P.km[k] * pyx, syy = -P.kl[k] * pyy;
+        for (int a = 0; a < nb; ++a) {
+          fx[a] -= sxx * g[2 * a] + syx * g[2 * a + 1];
+          fy[a] -= sxy * g[2 * a] + syy * g[2 * a + 1];
+        }
+      }
       for (int a = 0; a < nb; ++a) {
-        fx[a] -= sxx * g[2 * a] + syx * g[2 * a + 1];
-        fy[a] -= sxy * g[2 * a] + syy * g[2 * a + 1];
+        f[2 * dn[cn[a]]] += fx[a];
+        f[2 * dn[cn[a]] + 1] += fy[a];
       }
-    }
-    for (int a = 0; a < nb; ++a) {
-      f[2 * dn[cn[a]]] += fx[a];
-      f[2 * dn[cn[a]] + 1] += fy[a];
     }
   }
   for (std::size_t j = 0; j < P.node.size(); ++j) {

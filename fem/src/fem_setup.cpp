@@ -265,15 +265,27 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
   std::vector<types::global_dof_index> ld(dpc);
   P.nb = static_cast<int>(dpc / 2);
   P.nq = static_cast<int>(q.size());
+  // Each layer cell: its nodes, its shape (cells of the same geometry share one table of shape
+  // gradients, as they share their stiffness), and per quadrature point the weights
+  // (d_y - d_x) JxW (lambda + 2 mu) and (d_y - d_x) JxW mu and d_x, d_y.
+  struct Cell {
+    std::vector<std::uint32_t> nodes;
+    std::uint32_t shape;
+    std::vector<double> kl, km, dx, dy;
+  };
+  std::vector<Cell> cells;
+  std::map<std::vector<long long>, std::uint32_t> shapes;
   std::set<std::uint32_t> touched;
   for (const auto& cell : d.dofh.active_cell_iterators()) {
     fv.reinit(cell);
-    std::vector<double> dx(q.size()), dy(q.size());
+    Cell c;
+    c.dx.resize(q.size());
+    c.dy.resize(q.size());
     bool inside = false;
     for (unsigned k = 0; k < q.size(); ++k) {
       const auto p = fv.quadrature_point(k);
-      dxy(p[0], p[1], dx[k], dy[k]);
-      inside = inside || dx[k] > 0 || dy[k] > 0;
+      dxy(p[0], p[1], c.dx[k], c.dy[k]);
+      inside = inside || c.dx[k] > 0 || c.dy[k] > 0;
     }
     if (!inside) continue;
     const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
@@ -282,24 +294,57 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
     for (unsigned i = 0; i < dpc; ++i)
       if (fe.system_to_component_index(i).first == 0) comp0.push_back(i);
     for (unsigned i : comp0) {
-      const auto node = static_cast<std::uint32_t>(ld[i] / 2);
-      P.cell_nodes.push_back(node);
-      touched.insert(node);
+      c.nodes.push_back(static_cast<std::uint32_t>(ld[i] / 2));
+      touched.insert(c.nodes.back());
     }
+    const auto key = cell_key(cell);
+    auto it = shapes.find(key);
+    if (it == shapes.end()) {
+      it = shapes.emplace(key, static_cast<std::uint32_t>(shapes.size())).first;
+      for (unsigned k = 0; k < q.size(); ++k)
+        for (unsigned i : comp0) {
+          const Tensor<1, 2> g = fv.shape_grad(i, k);
+          P.grad.push_back(g[0]);
+          P.grad.push_back(g[1]);
+        }
+    }
+    c.shape = it->second;
     for (unsigned k = 0; k < q.size(); ++k) {
-      for (unsigned i : comp0) {
-        const Tensor<1, 2> g = fv.shape_grad(i, k);
-        P.grad.push_back(g[0]);
-        P.grad.push_back(g[1]);
-      }
-      P.jxw.push_back(fv.JxW(k));
-      P.dx.push_back(dx[k]);
-      P.dy.push_back(dy[k]);
+      const double w = (c.dy[k] - c.dx[k]) * fv.JxW(k);
+      c.kl.push_back(w * (mat.lambda + 2 * mat.mu));
+      c.km.push_back(w * mat.mu);
     }
-    P.lam2mu.push_back(mat.lambda + 2 * mat.mu);
-    P.mu.push_back(mat.mu);
+    cells.push_back(std::move(c));
   }
-  P.xi.assign(4 * P.jxw.size(), 0.0);
+  // Colours: no two cells of one colour share a node, so each colour's cells add their forces
+  // in parallel (greedy, lowest colour free at all of a cell's nodes).
+  std::map<std::uint32_t, std::uint64_t> used;  // per node: the colours of its cells so far
+  std::vector<int> colour(cells.size());
+  int ncolours = 0;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    std::uint64_t busy = 0;
+    for (const auto n : cells[c].nodes) busy |= used[n];
+    int k = 0;
+    while (k < 63 && (busy >> k & 1)) ++k;
+    colour[c] = k;
+    ncolours = std::max(ncolours, k + 1);
+    for (const auto n : cells[c].nodes) used[n] |= std::uint64_t{1} << k;
+  }
+  P.colour_start.assign(1, 0);
+  for (int k = 0; k < ncolours; ++k) {
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      if (colour[c] != k) continue;
+      const Cell& e = cells[c];
+      P.cell_nodes.insert(P.cell_nodes.end(), e.nodes.begin(), e.nodes.end());
+      P.shape.push_back(e.shape);
+      P.kl.insert(P.kl.end(), e.kl.begin(), e.kl.end());
+      P.km.insert(P.km.end(), e.km.begin(), e.km.end());
+      P.dx.insert(P.dx.end(), e.dx.begin(), e.dx.end());
+      P.dy.insert(P.dy.end(), e.dy.begin(), e.dy.end());
+    }
+    P.colour_start.push_back(static_cast<std::uint32_t>(P.shape.size()));
+  }
+  P.xi.assign(4 * P.kl.size(), 0.0);
   double lam = 0;
   for (const std::uint32_t node : touched) {
     P.touched.push_back(node);

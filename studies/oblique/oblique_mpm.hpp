@@ -51,11 +51,14 @@ inline Result measure_mpm(const Setup& su) {
     for (std::size_t k = 0; k < p.size(); ++k) {
       const double px = p.x[k] - w.x0, py = p.y[k] - w.y0;
       const double sn = w.nx * px + w.ny * py, r = w.tx * px + w.ty * py;
-      const double e = w.envelope(r), g = G(sn), gp = dG(sn), ep = w.envelope_slope(r);
+      // The initial data cut off before the boundary (oblique.hpp): E times W(x).
+      const double wc = w.cut(p.x[k]), wcs = w.cut_slope(p.x[k]);
+      const double e = w.envelope(r) * wc, g = G(sn), gp = dG(sn), ep = w.envelope_slope(r) * wc;
       p.vx[k] = -c * w.dx * gp * e;
       p.vy[k] = -c * w.dy * gp * e;
-      // grad u = d (x) (n G' E + t G E')
-      const double ax = w.nx * gp * e + w.tx * g * ep, ay = w.ny * gp * e + w.ty * g * ep;
+      // grad u = d (x) (n G' E W + t G E' W + x G E W')
+      const double ax = w.nx * gp * e + w.tx * g * ep + g * w.envelope(r) * wcs;
+      const double ay = w.ny * gp * e + w.ty * g * ep;
       const double exx = w.dx * ax, eyy = w.dy * ay, gxy = w.dx * ay + w.dy * ax;
       const double tr = exx + eyy;
       p.sxx[k] = mat.lambda * tr + 2 * mat.mu * exx;
@@ -79,8 +82,10 @@ inline Result measure_mpm(const Setup& su) {
   {
     const double px = w.rx - w.x0, py = w.ry - w.y0;
     const double sn = w.nx * px + w.ny * py, r = w.tx * px + w.ty * py;
-    const double e = w.envelope(r), g = G(sn), gp = dG(sn), ep = w.envelope_slope(r);
-    const double ax = w.nx * gp * e + w.tx * g * ep, ay = w.ny * gp * e + w.ty * g * ep;
+    const double wc = w.cut(w.rx), wcs = w.cut_slope(w.rx);
+    const double e = w.envelope(r) * wc, g = G(sn), gp = dG(sn), ep = w.envelope_slope(r) * wc;
+    const double ax = w.nx * gp * e + w.tx * g * ep + g * w.envelope(r) * wcs;
+    const double ay = w.ny * gp * e + w.ty * g * ep;
     div0 = w.dx * ax + w.dy * ay;
     curl0 = w.dx * ay - w.dy * ax;
   }
