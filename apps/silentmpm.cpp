@@ -1,6 +1,7 @@
 // silentmpm: command-line entry point. A thin shell over the driver.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -12,6 +13,74 @@
 #include "silentmpm/case.hpp"
 #include "silentmpm/driver.hpp"
 #include "silentmpm/history.hpp"
+
+namespace {
+
+// silentmpm compare: the relative L2 difference of one or more history columns (see its --help).
+int compare(const std::string& a_csv, const std::string& b_csv, std::vector<std::string> columns,
+            bool all, double t0, double t1, double n0, double n1, bool json) {
+  if (columns.empty() && !all)
+    throw std::runtime_error("compare: give --column (one or more) or --all");
+  if (!columns.empty() && all) throw std::runtime_error("compare: give either --column or --all");
+  if (!(t1 > t0))
+    throw std::runtime_error("compare: the window [--from, --to] is empty (" + std::to_string(t0) +
+                             " to " + std::to_string(t1) + ")");
+  if (std::isnan(n0)) n0 = t0;
+  if (std::isnan(n1)) n1 = t1;
+  if (!(n1 > n0)) throw std::runtime_error("compare: the norm window [--norm-from, --norm-to] is empty");
+  const auto a = smpm::read_history(a_csv);
+  const auto b = smpm::read_history(b_csv);
+  if (all)
+    for (const auto& c : a.columns)
+      if (std::find(b.columns.begin(), b.columns.end(), c) != b.columns.end()) columns.push_back(c);
+  if (columns.empty()) throw std::runtime_error("compare: " + a_csv + " and " + b_csv + " share no column");
+  // With --all a column that cannot be compared (a reference that is zero over the window, such
+  // as the dissipated energy of an elastic run) is reported as such; a named one is an error.
+  std::vector<smpm::Difference> d(columns.size());
+  std::vector<std::string> why(columns.size());
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    try {
+      d[k] = smpm::difference(a, b, columns[k], t0, t1, n0, n1);
+    } catch (const std::runtime_error& e) {
+      if (!all) throw;
+      why[k] = e.what();
+    }
+  }
+  if (json) {
+    nlohmann::ordered_json j;
+    j["a"] = a_csv;
+    j["b"] = b_csv;
+    j["window"] = {t0, t1};
+    j["norm_window"] = {n0, n1};
+    j["interpolation"] = "b linear in time at a's rows; rows outside b's time span are left out";
+    j["columns"] = nlohmann::ordered_json::object();
+    for (std::size_t k = 0; k < columns.size(); ++k)
+      j["columns"][columns[k]] =
+          why[k].empty() ? nlohmann::ordered_json{{"relative", d[k].relative},
+                                                  {"absolute", d[k].absolute},
+                                                  {"reference", d[k].reference},
+                                                  {"samples", d[k].samples},
+                                                  {"norm_samples", d[k].norm_samples}}
+                         : nlohmann::ordered_json{{"error", why[k]}};
+    std::printf("%s\n", j.dump(2).c_str());
+  } else if (columns.size() == 1) {
+    std::printf("%.6e\n", d[0].relative);
+  } else {
+    std::size_t w = 6;
+    for (const auto& c : columns) w = std::max(w, c.size());
+    std::printf("%-*s  %12s  %12s  %12s  %7s\n", static_cast<int>(w), "column", "relative",
+                "absolute", "reference", "samples");
+    for (std::size_t k = 0; k < columns.size(); ++k)
+      if (why[k].empty())
+        std::printf("%-*s  %12.6e  %12.6e  %12.6e  %7zu\n", static_cast<int>(w), columns[k].c_str(),
+                    d[k].relative, d[k].absolute, d[k].reference, d[k].samples);
+      else
+        std::printf("%-*s  %12s  (%s)\n", static_cast<int>(w), columns[k].c_str(), "-", why[k].c_str());
+  }
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -60,15 +129,26 @@ int main(int argc, char** argv) {
   check->add_option("case", case_path, "Case file (JSON)")->required();
   check->add_option("--set", overrides, "Override a case key (as for run)");
 
-  std::string a_csv, b_csv, column;
-  double t0 = 0, t1 = 1e300;
-  auto* cmp = app.add_subcommand("compare", "Relative L2 difference ||a - b|| / ||b|| of one "
-                                            "history column over a time window");
+  std::string a_csv, b_csv;
+  std::vector<std::string> columns;
+  double t0 = 0, t1 = 1e300, n0 = std::nan(""), n1 = std::nan("");
+  bool cmp_all = false, cmp_json = false;
+  auto* cmp = app.add_subcommand(
+      "compare", "Relative L2 difference ||a - b|| / ||b|| of history columns over a time window "
+                 "(b interpolated linearly at a's times, never extrapolated)");
   cmp->add_option("a", a_csv, "history.csv of the run to test")->required();
   cmp->add_option("b", b_csv, "history.csv of the reference run")->required();
-  cmp->add_option("--column,-c", column, "Column, e.g. A.sxx")->required();
+  cmp->add_option("--column,-c", columns, "Column, e.g. A.sxx (repeatable, or a comma-separated list)")
+      ->delimiter(',');
+  cmp->add_flag("--all", cmp_all, "Every column the two files share");
   cmp->add_option("--from", t0, "Window start (s)");
   cmp->add_option("--to", t1, "Window end (s)");
+  cmp->add_option("--norm-from", n0, "Start of the window ||b|| is taken over (default: --from)");
+  cmp->add_option("--norm-to", n1, "End of the window ||b|| is taken over (default: --to)");
+  cmp->add_flag("--json", cmp_json, "Print the result as JSON");
+  cmp->footer("One column prints the bare number; several print a table (column, relative, "
+              "absolute ||a - b||, reference ||b||, samples); --json prints every figure with the "
+              "files, windows and the interpolation used.");
 
   // Command-line errors exit 1, as bad case files do (CLI11's own codes are 100 and more).
   if (argc > 1 && argv[1][0] != '-') {
@@ -95,12 +175,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   try {
-    if (*cmp) {
-      const auto a = smpm::read_history(a_csv);
-      const auto b = smpm::read_history(b_csv);
-      std::printf("%.6e\n", smpm::relative_l2(a, b, column, t0, t1));
-      return 0;
-    }
+    if (*cmp) return compare(a_csv, b_csv, columns, cmp_all, t0, t1, n0, n1, cmp_json);
     // The command line's own settings: a section the case leaves out is created with the key
     // (overrides given with --set must name existing sections, so typos are caught).
     std::vector<std::string> cli;  // in order; prepended to the --set overrides below

@@ -51,13 +51,15 @@ const std::vector<double>& History::column(const std::string& name) const {
     if (columns[c] == name) return data[c];
   std::string have;
   for (const auto& c : columns) have += (have.empty() ? "" : ", ") + c;
-  throw std::runtime_error("history has no column '" + name + "' (columns: " + have + ")");
+  throw std::runtime_error((path.empty() ? std::string("history") : path) + ": no column '" + name +
+                           "' (columns: " + have + ")");
 }
 
 History read_history(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open history file '" + path + "'");
   History h;
+  h.path = path;
   std::string line;
   long lineno = 0;
   bool have_header = false;
@@ -102,23 +104,20 @@ History read_history(const std::string& path) {
   return h;
 }
 
-double relative_l2(const History& a, const History& b, const std::string& col, double t0,
-                   double t1) {
-  const std::vector<double>& ya = a.column(col);
-  const std::vector<double>& yb = b.column(col);
-  const std::vector<double>& tb = b.time;
-  if (ya.size() != a.time.size() || yb.size() != tb.size())
-    throw std::runtime_error("relative_l2: column '" + col + "' and time have different lengths");
-  if (tb.empty()) throw std::runtime_error("relative_l2: reference history has no rows");
-  for (std::size_t k = 1; k < tb.size(); ++k)
-    if (!(tb[k] >= tb[k - 1]))
-      throw std::runtime_error("relative_l2: reference history times are not increasing");
+namespace {
 
-  // Rows of a in [t0, t1] that also lie inside b's time span (b is interpolated, never
-  // extrapolated).
+// Sum over a's rows with t in [t0, t1] inside b's span of (a - b)^2 and b^2, b interpolated.
+struct Sums {
+  double diff2 = 0, ref2 = 0;
+  std::size_t n = 0;
+};
+
+Sums sums(const History& a, const History& b, const std::vector<double>& ya,
+          const std::vector<double>& yb, double t0, double t1) {
+  const std::vector<double>& tb = b.time;
   const double lo = std::max(t0, tb.front()), hi = std::min(t1, tb.back());
-  double num = 0.0, den = 0.0;
-  std::size_t used = 0, j = 0;  // j: segment [tb[j], tb[j+1]] of b; a's times are usually sorted
+  Sums s;
+  std::size_t j = 0;  // segment [tb[j], tb[j+1]] of b; a's times are usually sorted
   for (std::size_t i = 0; i < a.time.size(); ++i) {
     const double t = a.time[i];
     if (!(t >= lo && t <= hi)) continue;
@@ -133,20 +132,53 @@ double relative_l2(const History& a, const History& b, const std::string& col, d
       vb = (1.0 - w) * yb[j] + w * yb[j + 1];
     }
     const double d = ya[i] - vb;
-    num += d * d;
-    den += vb * vb;
-    ++used;
+    s.diff2 += d * d;
+    s.ref2 += vb * vb;
+    ++s.n;
   }
-  if (used == 0) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "' in the window [%g, %g] within the reference's span [%g, %g]",
-                  t0, t1, tb.front(), tb.back());
-    throw std::runtime_error("relative_l2: no samples of column '" + col + buf);
-  }
-  if (!(den > 0.0))
-    throw std::runtime_error("relative_l2: reference column '" + col +
-                             "' is zero over the window, the relative error is undefined");
-  return std::sqrt(num / den);
+  return s;
+}
+
+std::string name_of(const History& h) { return h.path.empty() ? std::string("history") : h.path; }
+
+}  // namespace
+
+Difference difference(const History& a, const History& b, const std::string& col, double t0,
+                      double t1, double n0, double n1) {
+  const std::vector<double>& ya = a.column(col);
+  const std::vector<double>& yb = b.column(col);
+  const std::vector<double>& tb = b.time;
+  if (ya.size() != a.time.size() || yb.size() != tb.size())
+    throw std::runtime_error("column '" + col + "' and time have different lengths");
+  if (tb.empty()) throw std::runtime_error(name_of(b) + ": the reference history has no rows");
+  for (std::size_t k = 1; k < tb.size(); ++k)
+    if (!(tb[k] >= tb[k - 1]))
+      throw std::runtime_error(name_of(b) + ": the reference history's times are not increasing");
+  auto none = [&](const char* what, double w0, double w1) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "' of %s in the %s [%g, %g] within the reference's span [%g, %g]",
+                  name_of(a).c_str(), what, w0, w1, tb.front(), tb.back());
+    return std::runtime_error("no samples of column '" + col + buf);
+  };
+  const Sums d = sums(a, b, ya, yb, t0, t1);
+  if (d.n == 0) throw none("window", t0, t1);
+  const Sums r = n0 == t0 && n1 == t1 ? d : sums(a, b, ya, yb, n0, n1);
+  if (r.n == 0) throw none("norm window", n0, n1);
+  if (!(r.ref2 > 0.0))
+    throw std::runtime_error(name_of(b) + ": column '" + col +
+                             "' is zero over the norm window, the relative error is undefined");
+  Difference out;
+  out.absolute = std::sqrt(d.diff2);
+  out.reference = std::sqrt(r.ref2);
+  out.relative = std::sqrt(d.diff2 / r.ref2);
+  out.samples = d.n;
+  out.norm_samples = r.n;
+  return out;
+}
+
+double relative_l2(const History& a, const History& b, const std::string& col, double t0,
+                   double t1) {
+  return difference(a, b, col, t0, t1, t0, t1).relative;
 }
 
 }  // namespace smpm

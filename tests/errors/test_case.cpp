@@ -387,3 +387,46 @@ TEST(CaseCliFaults, DiskFullWritingSummary) {
 }
 
 }  // namespace
+
+// silentmpm compare: one column prints the bare number, several a table, --json every figure;
+// errors name the file (exit 1).
+TEST(CompareCli, ColumnsTableJsonAndErrors) {
+  if (!have_cli()) GTEST_SKIP() << "CLI not built";
+  const fs::path a = scratch() / "cmp_a.csv", b = scratch() / "cmp_b.csv";
+  {
+    std::ofstream fa(a), fb(b);
+    fa << "time,A.sxx,A.vx\n";
+    fb << "time,A.sxx,A.vx\n";
+    for (int k = 0; k <= 100; ++k) {
+      const double t = 0.01 * k;
+      fa << t << "," << 1.0 * t << "," << 2.0 * t << "\n";
+      fb << t << "," << 1.0 * t << "," << 2.5 * t << "\n";
+    }
+  }
+  const std::string files = "\"" + a.string() + "\" \"" + b.string() + "\"";
+  CliResult r = run_cli("compare " + files + " -c A.vx", "cmp_one");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(std::stod(r.out), 0.2, 1e-12);  // |2 - 2.5| / 2.5
+  r = run_cli("compare " + files + " --all", "cmp_all");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("column"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("A.sxx   0.000000e+00"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("A.vx    2.000000e-01"), std::string::npos) << r.out;
+  r = run_cli("compare " + files + " -c A.sxx,A.vx --json --from 0 --to 0.5 --norm-to 1", "cmp_json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  // ||a - b|| over [0, 0.5] / ||b|| over [0, 1]: 0.5 sqrt(sum_{k<=50} t^2 / sum_{k<=100} t^2).
+  double s50 = 0, s100 = 0;
+  for (int k = 0; k <= 100; ++k) (k <= 50 ? s50 : s100) += 1e-4 * k * k;
+  s100 += s50;
+  EXPECT_NEAR(j["columns"]["A.vx"]["relative"].get<double>(), 0.2 * std::sqrt(s50 / s100), 1e-9);
+  EXPECT_EQ(j["columns"]["A.vx"]["samples"].get<int>(), 51);
+  EXPECT_EQ(j["columns"]["A.vx"]["norm_samples"].get<int>(), 101);
+  EXPECT_EQ(j["b"].get<std::string>(), b.string());
+  r = run_cli("compare " + files + " -c A.vy", "cmp_missing");
+  EXPECT_EQ(WEXITSTATUS(r.status), 1);
+  EXPECT_NE(r.err.find(a.string() + ": no column 'A.vy' (columns: A.sxx, A.vx)"), std::string::npos) << r.err;
+  r = run_cli("compare " + files, "cmp_none");
+  EXPECT_EQ(WEXITSTATUS(r.status), 1);
+  EXPECT_NE(r.err.find("give --column (one or more) or --all"), std::string::npos) << r.err;
+}

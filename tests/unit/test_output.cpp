@@ -199,6 +199,37 @@ TEST(HistoryRelativeL2, ClosedForms) {
   EXPECT_THROW(relative_l2(a, b, "A.vx", 0.0, 10.0), std::runtime_error);
 }
 
+// The norm taken over its own window: a = sin t, b = 1.1 sin t. Over [0, pi] the difference is
+// 0.1 sin t; normalised by ||b|| over [0, 2 pi] (twice the samples of the same square) the ratio is
+// (0.1 / 1.1) / sqrt(2).
+TEST(HistoryRelativeL2, NormWindowApart) {
+  const History a = sampled(1.0, 0.001, 7.0);
+  const History b = sampled(1.1, 0.001, 7.0);
+  const double pi = std::acos(-1.0);
+  const Difference d = difference(a, b, "A.sxx", 0.0, pi, 0.0, 2 * pi);
+  EXPECT_NEAR(d.relative, 0.1 / 1.1 / std::sqrt(2.0), 1e-3);
+  EXPECT_NEAR(d.norm_samples, 2.0 * d.samples, 2.0);
+  EXPECT_NEAR(d.absolute / d.reference, d.relative, 1e-15);
+  // The same window: relative_l2 exactly.
+  EXPECT_EQ(difference(a, b, "A.sxx", 0.0, pi, 0.0, pi).relative, relative_l2(a, b, "A.sxx", 0.0, pi));
+  // A norm window outside b's span names the file and the window.
+  History named = b;
+  named.path = "ref/history.csv";
+  try {
+    difference(a, named, "A.sxx", 0.0, 1.0, 20.0, 30.0);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("norm window [20, 30]"), std::string::npos) << e.what();
+  }
+  try {
+    named.column("A.vx");
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("ref/history.csv: no column 'A.vx' (columns: A.sxx)"),
+              std::string::npos) << e.what();
+  }
+}
+
 TEST(OutputSnapshot, WriteAndReadBack) {
   TempDir dir("snap");
   const std::size_t n = 7;

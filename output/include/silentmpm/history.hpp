@@ -7,6 +7,7 @@
 namespace smpm {
 
 struct History {
+  std::string path;                          // the file it was read from (for messages)
   std::vector<std::string> columns;          // without "time"
   std::vector<double> time;
   std::vector<std::vector<double>> data;     // data[column][row]
@@ -19,5 +20,17 @@ History read_history(const std::string& path);
 // interpolated linearly onto a's time samples.
 double relative_l2(const History& a, const History& b, const std::string& col, double t0,
                    double t1);
+
+// The same with the norm of the reference taken over its own window [n0, n1] (a's samples there,
+// b interpolated onto them): ||a - b||_[t0, t1] / ||b||_[n0, n1]. Samples are a's rows inside the
+// window and inside b's time span (b is interpolated linearly, never extrapolated).
+struct Difference {
+  double relative = 0;   // ||a - b|| / ||b||
+  double absolute = 0;   // ||a - b|| (root of the sum of squares over the samples)
+  double reference = 0;  // ||b|| over the norm's window
+  std::size_t samples = 0, norm_samples = 0;
+};
+Difference difference(const History& a, const History& b, const std::string& col, double t0,
+                      double t1, double n0, double n1);
 
 }  // namespace smpm
