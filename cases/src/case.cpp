@@ -397,11 +397,12 @@ Material parse_material(const Ctx& ctx, const std::string& name, const ojson& j)
 
 TimeFunction parse_time_function(Obj o) {
   const std::string shape =
-      o.choice("shape", {"constant", "step", "rectangular", "triangular", "sin2", "table"},
+      o.choice("shape", {"constant", "step", "rectangular", "triangular", "sin2", "half_sine", "table"},
                "constant");
   std::vector<std::string> keys = {"shape"};
   if (shape == "step") keys.insert(keys.end(), {"start", "ramp"});
-  if (shape == "rectangular" || shape == "triangular") keys.insert(keys.end(), {"start", "duration"});
+  if (shape == "rectangular" || shape == "triangular" || shape == "half_sine")
+    keys.insert(keys.end(), {"start", "duration"});
   if (shape == "sin2") keys.insert(keys.end(), {"start", "duration", "ramp"});
   if (shape == "table") keys.push_back("table");
   if ((shape == "constant" || shape == "table") && o.has("start"))
@@ -421,9 +422,10 @@ TimeFunction parse_time_function(Obj o) {
     f.ramp = o.num("ramp", 0.0);
     o.ge("ramp", f.ramp, 0);
   }
-  if (shape == "rectangular" || shape == "triangular" || shape == "sin2") {
+  if (shape == "rectangular" || shape == "triangular" || shape == "sin2" || shape == "half_sine") {
     f.kind = shape == "rectangular"  ? TimeFunction::Kind::Rectangular
              : shape == "triangular" ? TimeFunction::Kind::Triangular
+             : shape == "half_sine"  ? TimeFunction::Kind::HalfSine
                                      : TimeFunction::Kind::Sin2Pulse;
     f.duration = o.num("duration");
     o.gt("duration", f.duration, 0);

@@ -33,6 +33,9 @@ double TimeFunction::operator()(double t) const {
       if (s < 0 || s > duration) return 0;
       return std::min(sin2_ramp(s / ramp), sin2_ramp((duration - s) / ramp));
     }
+    case Kind::HalfSine:  // sin(pi s / duration) over one half period
+      if (s < 0 || s > duration) return 0;
+      return std::sin(M_PI * s / duration);
     case Kind::Table: {
       if (table.empty()) return 0;
       if (t <= table.front().first) return table.front().second;
@@ -60,6 +63,7 @@ std::string TimeFunction::describe() const {
     case Kind::Sin2Pulse:
       o << "sin^2-ramped pulse " << start << " s + " << duration << " s (ramps " << ramp << " s)";
       break;
+    case Kind::HalfSine: o << "half-sine pulse " << start << " s + " << duration << " s"; break;
     case Kind::Table: o << "table of " << table.size() << " points"; break;
   }
   return o.str();

@@ -130,6 +130,12 @@ std::vector<Bad> bad_cases() {
       {"rectangular_without_duration",
        [](ojson& j) { bnd(j, 1)["time"] = {{"shape", "rectangular"}}; },
        "boundaries[1].time.duration: missing required key"},
+      {"half_sine_with_ramp",
+       [](ojson& j) { bnd(j, 1)["time"] = {{"shape", "half_sine"}, {"duration", 1e-6}, {"ramp", 1e-7}}; },
+       "boundaries[1].time.ramp: unknown key for shape \"half_sine\""},
+      {"half_sine_zero_duration",
+       [](ojson& j) { bnd(j, 1)["time"] = {{"shape", "half_sine"}, {"duration", 0}}; },
+       "boundaries[1].time.duration: must be > 0"},
       {"table_not_increasing",
        [](ojson& j) {
          bnd(j, 1)["time"] = {{"shape", "table"}, {"table", {{0, 0}, {1e-7, 1}, {1e-7, 0}}}};
