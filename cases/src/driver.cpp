@@ -220,7 +220,7 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
 
     const auto t_start = Clock::now();
     double step_seconds = 0;
-    detail::Progress prog(c.output.progress, nsteps, region.progress_eta(), t_start, first);
+    detail::Progress prog(c.output.progress, nsteps, t_start, first);
     if (!resuming) {
       record();
       if (snap_every) region.write_snapshot(out_dir);
@@ -254,7 +254,7 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
         throw RunInterrupted(why.str());
       }
       if (checkpoint_due(n, t_before, region.time())) write_checkpoint(c, region, dir, hist);
-      prog.update(n);
+      prog.update(n, step_seconds);
     }
     hist.close();
     region.finish();

@@ -121,31 +121,23 @@ double probe_field(const fem::Sample& s, const std::string& f) {
   return probe_field(p, f);
 }
 
-Progress::Progress(bool on, long total, bool eta, Clock::time_point t0, long first)
-    : on_(on), total_(total), first_(first), eta_(eta), tty_(isatty(2)), t0_(t0) {}
+Progress::Progress(bool on, long total, Clock::time_point t0, long first)
+    : on_(on), total_(total), first_(first), tty_(isatty(2)), t0_(t0) {}
 
-void Progress::update(long step) {
+void Progress::update(long step, double step_seconds) {
   if (!on_) return;
   const double el = seconds_since(t0_);
   const bool last = step >= total_;
   const double every = tty_ ? 0.5 : 5.0;
-  if (eta_) {
-    if (el - last_ < every && !last) return;
-    if (el < 2.0 && !last) return;  // short runs stay quiet
-  } else if (!(el > 2.0 && (el - last_ >= every || last))) {
-    return;
-  }
+  if (el - last_ < every && !last) return;
+  if (el < 2.0 && !last) return;  // short runs stay quiet
   last_ = el;
-  const double rate = (step - first_) / std::max(el, 1e-9);
-  if (eta_) {
-    const double left = (total_ - step) / std::max(rate, 1e-9);
-    std::fprintf(stderr, "%s  %5.1f%%  step %ld/%ld  %.0f steps/s  %.1f s left%s",
-                 tty_ ? "\r" : "", 100.0 * step / total_, step, total_, rate, left,
-                 tty_ ? "   " : "\n");
-  } else {
-    std::fprintf(stderr, "%s  %5.1f%%  step %ld/%ld  %.0f steps/s%s", tty_ ? "\r" : "",
-                 100.0 * step / total_, step, total_, rate, tty_ ? "   " : "\n");
-  }
+  const double done = static_cast<double>(step - first_);
+  const double rate = done / std::max(step_seconds, 1e-9);
+  const double left = (total_ - step) * el / std::max(done, 1.0);
+  std::fprintf(stderr, "%s  %5.1f%%  step %ld/%ld  %.0f steps/s  %.1f s left%s",
+               tty_ ? "\r" : "", 100.0 * step / total_, step, total_, rate, left,
+               tty_ ? "   " : "\n");
   if (last && tty_) std::fprintf(stderr, "\n");
 }
 

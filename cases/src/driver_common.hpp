@@ -58,16 +58,19 @@ double probe_field(const fem::Sample& s, const std::string& f);
 // The progress line on stderr (a carriage-return line on a terminal, else a line every 5 s).
 // With eta, the MPM form: "... steps/s  N s left", and the last step is always reported; without,
 // the FEM / hybrid form: no estimate, and runs shorter than 2 s print nothing.
+// The progress line: percent, step, the stepping rate (steps over the time spent in the steps
+// alone, not in set-up or output) and the time left (the remaining steps at the pace of the run
+// so far, output included). Quiet for the first 2 s.
 class Progress {
  public:
   // `first`: the step the run starts from (a restart's checkpoint), so rates count this run's steps.
-  Progress(bool on, long total, bool eta, Clock::time_point t0 = Clock::now(), long first = 0);
-  void update(long step);
+  Progress(bool on, long total, Clock::time_point t0 = Clock::now(), long first = 0);
+  // step_seconds: the time spent in this run's steps so far.
+  void update(long step, double step_seconds);
 
  private:
   bool on_;
   long total_, first_;
-  bool eta_;
   bool tty_;
   Clock::time_point t0_;
   double last_ = 0;

@@ -18,7 +18,6 @@ class FemRegion final : public Region {
   double dt() const override { return s_.dt; }
   double time() const override { return s_.t; }
   double cfl() const override { return s_.dt / s_.critical_dt(); }
-  bool progress_eta() const override { return false; }
   const char* kind() const override { return "fem"; }
   int threads() const override { return s_.thread_count(); }
   long steps() const override { return s_.steps; }

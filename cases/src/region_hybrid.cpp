@@ -28,7 +28,6 @@ class HybridRegion final : public Region {
   double dt() const override { return hy_.dt(); }
   double time() const override { return s_.t; }
   double cfl() const override { return hy_.dt() / hy_.critical_dt(); }
-  bool progress_eta() const override { return false; }
   const char* kind() const override { return "hybrid"; }
   int threads() const override { return s_.thread_count(); }
   long steps() const override { return s_.steps; }

@@ -23,8 +23,6 @@ class Region {
   virtual double time() const = 0;  // the time of a history row
   // dt over the region's stability limit (summary.json "cfl").
   virtual double cfl() const = 0;
-  // The progress line's form (Progress: eta).
-  virtual bool progress_eta() const = 0;
   // Called once the output folder exists (removes stale files of the region's own outputs; on a
   // restart, resuming, only those written after the checkpoint).
   virtual void prepare(const std::string& /*out_dir*/, bool /*resuming*/) {}

@@ -94,3 +94,36 @@ TEST(FemCase, RunsThroughTheDriver) {
     EXPECT_NE(x.find(std::string("Name=\"") + field + "\""), std::string::npos) << field;
   fs::remove_all(out);
 }
+
+// The progress line's rate counts the steps alone: with a snapshot every 2 steps, most of the run
+// is output, and the line still shows steps / step_seconds (summary.json), well above
+// steps / wall_seconds; it also gives the time left.
+TEST(FemCase, ProgressRateIsTheSteppingRate) {
+  const double h = 1e-3;
+  json c = json::parse(R"({
+    "time": {"end": 1.6e-5, "cfl": 0.5},
+    "materials": {"tungsten": {"model": "elastic", "young": 411e9, "poisson": 0.28, "density": 15000}},
+    "fem": {"mesh": "", "size": 0.001, "regions": {"1": "tungsten"},
+            "boundaries": [{"type": "traction", "curve": "left", "normal": -50e6}]},
+    "output": {"snapshots": 60, "progress": true}
+  })");
+  c["fem"]["mesh"] = rectangle_geo("progress_column", 120 * h, 2 * h, h);
+  Case k = build_case(c, "progress.json");
+  const fs::path out = temp_dir() / "fem_progress_run";
+  fs::remove_all(out);
+  testing::internal::CaptureStderr();
+  const RunResult r = run_case(k, out.string());
+  const std::string err = testing::internal::GetCapturedStderr();
+  const std::size_t at = err.rfind(" steps/s");
+  ASSERT_NE(at, std::string::npos) << err;
+  const std::size_t from = err.rfind(' ', at - 1);
+  const double shown = std::stod(err.substr(from + 1, at - from - 1));
+  std::ifstream sf(out / "summary.json");
+  const json s = json::parse(sf);
+  const double stepping = r.steps / s["step_seconds"].get<double>();
+  const double overall = r.steps / s["wall_seconds"].get<double>();
+  std::printf("  shown %.0f steps/s, stepping %.0f, overall %.0f\n", shown, stepping, overall);
+  EXPECT_NEAR(shown, stepping, 0.01 * stepping + 1);
+  EXPECT_GT(stepping, 1.5 * overall);
+  EXPECT_NE(err.find("s left"), std::string::npos) << err;
+}
