@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
   std::string shape;
   run->add_option("--shape", shape, "Grid shape functions: bilinear, gimp or bspline (default: "
                                     "the case's scheme.shape)");
-  run->add_flag("--quiet,-q", quiet, "No progress line");
+  run->add_flag("--quiet,-q", quiet, "Print nothing but errors: no progress line, no completion line");
   std::string restart;
   run->add_option("--restart", restart, "Continue from a checkpoint (DIR/checkpoint.smpm) of this "
                                         "case, written by output.checkpoint_every/_time or an "

@@ -306,7 +306,8 @@ TEST(CaseCliValid, RunThreadsWithoutSchemeOrOutputSection) {
   ASSERT_EQ(r.status, 0) << "stderr:\n" << r.err;
   const std::string summary = read_file(out / "summary.json");
   EXPECT_NE(summary.find("\"threads\": 1"), std::string::npos) << summary;
-  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
+  EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet: nothing but errors
+  EXPECT_TRUE(r.err.empty()) << r.err;
   // --shape together with --threads on the same missing section: both are set.
   const fs::path out2 = scratch() / "no_scheme_cli_shape_out";
   const CliResult r2 = run_cli("run \"" + file.string() + "\" --out \"" + out2.string() +
