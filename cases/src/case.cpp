@@ -1112,12 +1112,7 @@ class Builder {
     if (fs::path(file).is_relative()) file = (fs::path(ctx_.source).parent_path() / file).string();
     const double size = o.num("size", 0.5 * grid_.h);
     o.gt("size", size, 0);
-    std::vector<std::pair<std::string, double>> params;
-    if (const ojson* p = o.find("parameters")) {
-      if (!p->is_object()) o.fail("parameters", "expected an object {name: number}, got " + a_type(*p));
-      for (const auto& item : p->items())
-        params.emplace_back(item.key(), as_number(ctx_, item.value(), o.at("parameters") + "." + item.key()));
-    }
+    const auto params = read_geo_parameters(o);
     o.done();
     try {
       geo_ = std::make_unique<Geometry>(checking_ ? load_geometry_groups(file, size, params)

@@ -144,7 +144,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
 
   // fem
   Obj f = top.obj("fem");
-  f.allow({"mesh", "size", "degree", "regions", "boundaries"});
+  f.allow({"mesh", "size", "parameters", "degree", "regions", "boundaries"});
   fem::Spec spec;
   spec.threads = threads;
   const std::string mesh_file = resolve_path(source, f.str("mesh"));
@@ -153,6 +153,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
     size = f.num("size");
     f.gt("size", size, 0);
   }
+  const auto parameters = read_geo_parameters(f);
   const long degree = f.integer("degree", 1);
   if (degree != 1 && degree != 2) f.fail("degree", "must be 1 or 2, got " + std::to_string(degree));
   spec.degree = static_cast<int>(degree);
@@ -315,7 +316,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   // probes: the same (read below, placed once the solver exists).
   if (const ojson* p = top.find("probes")) read_probes(*p, nullptr);
   try {
-    spec.mesh = fem::load_mesh(mesh_file, size, load_limits().mesh_cells);
+    spec.mesh = fem::load_mesh(mesh_file, size, load_limits().mesh_cells, parameters);
   } catch (const fem::FemError& e) {
     f.fail(f.has("size") && std::string(e.what()).find("size") != std::string::npos ? "size" : "mesh",
            e.what());

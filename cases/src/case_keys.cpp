@@ -234,4 +234,23 @@ std::uint64_t case_fingerprint(const ojson& doc) {
   return fnv1a64(text.data(), text.size());
 }
 
+std::vector<std::pair<std::string, double>> read_geo_parameters(Obj& o) {
+  std::vector<std::pair<std::string, double>> out;
+  const ojson* p = o.find("parameters");
+  if (!p) return out;
+  if (!p->is_object())
+    o.fail("parameters", "expected an object {name: number}, got " + a_type(*p));
+  for (const auto& item : p->items()) {
+    const std::string& name = item.key();
+    const std::string path = o.at("parameters") + "." + name;
+    if (name.empty() || name == "h" ||
+        name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
+            std::string::npos)
+      o.ctx().fail(path, "a parameter name must be letters, digits and _ (and not h: the mesh "
+                         "size sets it)");
+    out.emplace_back(name, as_number(o.ctx(), item.value(), path));
+  }
+  return out;
+}
+
 }  // namespace smpm::detail

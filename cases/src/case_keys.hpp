@@ -120,4 +120,8 @@ void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots);
 // applied) except the keys a restart may change (output.*, time.end, scheme.threads).
 std::uint64_t case_fingerprint(const ojson& doc);
 
+// The "parameters" object of an Obj that names a gmsh .geo (geometry.parameters,
+// fem.parameters): {name: number}, names of letters, digits and _ (not h, which the size sets).
+std::vector<std::pair<std::string, double>> read_geo_parameters(Obj& o);
+
 }  // namespace smpm::detail

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -62,7 +63,8 @@ static int find_tag(const std::vector<PhysicalGroup>& gs, const std::string& s) 
 int Mesh::surface_tag(const std::string& s) const { return find_tag(surfaces, s); }
 int Mesh::curve_tag(const std::string& s) const { return find_tag(curves, s); }
 
-Mesh load_mesh(const std::string& file, double size, double max_cells) {
+Mesh load_mesh(const std::string& file, double size, double max_cells,
+               const std::vector<std::pair<std::string, double>>& parameters) {
   std::error_code ec;
   if (!fs::exists(file, ec)) throw FemError(file + ": mesh file not found");
   if (fs::is_directory(file, ec)) throw FemError(file + ": is a directory, not a mesh file");
@@ -73,12 +75,23 @@ Mesh load_mesh(const std::string& file, double size, double max_cells) {
   if (ext == ".msh" && size > 0)
     throw FemError(file + ": a mesh size applies to a .geo only (a .msh is already meshed)");
 
+  if (ext == ".msh" && !parameters.empty())
+    throw FemError(file + ": parameters apply to a .geo only (a .msh is already meshed)");
+
   Mesh m;
   m.file = file;
   m.size = size;
+  // The parameters go in through a wrapper .geo (gmsh_session.hpp); the size through ONELAB.
+  std::unique_ptr<GeoParameters> wrapper;
+  try {
+    wrapper = std::make_unique<GeoParameters>(file, 0.0, parameters);
+  } catch (const std::runtime_error& e) {
+    throw FemError(e.what());
+  }
+  const std::string opened = wrapper->path();
   GmshSession gs;
   auto fail = [&](const std::string& what) -> void { throw FemError(file + ": " + what); };
-  if (const std::string e = gs.call_error([&] { gmsh::open(file); }); !e.empty())
+  if (const std::string e = gs.call_error([&] { gmsh::open(opened); }); !e.empty())
     fail("gmsh cannot read it: " + e);
   if (ext == ".geo") {
     std::vector<double> hv;
@@ -90,7 +103,7 @@ Mesh load_mesh(const std::string& file, double size, double max_cells) {
              " cannot be applied");
       gmsh::onelab::setNumber(kSizeParameter, {size});
       // Parse again with the new size.
-      if (const std::string e = gs.call_error([&] { gmsh::open(file); }); !e.empty())
+      if (const std::string e = gs.call_error([&] { gmsh::open(opened); }); !e.empty())
         fail("gmsh cannot read it: " + e);
     }
     // Before meshing: a size that would make more cells than the run could hold is refused

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <unordered_map>
 
@@ -232,38 +233,16 @@ Geometry load(const std::string& file, double size,
     throw GeometryError(file + ": unsupported file type \"" + ext +
                         "\" (give a gmsh .geo or .msh file)");
 
-  // The numbers (h and the parameters) go in through a small wrapper .geo that assigns them and
-  // then includes the file; the file's DefineConstant keeps an already defined value. (gmsh's
-  // -setnumber is kept by gmsh across sessions of one process, so it would leak into later
-  // loads, fem/'s included.)
-  std::string preamble;
-  if (geo && size > 0) preamble += "h = " + fmt17(size) + ";\n";
-  for (const auto& [name, value] : parameters) {
-    if (!geo) throw GeometryError(file + ": parameters are only used by a .geo file");
-    if (name.empty() || name == "h" || name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos)
-      throw GeometryError(file + ": parameter name \"" + name + "\" must be letters, digits and _ (and not h: use size)");
-    preamble += name + " = " + fmt17(value) + ";\n";
+  // The numbers (h and the parameters) go in through a wrapper .geo (gmsh_session.hpp).
+  if (!geo && !parameters.empty())
+    throw GeometryError(file + ": parameters are only used by a .geo file");
+  std::unique_ptr<GeoParameters> wrapper;
+  try {
+    wrapper = std::make_unique<GeoParameters>(file, geo ? size : 0.0, parameters);
+  } catch (const std::runtime_error& e) {
+    throw GeometryError(e.what());
   }
-  std::string opened = file;
-  struct TempFile {
-    std::string path;
-    ~TempFile() {
-      std::error_code ec;
-      if (!path.empty()) fs::remove(path, ec);
-    }
-  } wrapper;
-  if (!preamble.empty()) {
-    static std::atomic<int> counter{0};
-    const fs::path abs = fs::absolute(file, ec);
-    wrapper.path = (fs::temp_directory_path(ec) /
-                    ("silentmpm_" + std::to_string(static_cast<long>(::getpid())) + "_" +
-                     std::to_string(++counter) + "_" + abs.filename().string()))
-                       .string();
-    std::ofstream w(wrapper.path);
-    w << preamble << "Include \"" << abs.string() << "\";\n";
-    if (!w) throw GeometryError(file + ": cannot write a temporary file " + wrapper.path);
-    opened = wrapper.path;
-  }
+  const std::string opened = wrapper->path();
   GmshSession session;
 
   gmsh_call(session, file, geo ? "read the geometry" : "read the mesh",

@@ -1,6 +1,10 @@
 #include "silentmpm/gmsh_session.hpp"
 
+#include <atomic>
 #include <cstdio>
+#include <fstream>
+#include <stdexcept>
+#include <unistd.h>
 #include <filesystem>
 
 #include <gmsh.h>
@@ -127,6 +131,47 @@ std::string gmsh_mesh_size_problem(double h, double max_cells) {
                 "%.3g are allowed: use a larger size",
                 h, cells, w, hh, max_cells);
   return b;
+}
+
+namespace {
+std::string fmt17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+}  // namespace
+
+GeoParameters::GeoParameters(const std::string& file, double h,
+                             const std::vector<std::pair<std::string, double>>& parameters)
+    : path_(file) {
+  namespace fs = std::filesystem;
+  std::string preamble;
+  if (h > 0) preamble += "h = " + fmt17(h) + ";\n";
+  for (const auto& [name, value] : parameters) {
+    if (name.empty() || name == "h" ||
+        name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
+            std::string::npos)
+      throw std::runtime_error(file + ": parameter name \"" + name +
+                               "\" must be letters, digits and _ (and not h: use size)");
+    preamble += name + " = " + fmt17(value) + ";\n";
+  }
+  if (preamble.empty()) return;
+  static std::atomic<int> counter{0};
+  std::error_code ec;
+  const fs::path abs = fs::absolute(file, ec);
+  wrapper_ = (fs::temp_directory_path(ec) /
+              ("silentmpm_" + std::to_string(static_cast<long>(::getpid())) + "_" +
+               std::to_string(++counter) + "_" + abs.filename().string()))
+                 .string();
+  std::ofstream w(wrapper_);
+  w << preamble << "Include \"" << abs.string() << "\";\n";
+  if (!w) throw std::runtime_error(file + ": cannot write a temporary file " + wrapper_);
+  path_ = wrapper_;
+}
+
+GeoParameters::~GeoParameters() {
+  std::error_code ec;
+  if (!wrapper_.empty()) std::filesystem::remove(wrapper_, ec);
 }
 
 }  // namespace smpm

@@ -275,3 +275,31 @@ TEST(FemErrors, ThroughTheCli) {
   const std::string good = write_file("good_fem_case.json", good_case().dump());
   EXPECT_EQ(std::system((std::string(SMPM_CLI) + " check " + good + " > /dev/null").c_str()), 0);
 }
+
+// fem.parameters set a .geo's other DefineConstant numbers (as geometry.parameters does for MPM):
+// a rectangle W wide meshed at h = 1 mm has 10 W / 0.01 cells along x.
+TEST(FemErrors, GeoParameters) {
+  const std::string geo = write_file("param_rect.geo",
+      "DefineConstant[ h = {0.001, Name \"Parameters/h\"} ];\n"
+      "DefineConstant[ W = {0.01, Name \"Parameters/W\"} ];\n"
+      "Point(1) = {0, 0, 0}; Point(2) = {W, 0, 0}; Point(3) = {W, 0.005, 0}; Point(4) = {0, 0.005, 0};\n"
+      "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
+      "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
+      "Transfinite Curve{1, 3} = Round(W / h) + 1; Transfinite Curve{2, 4} = Round(0.005 / h) + 1;\n"
+      "Transfinite Surface{1}; Recombine Surface{1};\n"
+      "Physical Surface(\"body\", 1) = {1};\n"
+      "Physical Curve(\"left\", 11) = {4}; Physical Curve(\"right\", 12) = {2};\n");
+  json c = base_case();
+  c["fem"]["mesh"] = geo;
+  c["fem"]["boundaries"] = {{{"type", "dashpot"}, {"curve", "right"}}};
+  c["probes"] = json::array();
+  EXPECT_EQ(build_case(c, "case.json").fem->cells(), 50u);
+  c["fem"]["parameters"] = {{"W", 0.02}};
+  EXPECT_EQ(build_case(c, "case.json").fem->cells(), 100u);
+  c["fem"]["parameters"] = {{"h", 0.002}};
+  EXPECT_ERROR(error_of(c), "case.json: fem.parameters.h", "not h");
+  c["fem"]["parameters"] = {{"W", "wide"}};
+  EXPECT_ERROR(error_of(c), "fem.parameters.W", "number");
+  c["fem"]["parameters"] = json::array();
+  EXPECT_ERROR(error_of(c), "fem.parameters", "expected an object");
+}

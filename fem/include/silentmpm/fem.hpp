@@ -25,6 +25,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "silentmpm/material.hpp"
@@ -62,8 +63,10 @@ struct Mesh {
 };
 
 // Reads or meshes `file` (".geo" or ".msh"); a .geo whose size would give more than max_cells
-// cells (estimated before meshing) is refused. Throws FemError naming the file.
-Mesh load_mesh(const std::string& file, double size, double max_cells = 1e7);
+// cells (estimated before meshing) is refused. `parameters` set other numbers of a .geo before it
+// is read (its DefineConstant keeps them). Throws FemError naming the file.
+Mesh load_mesh(const std::string& file, double size, double max_cells = 1e7,
+               const std::vector<std::pair<std::string, double>>& parameters = {});
 
 // ---- model -------------------------------------------------------------------------------------
 struct Boundary {

@@ -16,6 +16,8 @@
 #include <functional>
 #include <mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace smpm {
 
@@ -49,5 +51,25 @@ std::string gmsh_input_problem(const std::string& file);
 // the cells a mesh of size h would have, estimated from the model's bounding box as area / h^2,
 // must not exceed max_cells. The message gives the estimate and the box.
 std::string gmsh_mesh_size_problem(double h, double max_cells);
+
+// Numbers set in a .geo before it is read (a case's `parameters`, the mesh size h): a small
+// wrapper .geo in the temporary folder that assigns them and then includes the file, whose
+// DefineConstant keeps an already defined value. (gmsh's -setnumber is kept across sessions of
+// one process, so it would leak into later loads.) path() is the file to open: the wrapper, or
+// the file itself when there is nothing to set; the wrapper is removed with the object. Throws
+// std::runtime_error "<file>: ..." for a parameter name that is not letters, digits and _ (or is
+// h, which the mesh size sets) and when the wrapper cannot be written.
+class GeoParameters {
+ public:
+  GeoParameters(const std::string& file, double h,
+                const std::vector<std::pair<std::string, double>>& parameters);
+  ~GeoParameters();
+  GeoParameters(const GeoParameters&) = delete;
+  GeoParameters& operator=(const GeoParameters&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, wrapper_;
+};
 
 }  // namespace smpm
