@@ -965,17 +965,41 @@ class Builder {
   BoundaryLayer select_layer(Obj& o, const std::string& name, std::string& what) {
     const int bi = body_ref(o);
     const BodySpec& b = bodies_[bi];
+    if (o.has("interval") && (o.has("curve") || b.surface >= 0))
+      o.fail("interval", "is for a side of a box body (on a gmsh body, name a physical curve for "
+                         "the part to load)");
     if (o.has("curve") || b.surface >= 0) return curve_layer(o, bi, name, what);
     const std::string side = o.choice("side", kSides);
-    const Edge e = box_edge(b, side);
+    Edge e = box_edge(b, side);
     const double width = o.num("width", grid_.h);
     o.gt("width", width, 0);
     if (!(width <= e.extent * (1 + 1e-12)))
       o.fail("width", "must be <= the size of body \"" + b.name + "\" normal to its " + side +
                           " side (" + fmt(e.extent) + "), got " + fmt(width));
+    // traction "interval": [a, b], the part of the side between two coordinates along it (x on
+    // the top and bottom sides, y on the left and right).
+    std::string part;
+    if (o.has("interval")) {
+      const auto iv = o.nums("interval", 2);
+      const bool along_x = e.nx == 0;
+      const double lo = along_x ? b.x0 : b.y0, hi = along_x ? b.x1 : b.y1;
+      const double tol = 1e-9 * grid_.h;
+      if (!(iv[1] > iv[0]))
+        o.fail("interval", "must be [a, b] with a < b, got " + fmt_list(iv));
+      if (iv[0] < lo - tol || iv[1] > hi + tol)
+        o.fail("interval", fmt_list(iv) + " is not within the " + side + " side of body \"" +
+                               b.name + "\" (" + (along_x ? "x" : "y") + " from " + fmt(lo) +
+                               " to " + fmt(hi) + ")");
+      // The edge runs counter-clockwise around the box: keep its direction.
+      const double from = (along_x ? e.ex1 > e.ex0 : e.ey1 > e.ey0) ? iv[0] : iv[1];
+      const double to = from == iv[0] ? iv[1] : iv[0];
+      (along_x ? e.ex0 : e.ey0) = from;
+      (along_x ? e.ex1 : e.ey1) = to;
+      part = std::string(" over ") + (along_x ? "x" : "y") + " in " + fmt_list(iv);
+    }
     if (checking_) return {};  // no particles yet
     BoundaryLayer layer = s_->select_layer(name, bi, e.ex0, e.ey0, e.ex1, e.ey1, e.nx, e.ny, width);
-    what = side + " side of body \"" + b.name + "\", width " + fmt(width);
+    what = side + " side of body \"" + b.name + "\"" + part + ", width " + fmt(width);
     if (layer.ids.empty()) o.fail("", "selects no particle (" + what + ")");
     return layer;
   }
@@ -990,7 +1014,7 @@ class Builder {
       o.allow(keys, where);
     } else if (type == "traction") {
       o.allow({"type", "name", "body", "side", "curve", "width", "normal", "tangential", "vector",
-               "time", "anchor"},
+               "time", "anchor", "interval"},
               where);
     } else if (type == "damping_layer") {
       o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power"}, where);

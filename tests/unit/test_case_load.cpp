@@ -114,6 +114,29 @@ TEST(CaseLoad, KelvinVoigtBoundary) {
   EXPECT_NE(c.notes[1].find("delta 0.02 m"), std::string::npos) << c.notes[1];
 }
 
+// A traction on part of a side ("interval"): the layer's particles are those whose centres lie
+// in the interval, and their boundary weights sum to its length, so the load is t (b - a).
+TEST(CaseLoad, TractionOnAnInterval) {
+  const fs::path file = write_file("valid_iv.json", kValid);
+  const smpm::Case c = smpm::load_case(file.string(), {"boundaries.1.interval=[0.002, 0.0055]"});
+  const smpm::TractionLoad& t = c.solver->tractions.at(0);
+  const smpm::Solver& s = *c.solver;
+  EXPECT_NEAR(t.layer.length, 0.0035, 1e-15);
+  double wsum = 0;
+  for (std::size_t q = 0; q < t.layer.idx.size(); ++q) {
+    wsum += t.layer.w[q];
+    const double x = s.p.x[t.layer.idx[q]];
+    EXPECT_GE(x, 0.002);
+    EXPECT_LE(x, 0.0055);
+  }
+  EXPECT_NEAR(wsum, 0.0035, 1e-15);
+  // 4 particles per cell: x = 2.25, 2.75, ..., 5.25 mm, one row within 0.5 mm of the top.
+  EXPECT_EQ(t.layer.idx.size(), 7u);
+  bool noted = false;
+  for (const auto& n : c.notes) noted = noted || n.find("over x in [0.002, 0.0055]") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
 TEST(CaseLoad, Gravity) {
   const fs::path file = write_file("valid_g.json", kValid);
   const smpm::Case c = smpm::load_case(file.string(), {"gravity=[0.5, -9.81]"});
