@@ -1,6 +1,7 @@
 #include "case_keys.hpp"
 
 #include "silentmpm/case.hpp"
+#include "silentmpm/gmsh_session.hpp"
 #include "silentmpm/state_io.hpp"
 
 #include <algorithm>
@@ -243,9 +244,7 @@ std::vector<std::pair<std::string, double>> read_geo_parameters(Obj& o) {
   for (const auto& item : p->items()) {
     const std::string& name = item.key();
     const std::string path = o.at("parameters") + "." + name;
-    if (name.empty() || name == "h" ||
-        name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
-            std::string::npos)
+    if (!geo_parameter_name_ok(name))
       o.ctx().fail(path, "a parameter name must be letters, digits and _ (and not h: the mesh "
                          "size sets it)");
     out.emplace_back(name, as_number(o.ctx(), item.value(), path));

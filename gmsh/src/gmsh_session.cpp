@@ -141,6 +141,12 @@ std::string fmt17(double v) {
 }
 }  // namespace
 
+bool geo_parameter_name_ok(const std::string& name) {
+  return !name.empty() && name != "h" &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+             std::string::npos;
+}
+
 GeoParameters::GeoParameters(const std::string& file, double h,
                              const std::vector<std::pair<std::string, double>>& parameters)
     : path_(file) {
@@ -148,9 +154,7 @@ GeoParameters::GeoParameters(const std::string& file, double h,
   std::string preamble;
   if (h > 0) preamble += "h = " + fmt17(h) + ";\n";
   for (const auto& [name, value] : parameters) {
-    if (name.empty() || name == "h" ||
-        name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
-            std::string::npos)
+    if (!geo_parameter_name_ok(name))
       throw std::runtime_error(file + ": parameter name \"" + name +
                                "\" must be letters, digits and _ (and not h: use size)");
     preamble += name + " = " + fmt17(value) + ";\n";

@@ -59,6 +59,9 @@ std::string gmsh_mesh_size_problem(double h, double max_cells);
 // the file itself when there is nothing to set; the wrapper is removed with the object. Throws
 // std::runtime_error "<file>: ..." for a parameter name that is not letters, digits and _ (or is
 // h, which the mesh size sets) and when the wrapper cannot be written.
+// A name GeoParameters accepts: letters, digits and _, and not h.
+bool geo_parameter_name_ok(const std::string& name);
+
 class GeoParameters {
  public:
   GeoParameters(const std::string& file, double h,
