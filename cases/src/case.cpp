@@ -1006,7 +1006,7 @@ class Builder {
 
   void parse_boundary(Obj o, std::size_t i, Case& c) {
     const std::string type =
-        o.choice("type", {"fixed", "roller", "traction", "silent", "kelvin_voigt", "damping_layer"});
+        o.choice("type", {"fixed", "roller", "traction", "silent", "kelvin_voigt", "damping_layer", "pml"});
     const std::string where = "for a " + type + " boundary";
     if (type == "fixed" || type == "roller") {
       std::vector<std::string> keys = {"type", "name", "grid_side", "box", "body", "side", "curve"};
@@ -1018,6 +1018,8 @@ class Builder {
               where);
     } else if (type == "damping_layer") {
       o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power"}, where);
+    } else if (type == "pml") {
+      o.allow({"type", "name", "body", "side", "width", "r0", "power", "alpha"}, where);
     } else if (type == "silent") {
       o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor"},
               where);
@@ -1069,6 +1071,48 @@ class Builder {
                         std::to_string(t.layer.ids.size()) + " particles): " + amp + " x " +
                         t.fn.describe());
       s_->tractions.push_back(std::move(t));
+      return;
+    }
+
+    if (type == "pml") {
+      // A band inside a side of a box body: the stretching acts along the side's normal, which
+      // must be an axis (docs/physics.md section 9.3). Under MUSL and USF a shear wave in the
+      // layer grows slowly (measured; not understood yet): USL only.
+      if (s_->opt.scheme != Scheme::USL)
+        o.fail("type", "a pml on particles needs scheme.update \"USL\" (under MUSL and USF a "
+                       "shear wave entering the layer grows; see docs/physics.md section 9.3)");
+      PmlBand band;
+      band.name = name;
+      band.body = body_ref(o);
+      const BodySpec& b = bodies_[band.body];
+      if (b.surface >= 0)
+        o.fail("body", "body \"" + b.name + "\" comes from a gmsh surface: a pml is a band inside a "
+                       "side of a box body (an edge parallel to an axis)");
+      const std::string side = o.choice("side", kSides);
+      const Edge e = box_edge(b, side);
+      band.axis = e.nx != 0 ? 0 : 1;
+      band.side = (e.nx + e.ny) > 0 ? 1 : -1;
+      band.c = band.axis == 0 ? e.ex0 : e.ey0;
+      band.width = o.num("width");
+      o.gt("width", band.width, 0);
+      if (!(band.width <= e.extent * (1 + 1e-12)))
+        o.fail("width", "must be <= the size of body \"" + b.name + "\" normal to its " + side +
+                            " side (" + fmt(e.extent) + "), got " + fmt(band.width));
+      band.r0 = o.num("r0", 1e-3);
+      if (!(band.r0 > 0 && band.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(band.r0));
+      band.power = o.num("power", 2.0);
+      o.ge("power", band.power, 0);
+      band.alpha = o.num("alpha", 0.0);
+      o.ge("alpha", band.alpha, 0);
+      for (const PmlBand& other : s_->pml_bands)
+        if (other.alpha != band.alpha)
+          o.fail("alpha", "every pml must have the same alpha (\"" + other.name + "\" has " +
+                              fmt(other.alpha) + ", this one " + fmt(band.alpha) + ")");
+      o.done();
+      c.notes.push_back("pml \"" + name + "\" inside the " + side + " side of body \"" + b.name +
+                        "\": " + fmt(band.width) + " m, r0 " + fmt(band.r0) + ", power " +
+                        fmt(band.power) + ", alpha " + fmt(band.alpha) + " 1/s");
+      s_->pml_bands.push_back(std::move(band));
       return;
     }
 

@@ -169,6 +169,36 @@ void Solver::finalize() {
       dl.alpha[k] = a0 * std::pow(sdep, dl.power);
     }
   }
+  // Perfectly matched layers: every particle of a band's body inside it, with d_x and d_y summed
+  // over the bands (both at a corner) from its position at the start.
+  pml = PmlLayer{};
+  for (std::size_t k = 0; k < p.size() && !pml_bands.empty(); ++k) {
+    const Material& m = materials[p.group[k]];
+    double dx = 0, dy = 0;
+    for (const PmlBand& b : pml_bands) {
+      if (b.body != p.body[k]) continue;
+      const double pos = b.axis == 0 ? p.x[k] : p.y[k];
+      const double s = (pos - (b.c - b.side * b.width)) * b.side / b.width;  // 0 at the inner edge
+      if (!(s > 0)) continue;
+      const double d0 = -(b.power + 1) * m.cd * std::log(b.r0) / (2 * b.width);
+      (b.axis == 0 ? dx : dy) += d0 * std::pow(std::min(s, 1.0), b.power);
+    }
+    if (!(dx + dy > 0)) continue;
+    pml.layer.ids.push_back(p.id[k]);
+    pml.layer.idx.push_back(static_cast<uint32_t>(k));
+    pml.dx.push_back(dx);
+    pml.dy.push_back(dy);
+  }
+  if (pml.active()) {
+    const std::size_t n = pml.layer.ids.size();
+    pml.layer.name = "pml";
+    pml.alpha = pml_bands.front().alpha;
+    pml.H.assign(4 * n, 0.0);
+    pml.u.assign(2 * n, 0.0);
+    pml.xi.assign(4 * n, 0.0);
+    pml.zeta.assign(4 * n, 0.0);
+    pml.f.assign(6 * n, 0.0);
+  }
   sort_particles();
   update_energies();
   energy.initial = energy.kinetic + energy.elastic;
@@ -228,6 +258,7 @@ void Solver::sort_particles() {
     for (std::size_t k = 0; k < sl.layer.ids.size(); ++k) sl.layer.idx[k] = where_[sl.layer.ids[k]];
   for (auto& dl : dampers)
     for (std::size_t k = 0; k < dl.layer.ids.size(); ++k) dl.layer.idx[k] = where_[dl.layer.ids[k]];
+  for (std::size_t k = 0; k < pml.layer.ids.size(); ++k) pml.layer.idx[k] = where_[pml.layer.ids[k]];
   refresh_strip_rows();
   strips_ok_ = !strips_conflict();
   refresh_fields();
@@ -539,6 +570,88 @@ static inline void advance_spring(SilentBoundary& sl, std::size_t q, const S& sf
   sl.uy[q] += dt * dy;
 }
 
+// Perfectly matched layers on particles (docs/physics.md section 9.3; the FE far field's
+// formulation, with the particle in the role of the quadrature point). Each layer particle
+// accumulates its displacement u and gradient H from the grid velocity the scheme strains it with,
+// through the same shape functions (pml_advance). At the start of a step it loads the grid with
+// the stretched parts of its stress, V_p grad N . [(d_y - d_x) C_x psi_x + (d_x - d_y) C_y psi_y]
+// with psi_x, psi_y the convolutions of H's x and y rows with exp(-(alpha + d) t), and the mass
+// term m_p N (pml_mass_term), and puts m_p (d_x + d_y) N into the nodal dashpot blocks.
+template <class S>
+void Solver::pml_loads() {
+  PmlLayer& P = pml;
+  const std::size_t n = P.layer.idx.size();
+  if (P.dt_coef != dt) {
+    P.cx.resize(3 * n);
+    P.cy.resize(3 * n);
+    for (std::size_t q = 0; q < n; ++q) {
+      convolution_coefficients(P.alpha + P.dx[q], dt, P.cx[3 * q], P.cx[3 * q + 1], P.cx[3 * q + 2]);
+      convolution_coefficients(P.alpha + P.dy[q], dt, P.cy[3 * q], P.cy[3 * q + 1], P.cy[3 * q + 2]);
+    }
+    convolution_coefficients(P.alpha, dt, P.e_a, P.ca_a, P.cb_a);
+    P.dt_coef = dt;
+  }
+  // USF strains the particles with the start-of-step velocity, before the forces.
+  if (opt.scheme == Scheme::USF) pml_advance<S>(grid.vx, grid.vy);
+  S sf;
+  long nodes[S::kNodes];
+  has_nodal_dashpot_ = true;
+  for (std::size_t q = 0; q < n; ++q) {
+    const uint32_t k = P.layer.idx[q];
+    layer_shape(P.layer, q, Anchor::Particle, sf, nodes);
+    const Material& m = materials[p.group[k]];
+    const double L = m.lambda + 2 * m.mu, mu = m.mu;
+    const double* H = P.H.data() + 4 * q;
+    double* xi = P.xi.data() + 4 * q;
+    const double* cx = P.cx.data() + 3 * q;
+    const double* cy = P.cy.data() + 3 * q;
+    const double pxx = xi[0] + cx[2] * H[0], pxy = xi[1] + cx[2] * H[1];
+    const double pyx = xi[2] + cy[2] * H[2], pyy = xi[3] + cy[2] * H[3];
+    xi[0] = cx[0] * pxx + cx[1] * H[0];
+    xi[1] = cx[0] * pxy + cx[1] * H[1];
+    xi[2] = cy[0] * pyx + cy[1] * H[2];
+    xi[3] = cy[0] * pyy + cy[1] * H[3];
+    const double kx = (P.dy[q] - P.dx[q]) * p.vol[k];
+    double* f = P.f.data() + 6 * q;
+    f[0] = kx * L * pxx;
+    f[1] = kx * mu * pxy;
+    f[2] = -kx * mu * pyx;
+    f[3] = -kx * L * pyy;
+    const double sum = P.dx[q] + P.dy[q], prod = P.dx[q] * P.dy[q];
+    for (int c = 0; c < 2; ++c)
+      f[4 + c] = p.mass[k] * pml_mass_term(sum, prod, P.alpha, P.u[2 * q + c],
+                                           P.zeta.data() + 4 * q + 2 * c, P.e_a, P.ca_a, P.cb_a);
+    const double cm = sum * p.mass[k];
+    for (int a = 0; a < S::kNodes; ++a) {
+      grid.fx[nodes[a]] += f[4] * sf.N[a] - (f[0] * sf.dNx[a] + f[2] * sf.dNy[a]);
+      grid.fy[nodes[a]] += f[5] * sf.N[a] - (f[1] * sf.dNx[a] + f[3] * sf.dNy[a]);
+      grid.cxx[nodes[a]] += cm * sf.N[a];
+      grid.cyy[nodes[a]] += cm * sf.N[a];
+      dashpot_nodes_.push_back(nodes[a]);
+    }
+  }
+}
+
+template <class S>
+void Solver::pml_advance(const std::vector<double>& vx, const std::vector<double>& vy) {
+  S sf;
+  long nodes[S::kNodes];
+  for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
+    layer_shape(pml.layer, q, Anchor::Particle, sf, nodes);
+    double* H = pml.H.data() + 4 * q;
+    double* u = pml.u.data() + 2 * q;
+    for (int a = 0; a < S::kNodes; ++a) {
+      const double wx = vx[nodes[a]], wy = vy[nodes[a]];
+      H[0] += dt * sf.dNx[a] * wx;
+      H[1] += dt * sf.dNx[a] * wy;
+      H[2] += dt * sf.dNy[a] * wx;
+      H[3] += dt * sf.dNy[a] * wy;
+      u[0] += dt * sf.N[a] * wx;
+      u[1] += dt * sf.N[a] * wy;
+    }
+  }
+}
+
 // Tractions and silent-layer dashpots carried by boundary particles (Eq. 16, 20, 21).
 template <class S>
 void Solver::apply_loads() {
@@ -613,6 +726,7 @@ void Solver::apply_loads() {
       }
     }
   }
+  if (pml.active()) pml_loads<S>();
   std::sort(dashpot_nodes_.begin(), dashpot_nodes_.end());
   dashpot_nodes_.erase(std::unique(dashpot_nodes_.begin(), dashpot_nodes_.end()), dashpot_nodes_.end());
   // Gravity: f_i += m_i g, the nodal form of sum_p m_p g N_i (the lumped mass is sum_p m_p N_i).
@@ -729,6 +843,24 @@ void Solver::boundary_work(bool remapped) {
         energy.absorbed -= dt * L.w[q] * sf.N[a] * (tx * bx + ty * by);
       }
     }
+  }
+  // Perfectly matched layers: the damping force's power, and that of the explicit loads; then
+  // the particles' displacements advance (USF: in pml_loads).
+  if (pml.active()) {
+    for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
+      layer_shape(pml.layer, q, Anchor::Particle, sf, nodes);
+      const double* f = pml.f.data() + 6 * q;
+      const double cm = (pml.dx[q] + pml.dy[q]) * p.mass[pml.layer.idx[q]];
+      for (int a = 0; a < S::kNodes; ++a) {
+        double ax, ay, bx, by;
+        vbar(nodes[a], ax, ay);
+        wbar(nodes[a], bx, by);
+        const double fx = f[4] * sf.N[a] - (f[0] * sf.dNx[a] + f[2] * sf.dNy[a]);
+        const double fy = f[5] * sf.N[a] - (f[1] * sf.dNx[a] + f[3] * sf.dNy[a]);
+        energy.absorbed += dt * (cm * sf.N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
+      }
+    }
+    if (opt.scheme != Scheme::USF) pml_advance<S>(ux, uy);
   }
   // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i.
   for (const auto& dl : dampers) {

@@ -38,6 +38,12 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
     w.put(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux);
     w.put(pre + "silent" + std::to_string(k) + ".uy", silents[k].uy);
   }
+  if (pml.active()) {  // a perfectly matched layer's particles: displacements and memories
+    w.put(pre + "pml.H", pml.H);
+    w.put(pre + "pml.u", pml.u);
+    w.put(pre + "pml.xi", pml.xi);
+    w.put(pre + "pml.zeta", pml.zeta);
+  }
   // The particle order and the strips it was cut into (a re-sort happens only when the strips
   // conflict, so the order is part of the state: sums over particles follow it).
   w.put(pre + "strips", static_cast<std::int32_t>(nstrips_));
@@ -60,6 +66,13 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
     const std::size_t m = silents[k].layer.ids.size();
     r.get(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux, m);
     r.get(pre + "silent" + std::to_string(k) + ".uy", silents[k].uy, m);
+  }
+  if (pml.active()) {
+    const std::size_t m = pml.layer.ids.size();
+    r.get(pre + "pml.H", pml.H, 4 * m);
+    r.get(pre + "pml.u", pml.u, 2 * m);
+    r.get(pre + "pml.xi", pml.xi, 4 * m);
+    r.get(pre + "pml.zeta", pml.zeta, 4 * m);
   }
   const double dt_saved = r.get<double>(pre + "dt");
   if (dt_saved != dt)
@@ -89,6 +102,7 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
   for (auto& tl : tractions) reindex(tl.layer);
   for (auto& sl : silents) reindex(sl.layer);
   for (auto& dl : dampers) reindex(dl.layer);
+  reindex(pml.layer);
 
   const int saved_strips = r.get<std::int32_t>(pre + "strips");
   if (saved_strips != nstrips_) {

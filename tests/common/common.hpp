@@ -38,6 +38,8 @@ struct ColumnSpec {
   double gravity = 0;       // body force along +x (m/s^2), towards the right end
   int damp_cells = 0;       // a damping layer this many cells thick at the right end (r0, power 2)
   double damp_r0 = 1e-3;
+  int pml_cells = 0;        // a perfectly matched layer this many cells thick at the right end
+  double pml_alpha = 0;
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -74,6 +76,17 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
                                c.damp_cells * c.h);
     dl.r0 = c.damp_r0;
     s->dampers.push_back(dl);
+  }
+  if (c.pml_cells > 0) {
+    PmlBand band;
+    band.name = "pml";
+    band.body = 0;
+    band.axis = 0;
+    band.side = 1;
+    band.c = c.offset + L;
+    band.width = c.pml_cells * c.h;
+    band.alpha = c.pml_alpha;
+    s->pml_bands.push_back(band);
   }
   s->opt.scheme = c.scheme;
   s->opt.shape = c.shape;

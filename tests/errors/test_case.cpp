@@ -189,6 +189,40 @@ std::vector<Bad> bad_cases() {
                       {"width", 0.002}, {"a", 1}};
        },
        "boundaries[2].a: unknown key for a damping_layer boundary"},
+      {"pml_under_musl",
+       [](ojson& j) {
+         j["scheme"]["update"] = "MUSL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002}};
+       },
+       "boundaries[2].type: a pml on particles needs scheme.update \"USL\""},
+      {"pml_thicker_than_body",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 1.0}};
+       },
+       "boundaries[2].width: must be <= the size of body \"plate\""},
+      {"pml_alpha_negative",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002},
+                      {"alpha", -1}};
+       },
+       "boundaries[2].alpha: must be >= 0"},
+      {"pml_curve_key",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002},
+                      {"curve", 3}};
+       },
+       "boundaries[2].curve: unknown key for a pml boundary"},
+      {"pml_two_alphas",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002}};
+         j["boundaries"].push_back({{"type", "pml"}, {"body", "plate"}, {"side", "left"},
+                                    {"width", 0.002}, {"alpha", 1e5}});
+       },
+       "boundaries[4].alpha: every pml must have the same alpha (\"pml2\" has 0, this one 1e+05)"},
       {"kelvin_voigt_without_delta", [](ojson& j) { bnd(j, 2)["type"] = "kelvin_voigt"; },
        "boundaries[2].delta: missing required key"},
       {"kelvin_voigt_delta_below_cell",

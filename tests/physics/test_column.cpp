@@ -93,6 +93,7 @@ double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
   cb.cells = 3 * c.cells;
   cb.end = End::Free;
   cb.damp_cells = 0;
+  cb.pml_cells = 0;
   auto B = make_column(cb);
   const double tstar = dur + 1.8 * c.cells * c.h / cw;
   while (A->t < tstar - 0.5 * A->dt) A->step();
@@ -104,6 +105,8 @@ double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
   double er = 0;
   for (std::size_t k = 0; k < A->p.size(); ++k) {
     const long id = A->p.id[k], j = id / na, i = id % na;
+    // A perfectly matched layer's field is not a physical one: the difference is taken in front.
+    if (i >= na - static_cast<long>(c.pml_cells) * c.ppc_side) continue;
     const long kb = of_b[j * nb + i];
     const double dvx = A->p.vx[k] - B->p.vx[kb], dvy = A->p.vy[k] - B->p.vy[kb];
     er += 0.5 * A->p.mass[k] * (dvx * dvx + dvy * dvy) +
@@ -113,12 +116,17 @@ double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
                                                A->p.sxy[k] - B->p.sxy[kb]);
   }
   EXPECT_NEAR(A->energy.external_work, B->energy.external_work, 1e-9 * B->energy.external_work);
-  if ((c.end == End::Silent || c.end == End::KelvinVoigt || c.damp_cells > 0) && c.ppc_side == 1) {
+  if ((c.end == End::Silent || c.end == End::KelvinVoigt || c.damp_cells > 0 || c.pml_cells > 0) &&
+      c.ppc_side == 1) {
     // Energy balance with the dashpots: kinetic + elastic + absorbed = external work. (At 4 and 9
     // particles per cell the FLIP particle kinetic energy exceeds the grid's by about 1 %.)
+    // A perfectly matched layer's work is booked with the forces' mid-step velocity, as the
+    // other loads are, but its forces are of the order of the stresses: under USL (the power
+    // taken with v+, not with what the particles receive) the account then closes to 4-7 %.
     A->update_energies();
     const double imb = std::abs(A->energy.imbalance()) / A->energy.external_work;
-    EXPECT_LE(imb, 0.01) << "energy imbalance";
+    if (c.pml_cells > 0) std::printf("  energy imbalance %.3f\n", imb);
+    EXPECT_LE(imb, c.pml_cells > 0 ? 0.08 : 0.01) << "energy imbalance";
   }
   return er / A->energy.external_work;
 }
@@ -422,6 +430,30 @@ TEST(DampingLayer, ReflectionMatchesContinuum) {
       last = ratio;
     }
   }
+}
+
+// ---- Perfectly matched layer on particles, docs/physics.md section 9.3 ----
+
+// USL, 1 ppc, CFL 0.3, free end behind the layer, 8-cell sin^2 pulses; the reflected energy in
+// front of the layer. Measured: 10 cells 3.5e-5 (P) and 7.8e-5 (S), 20 cells 2.2e-6 and 3.6e-6
+// (the FE column: 6.7e-5 and 2.7e-4, 9.6e-7); the energy account closes to 4-7 % (checked by
+// reflected_energy_ratio against 8 %). Under MUSL and USF the P pulse is absorbed (8.3e-4 at 10 cells) but an
+// S pulse grows in the layer at a rate independent of dt (the same physical time at CFL 0.3, 0.1
+// and 0.03) that a shift alpha of 2e6 1/s stops and 2e5 does not: a slow growing mode of those
+// schemes' layer, not a time-step instability; cases refuse it.
+TEST(Pml, ColumnReflectionUsl) {
+  for (const int cells : {10, 20})
+    for (const bool shear : {false, true}) {
+      ColumnSpec c;
+      c.cells = 100;
+      c.end = End::Free;
+      c.scheme = Scheme::USL;
+      c.shear = shear;
+      c.pml_cells = cells;
+      const double ratio = reflected_energy_ratio(c, 8);
+      std::printf("  [USL, %d cells, %s] reflected energy %.3e\n", cells, shear ? "S" : "P", ratio);
+      EXPECT_LE(ratio, cells == 10 ? 2e-4 : 1e-5) << cells << " cells, " << (shear ? "S" : "P");
+    }
 }
 
 // ---- Health check: a NaN or Inf stops the run within the step it reaches the grid ----

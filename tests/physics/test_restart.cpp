@@ -74,6 +74,18 @@ TEST(Restart, MpmSpringsAndDampingBandBitIdentical) {
   EXPECT_EQ(from, 200);
 }
 
+// A perfectly matched layer on particles (USL): its displacements and memories are state.
+TEST(Restart, MpmPmlBitIdentical) {
+  using namespace hybrid_case_testing;
+  json c = small_plate(4, 240);
+  c["scheme"]["update"] = "USL";
+  c["boundaries"].push_back({{"type", "pml"}, {"body", "plate"}, {"side", "top"},
+                             {"width", 5 * h}, {"alpha", 1e5}});
+  c["output"]["snapshots"] = 4;
+  const long from = expect_restart_identical("mpm_pml", c, "checkpoint_every", 100);
+  EXPECT_EQ(from, 200);
+}
+
 TEST(Restart, MpmMultiFieldContactWithFrictionBitIdentical) {
   json c = contact_testing::impact_case();
   c["scheme"]["update"] = "USL";

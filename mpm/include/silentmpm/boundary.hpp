@@ -84,6 +84,32 @@ struct DampingLayer {
   std::vector<double> alpha;         // alpha per layer particle (1/s), set by Solver::finalize
 };
 
+// A perfectly matched layer inside a straight side of a body (docs/physics.md section 9.3): the
+// body's particles within `width` of the line x = c (axis 0) or y = c (axis 1), the body lying on
+// the side `side` (+1: at coordinates below c). d = d0 s^power with s the depth into the band over
+// width and d0 = -(power + 1) c_d ln(r0) / (2 width); alpha the frequency shift (1/s).
+struct PmlBand {
+  std::string name;
+  int body = -1, axis = 0, side = 1;
+  double c = 0, width = 0, r0 = 1e-3, power = 2, alpha = 0;
+};
+
+// The particles of every band of a solver, with their stretchings and memories (built by
+// Solver::finalize; a particle in two bands, at a corner, has both d_x and d_y).
+struct PmlLayer {
+  BoundaryLayer layer;            // ids and idx of the particles
+  double alpha = 0;
+  std::vector<double> dx, dy;     // per particle (1/s)
+  std::vector<double> H;          // 4 per particle: du_x/dx, du_y/dx, du_x/dy, du_y/dy
+  std::vector<double> u;          // 2 per particle: displacement
+  std::vector<double> xi, zeta;   // 4 per particle each: the memories (see solver.cpp)
+  std::vector<double> f;          // 6 per particle: this step's explicit loads (4 stresses, 2 per mass)
+  double dt_coef = 0;             // dt of the recursion coefficients below
+  std::vector<double> cx, cy;     // 3 per particle: e, ca, cb for alpha + d_x, alpha + d_y
+  double e_a = 1, ca_a = 0, cb_a = 0;
+  bool active() const { return !layer.ids.empty(); }
+};
+
 struct NodalConstraint {
   std::string name;
   std::vector<uint32_t> nodes;

@@ -83,6 +83,8 @@ class Solver {
   std::vector<TractionLoad> tractions;
   std::vector<SilentBoundary> silents;
   std::vector<DampingLayer> dampers;
+  std::vector<PmlBand> pml_bands;  // perfectly matched layers (every band shares one alpha)
+  PmlLayer pml;                    // their particles (built by finalize)
   SolverOptions opt;
   double dt = 0, t = 0;
   long steps = 0;
@@ -179,6 +181,8 @@ class Solver {
   template <class S> void p2g(unsigned what);
   void start_velocities();
   template <class S> void apply_loads();
+  template <class S> void pml_loads();
+  template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
