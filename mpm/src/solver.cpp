@@ -188,6 +188,15 @@ void Solver::finalize() {
     pml.layer.idx.push_back(static_cast<uint32_t>(k));
     pml.dx.push_back(dx);
     pml.dy.push_back(dy);
+    // The share of the grid's velocity the particle takes (pml_pic): (depth / width)^2.5 in its
+    // deepest band.
+    double depth = 0;
+    for (const PmlBand& b : pml_bands)
+      if (b.body == p.body[k]) {
+        const double pos = b.axis == 0 ? p.x[k] : p.y[k];
+        depth = std::max(depth, (pos - (b.c - b.side * b.width)) * b.side / b.width);
+      }
+    pml.pic.push_back(std::pow(std::min(depth, 1.0), kPmlPicPower));
   }
   if (pml.active()) {
     const std::size_t n = pml.layer.ids.size();
@@ -632,6 +641,35 @@ void Solver::pml_loads() {
   }
 }
 
+// Layer particles take a share w of the grid's velocity (PIC): the particle velocity becomes
+// w v_grid(start) + (1 - w) v_p, so that g2p's increment (FLIP, PIC or a blend) leaves it with
+// w v_grid(end) + (1 - w) v_p(FLIP). The layer's equations know the grid's unknowns only; the FLIP
+// particle velocity is a memory they do not contain, and with it the layer grew after a few
+// thousand steps. w grows from 0 at the layer's inner edge as (depth / width)^2.5: a sudden
+// switch to PIC reflects (PIC smooths the velocity over the stencil each step), a gentler one
+// (power 3 and more) leaves enough FLIP for the growth to return (docs/physics.md section 9.3).
+template <class S>
+void Solver::pml_pic() {
+  S sf;
+  long nodes[S::kNodes];
+  for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
+    const uint32_t k = pml.layer.idx[q];
+    const NodalField* f = &fields_[0].f;
+    if (!body_of_group_.empty())
+      for (const VelocityField& F : fields_)
+        if (F.body == body_of_group_[p.group[k]]) f = &F.f;
+    layer_shape(pml.layer, q, Anchor::Particle, sf, nodes);
+    double wx = 0, wy = 0;
+    for (int a = 0; a < S::kNodes; ++a) {
+      wx += sf.N[a] * f->vx[nodes[a]];
+      wy += sf.N[a] * f->vy[nodes[a]];
+    }
+    const double w = pml.pic[q];
+    p.vx[k] = w * wx + (1 - w) * p.vx[k];
+    p.vy[k] = w * wy + (1 - w) * p.vy[k];
+  }
+}
+
 template <class S>
 void Solver::pml_advance(const std::vector<double>& vx, const std::vector<double>& vy) {
   S sf;
@@ -1033,6 +1071,7 @@ void Solver::step_with() {
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
   if (!remapped_power) boundary_work<S>(false);
   call([&](StepHooks& h) { h.before_g2p(*this); });
+  if (pml.active()) pml_pic<S>();
   switch (sc) {
     case Scheme::MUSL:
       g2p<S>(true, false);

@@ -95,10 +95,6 @@ int main(int argc, char** argv) {
       j["damping_r0"] = base.r0;
     }
     if (base.boundary == "pml") {
-      if (method != "fem") {
-        std::fprintf(stderr, "oblique: --boundary pml is for the FEM method\n");
-        return 1;
-      }
       j["pml_cells"] = base.band;
       j["pml_r0"] = base.r0;
       j["pml_alpha"] = base.alpha;

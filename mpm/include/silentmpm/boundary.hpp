@@ -96,10 +96,14 @@ struct PmlBand {
 
 // The particles of every band of a solver, with their stretchings and memories (built by
 // Solver::finalize; a particle in two bands, at a corner, has both d_x and d_y).
+// The power of the layer particles' PIC share in their depth (Solver::pml_pic).
+inline constexpr double kPmlPicPower = 2.5;
+
 struct PmlLayer {
   BoundaryLayer layer;            // ids and idx of the particles
   double alpha = 0;
   std::vector<double> dx, dy;     // per particle (1/s)
+  std::vector<double> pic;        // per particle: the share of the grid's velocity it takes
   std::vector<double> H;          // 4 per particle: du_x/dx, du_y/dx, du_x/dy, du_y/dy
   std::vector<double> u;          // 2 per particle: displacement
   std::vector<double> xi, zeta;   // 4 per particle each: the memories (see solver.cpp)

@@ -182,6 +182,7 @@ class Solver {
   void start_velocities();
   template <class S> void apply_loads();
   template <class S> void pml_loads();
+  template <class S> void pml_pic();
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
   template <class S> void boundary_work(bool remapped);
