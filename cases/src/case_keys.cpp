@@ -2,6 +2,7 @@
 
 #include "silentmpm/case.hpp"
 #include "silentmpm/gmsh_session.hpp"
+#include "silentmpm/output.hpp"
 #include "silentmpm/state_io.hpp"
 
 #include <algorithm>
@@ -205,7 +206,8 @@ void Obj::le(const std::string& key, double v, double hi) const {
 }
 
 void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots) {
-  o.allow({"history_every", "snapshots", "progress", "checkpoint_every", "checkpoint_time"});
+  o.allow({"history_every", "snapshots", "progress", "checkpoint_every", "checkpoint_time",
+           "fields"});
   out.history_every = o.integer("history_every", 1);
   o.ge("history_every", static_cast<double>(out.history_every), 1);
   const long snaps = o.integer("snapshots", 10);
@@ -219,6 +221,21 @@ void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots) {
   o.ge("checkpoint_every", static_cast<double>(out.checkpoint_every), 0);
   out.checkpoint_time = o.num("checkpoint_time", 0.0);
   o.ge("checkpoint_time", out.checkpoint_time, 0);
+  if (o.has("fields")) {  // the particle snapshot's fields (positions are always written)
+    out.fields = 0;
+    const ojson& a = o.array("fields");
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      const std::string where = o.at("fields") + "[" + std::to_string(k) + "]";
+      const std::string name = as_string(o.ctx(), a[k], where);
+      const unsigned bit = snapshot_field(name);
+      if (!bit)
+        o.ctx().fail(where, "unknown field \"" + name + "\"" +
+                                suggestion(name, snapshot_field_names()) + " (known: " +
+                                quoted_list(snapshot_field_names()) + ")");
+      if (out.fields & bit) o.ctx().fail(where, "\"" + name + "\" is listed twice");
+      out.fields |= bit;
+    }
+  }
 }
 
 std::uint64_t case_fingerprint(const ojson& doc) {

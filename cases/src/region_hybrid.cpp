@@ -66,11 +66,13 @@ class HybridRegion final : public Region {
   }
 
   void open_snapshots(const std::string& out_dir) override {
+    snap_.set_fields(c_.output.fields);
     earlier_.open(snap_, out_dir);
     fe_.resume_snapshots(out_dir, "fem");
   }
   void write_snapshot(const std::string& out_dir) override {
-    snap_.write(s_.p, s_.steps, s_.t);
+    const auto layer = s_.layer_flags();
+    snap_.write(s_.p, s_.steps, s_.t, &layer);
     fe_.write_snapshot(out_dir, "fem");
   }
   void finish() override {

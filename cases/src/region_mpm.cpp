@@ -10,6 +10,10 @@
 
 namespace smpm::detail {
 
+// Solver::layer_flags uses the snapshot's layer bits.
+static_assert(kLayerSilent == 1 && kLayerTraction == 2 && kLayerSpring == 4 &&
+              kLayerDamping == 8 && kLayerPml == 16);
+
 namespace {
 
 class MpmRegion final : public Region {
@@ -51,8 +55,14 @@ class MpmRegion final : public Region {
     return s_.load_state(r, "mpm.");
   }
 
-  void open_snapshots(const std::string& out_dir) override { earlier_.open(snap_, out_dir); }
-  void write_snapshot(const std::string&) override { snap_.write(s_.p, s_.steps, s_.t); }
+  void open_snapshots(const std::string& out_dir) override {
+    snap_.set_fields(c_.output.fields);
+    earlier_.open(snap_, out_dir);
+  }
+  void write_snapshot(const std::string&) override {
+    const auto layer = s_.layer_flags();
+    snap_.write(s_.p, s_.steps, s_.t, &layer);
+  }
   void finish() override {
     snap_.close();
     s_.update_energies();

@@ -12,7 +12,8 @@ void apply(std::vector<T>& v, const std::vector<uint32_t>& perm) {
 }  // namespace
 
 void Particles::resize(std::size_t n) {
-  for (auto* v : {&x, &y, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p}) v->resize(n, 0.0);
+  for (auto* v : {&x, &y, &x0, &y0, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p})
+    v->resize(n, 0.0);
   if (film_) {
     for (auto* v : {&dnx, &dny, &dL, &dtnf, &dttf, &jump_n, &jump_t, &ubar}) v->resize(n, 0.0);
     state.resize(n, 0);
@@ -30,7 +31,8 @@ void Particles::enable_film() {
 }
 
 void Particles::permute(const std::vector<uint32_t>& perm) {
-  for (auto* v : {&x, &y, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p}) apply(*v, perm);
+  for (auto* v : {&x, &y, &x0, &y0, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p})
+    apply(*v, perm);
   if (film_) {
     for (auto* v : {&dnx, &dny, &dL, &dtnf, &dttf, &jump_n, &jump_t, &ubar}) apply(*v, perm);
     apply(state, perm);

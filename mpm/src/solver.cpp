@@ -1035,6 +1035,18 @@ void Solver::check_outside() {
 }
 
 // The time step: see the sequence at the top of solver.hpp.
+std::vector<std::uint8_t> Solver::layer_flags() const {
+  std::vector<std::uint8_t> f(p.size(), 0);
+  auto mark = [&](const BoundaryLayer& L, std::uint8_t bit) {
+    for (const uint32_t k : L.idx) f[k] |= bit;
+  };
+  for (const auto& sl : silents) mark(sl.layer, sl.delta > 0 ? 1 | 4 : 1);
+  for (const auto& tl : tractions) mark(tl.layer, 2);
+  for (const auto& dl : dampers) mark(dl.layer, 8);
+  mark(pml.layer, 16);
+  return f;
+}
+
 void Solver::step() {
   switch (opt.shape) {
     case ShapeKind::Bilinear: return step_with<Bilinear>();

@@ -15,7 +15,7 @@ namespace {
 // fn(name, array) for every particle array the run carries (the film block only when on).
 template <class P, class Fn>
 void particle_arrays(P& p, Fn&& fn) {
-  fn("x", p.x); fn("y", p.y); fn("vx", p.vx); fn("vy", p.vy); fn("mass", p.mass);
+  fn("x", p.x); fn("y", p.y); fn("x0", p.x0); fn("y0", p.y0); fn("vx", p.vx); fn("vy", p.vy); fn("mass", p.mass);
   fn("vol", p.vol); fn("sxx", p.sxx); fn("syy", p.syy); fn("szz", p.szz); fn("sxy", p.sxy);
   fn("eps_p", p.eps_p); fn("id", p.id); fn("body", p.body); fn("group", p.group);
   if (!p.has_film()) return;

@@ -3,15 +3,21 @@
 // Snapshot layout, one file DIR/<base>.h5:
 //   /step_000000123            group, attributes "time" (double) and "step" (int64)
 //     xyz                      N x 3 double (z = 0), the XDMF geometry
-//     vx vy sxx syy szz sxy J2 eps_p mass volume   N double
-//     body                     N int32
+//     then the fields chosen (SnapshotFields), each with an HDF5 attribute "units":
+//     velocity, displacement   N x 3 double (z component 0), m/s and m
+//     stress                   N x 9 double, the Cauchy stress as a full 3 x 3 tensor, row by row
+//                              (xx xy 0, xy yy 0, 0 0 zz), Pa
+//     J2                       N double, second invariant of the deviatoric stress, Pa^2
+//     eps_p mass volume        N double (1, kg/m and m^2 per unit thickness)
+//     body state layer         N int32 (state, film model: 0 elastic, 1 plastic, 2 decohesion,
+//                              3 separated; layer: SnapshotLayer bits)
 //     id                       N uint32 (permanent particle id; particles are re-sorted)
-//     state                    N int32 (film model: 0 elastic, 1 plastic, 2 decohesion, 3 separated)
-//     normal_x normal_y jump_n jump_t ubar   N double (film model: critical plane and jump)
+//     normal (N x 3), jump_n, jump_t, ubar   the film model's critical plane and jump (only when
+//                              a material of the run has the film model)
 //   /vertices_N                N int64 0 .. N-1: the Polyvertex connectivity of N particles
 // DIR/<base>.xdmf is an XDMF 3 temporal collection of Polyvertex grids that point into the .h5
-// by relative file name, so the output folder can be moved as a whole. It is rewritten (through
-// a temporary file and a rename) after every snapshot, so a partial run opens in ParaView.
+// by relative file name, so the output folder can be moved as a whole; its Domain carries an
+// Information element "units". It grows by one grid per snapshot (SnapshotWriter::append_xdmf).
 #include "silentmpm/output.hpp"
 
 #include <hdf5.h>
@@ -135,7 +141,7 @@ herr_t innermost_error(unsigned n, const H5E_error2_t* e, void* out) {
 
 void write_dataset(hid_t group, const char* name, hid_t file_type, hid_t mem_type,
                    const void* data, std::size_t n, std::size_t ncomp, const std::string& file,
-                   const std::string& group_name) {
+                   const std::string& group_name, const char* units = nullptr) {
   hsize_t dims[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(ncomp)};
   H5Handle space(H5Screate_simple(ncomp > 1 ? 2 : 1, dims, nullptr), H5Sclose);
   if (space.id < 0) h5_fail("cannot create dataspace for '" + group_name + "/" + name + "'", file);
@@ -144,6 +150,14 @@ void write_dataset(hid_t group, const char* name, hid_t file_type, hid_t mem_typ
   if (ds.id < 0) h5_fail("cannot create dataset '" + group_name + "/" + name + "'", file);
   if (n > 0 && H5Dwrite(ds.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
     h5_fail("cannot write dataset '" + group_name + "/" + name + "'", file);
+  if (!units) return;
+  H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Handle aspace(H5Screate(H5S_SCALAR), H5Sclose);
+  if (type.id < 0 || aspace.id < 0 || H5Tset_size(type.id, std::strlen(units)) < 0)
+    h5_fail("cannot make the units attribute of '" + group_name + "/" + name + "'", file);
+  H5Handle attr(H5Acreate2(ds.id, "units", type.id, aspace.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (attr.id < 0 || H5Awrite(attr.id, type.id, units) < 0)
+    h5_fail("cannot write attribute '" + group_name + "/" + name + "@units'", file);
 }
 
 template <class T>
@@ -178,23 +192,53 @@ std::string xml_escape(const std::string& s) {
   return out;
 }
 
-struct ScalarField {
+// Every field a snapshot can hold, in file order: its bit in SnapshotFields, dataset name, XDMF
+// number type and precision, components (1 scalar, 3 vector, 9 tensor) and units.
+struct FieldInfo {
+  unsigned bit;
   const char* name;
   const char* number_type;
   int precision;
+  int components;
+  const char* units;
 };
-// Every 1D dataset of a snapshot, in file order; the XDMF lists them all as node attributes.
-constexpr ScalarField kScalarFields[] = {
-    {"vx", "Float", 8},     {"vy", "Float", 8},    {"sxx", "Float", 8},   {"syy", "Float", 8},
-    {"szz", "Float", 8},    {"sxy", "Float", 8},   {"J2", "Float", 8},    {"eps_p", "Float", 8},
-    {"mass", "Float", 8},   {"volume", "Float", 8}, {"body", "Int", 4},   {"id", "UInt", 4},
-    // Film model (decohesion.hpp): state 0 elastic, 1 plastic, 2 decohesion, 3 separated;
-    // normal of the critical plane (0, 0 before bifurcation); jump; accumulated normalised jump.
-    {"state", "Int", 4},    {"normal_x", "Float", 8}, {"normal_y", "Float", 8},
-    {"jump_n", "Float", 8}, {"jump_t", "Float", 8},   {"ubar", "Float", 8},
+constexpr FieldInfo kFields[] = {
+    {kFieldVelocity, "velocity", "Float", 8, 3, "m/s"},
+    {kFieldDisplacement, "displacement", "Float", 8, 3, "m"},
+    {kFieldStress, "stress", "Float", 8, 9, "Pa"},
+    {kFieldJ2, "J2", "Float", 8, 1, "Pa^2"},
+    {kFieldEpsP, "eps_p", "Float", 8, 1, "1"},
+    {kFieldMass, "mass", "Float", 8, 1, "kg/m"},
+    {kFieldVolume, "volume", "Float", 8, 1, "m^2"},
+    {kFieldBody, "body", "Int", 4, 1, "1"},
+    {kFieldId, "id", "UInt", 4, 1, "1"},
+    {kFieldState, "state", "Int", 4, 1, "1"},
+    {kFieldLayer, "layer", "Int", 4, 1, "1"},
+    {kFieldFilm, "normal", "Float", 8, 3, "1"},
+    {kFieldFilm, "jump_n", "Float", 8, 1, "m"},
+    {kFieldFilm, "jump_t", "Float", 8, 1, "m"},
+    {kFieldFilm, "ubar", "Float", 8, 1, "1"},
 };
 
+const char* attribute_type(int components) {
+  return components == 1 ? "Scalar" : components == 3 ? "Vector" : "Tensor";
+}
+
 }  // namespace
+
+const std::vector<std::string>& snapshot_field_names() {
+  static const std::vector<std::string> names = {"velocity", "displacement", "stress", "J2",
+                                                 "eps_p",    "mass",         "volume", "body",
+                                                 "id",       "state",        "layer",  "film"};
+  return names;
+}
+
+unsigned snapshot_field(const std::string& name) {
+  const auto& names = snapshot_field_names();
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == name) return 1u << k;
+  return 0;
+}
 
 SnapshotWriter::~SnapshotWriter() {
   try {
@@ -273,6 +317,12 @@ int SnapshotWriter::resume(const std::string& dir, const std::string& base,
       h5_fail("cannot remove the later snapshot '/" + n + "'", path);
   }
   if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
+  // The file's fields are those of its first snapshot (a restart may not change them).
+  fields_ = 0;
+  for (const FieldInfo& fi : kFields)
+    if (H5Lexists(f, (step_name(steps[0]) + "/" + fi.name).c_str(), H5P_DEFAULT) > 0)
+      fields_ |= fi.bit;
+  film_ = (fields_ & kFieldFilm) != 0;
   steps_ = steps;
   times_ = times;
   sizes_ = sizes;
@@ -280,22 +330,28 @@ int SnapshotWriter::resume(const std::string& dir, const std::string& base,
   return static_cast<int>(steps.size());
 }
 
-void SnapshotWriter::write(const Particles& p, long step, double time) {
+void SnapshotWriter::write(const Particles& p, long step, double time,
+                           const std::vector<std::uint8_t>* layer) {
   const std::string path = dir_ + "/" + base_ + ".h5";
   if (file_ < 0) throw std::runtime_error("SnapshotWriter::write called before open()");
   const hid_t file = static_cast<hid_t>(file_);
   const std::size_t n = p.size();
   {
-    const std::size_t sizes[] = {p.y.size(),   p.vx.size(),  p.vy.size(),    p.mass.size(),
-                                 p.vol.size(), p.sxx.size(), p.syy.size(),   p.szz.size(),
-                                 p.sxy.size(), p.eps_p.size(), p.id.size(), p.body.size(),
-                                 p.state.size(), p.dnx.size(), p.dny.size(), p.jump_n.size(),
-                                 p.jump_t.size(), p.ubar.size()};
+    const std::size_t sizes[] = {p.y.size(),   p.x0.size(),  p.y0.size(),  p.vx.size(),
+                                 p.vy.size(),  p.mass.size(), p.vol.size(), p.sxx.size(),
+                                 p.syy.size(), p.szz.size(), p.sxy.size(), p.eps_p.size(),
+                                 p.id.size(),  p.body.size(), p.state.size(), p.dnx.size(),
+                                 p.dny.size(), p.jump_n.size(), p.jump_t.size(), p.ubar.size()};
     for (std::size_t k = 0; k < std::size(sizes); ++k)
-      if (sizes[k] != n && !(k >= 12 && !p.has_film()))  // the film block may be off
+      if (sizes[k] != n && !(k >= 14 && !p.has_film()))  // the film block may be off
         throw std::runtime_error("SnapshotWriter: particle arrays have inconsistent sizes (" +
                                  std::to_string(sizes[k]) + " vs " + std::to_string(n) + ")");
+    if (layer && layer->size() != n)
+      throw std::runtime_error("SnapshotWriter: the layer flags have " +
+                               std::to_string(layer->size()) + " entries for " +
+                               std::to_string(n) + " particles");
   }
+  if (steps_.empty()) film_ = p.has_film();  // the first snapshot fixes the file's fields
 
   const std::string gname = step_name(step);
   // Writing the same step twice replaces the earlier snapshot of that step.
@@ -313,55 +369,66 @@ void SnapshotWriter::write(const Particles& p, long step, double time) {
   write_scalar_attribute(group.id, "step", H5T_STD_I64LE, H5T_NATIVE_INT64,
                          static_cast<int64_t>(step), path, gname);
 
-  std::vector<double> xyz(3 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    xyz[3 * i] = p.x[i];
-    xyz[3 * i + 1] = p.y[i];
-    xyz[3 * i + 2] = 0.0;
-  }
-  write_dataset(group.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), n, 3, path, gname);
-  xyz.clear();
-  xyz.shrink_to_fit();
-
-  auto dbl = [&](const char* name, const double* data) {
-    write_dataset(group.id, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data, n, 1, path, gname);
+  std::vector<double> buf;
+  // An n x c array from c per-particle functions.
+  auto columns = [&](int c, auto&& value) {
+    buf.assign(static_cast<std::size_t>(c) * n, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int q = 0; q < c; ++q) buf[c * i + q] = value(i, q);
+    return buf.data();
   };
-  dbl("vx", p.vx.data());
-  dbl("vy", p.vy.data());
-  dbl("sxx", p.sxx.data());
-  dbl("syy", p.syy.data());
-  dbl("szz", p.szz.data());
-  dbl("sxy", p.sxy.data());
-  {
-    std::vector<double> j2(n);
-    for (std::size_t i = 0; i < n; ++i) j2[i] = j2_of(p.sxx[i], p.syy[i], p.szz[i], p.sxy[i]);
-    dbl("J2", j2.data());
-  }
-  dbl("eps_p", p.eps_p.data());
-  dbl("mass", p.mass.data());
-  dbl("volume", p.vol.data());
-  {
-    std::vector<int32_t> body(p.body.begin(), p.body.end());
-    write_dataset(group.id, "body", H5T_STD_I32LE, H5T_NATIVE_INT32, body.data(), n, 1, path,
-                  gname);
-  }
-  write_dataset(group.id, "id", H5T_STD_U32LE, H5T_NATIVE_UINT32, p.id.data(), n, 1, path, gname);
-  {
-    std::vector<int32_t> state(n, 0);
-    for (std::size_t i = 0; i < n && i < p.state.size(); ++i) state[i] = p.state[i];
-    write_dataset(group.id, "state", H5T_STD_I32LE, H5T_NATIVE_INT32, state.data(), n, 1, path,
-                  gname);
-  }
-  // The film block: zeros when no material of the run has one (same datasets in every file).
-  const std::vector<double> zeros(p.has_film() ? 0 : n, 0.0);
-  auto film = [&](const char* name, const std::vector<double>& v) {
-    dbl(name, p.has_film() ? v.data() : zeros.data());
+  auto vec3 = [&](const std::vector<double>& a, const std::vector<double>& b) {
+    return columns(3, [&](std::size_t i, int q) { return q == 0 ? a[i] : q == 1 ? b[i] : 0.0; });
   };
-  film("normal_x", p.dnx);
-  film("normal_y", p.dny);
-  film("jump_n", p.jump_n);
-  film("jump_t", p.jump_t);
-  film("ubar", p.ubar);
+  write_dataset(group.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, vec3(p.x, p.y), n, 3, path,
+                gname, "m");
+  std::vector<int32_t> ibuf(n);
+  for (const FieldInfo& f : kFields) {
+    if (!(fields_ & f.bit) || (f.bit == kFieldFilm && !film_)) continue;
+    const std::string name = f.name;
+    const double* d = nullptr;
+    if (name == "velocity") d = vec3(p.vx, p.vy);
+    else if (name == "displacement")
+      d = columns(3, [&](std::size_t i, int q) {
+        return q == 0 ? p.x[i] - p.x0[i] : q == 1 ? p.y[i] - p.y0[i] : 0.0;
+      });
+    else if (name == "stress")
+      d = columns(9, [&](std::size_t i, int q) {
+        switch (q) {
+          case 0: return p.sxx[i];
+          case 1: case 3: return p.sxy[i];
+          case 4: return p.syy[i];
+          case 8: return p.szz[i];
+          default: return 0.0;
+        }
+      });
+    else if (name == "J2")
+      d = columns(1, [&](std::size_t i, int) { return j2_of(p.sxx[i], p.syy[i], p.szz[i], p.sxy[i]); });
+    else if (name == "eps_p") d = p.eps_p.data();
+    else if (name == "mass") d = p.mass.data();
+    else if (name == "volume") d = p.vol.data();
+    else if (name == "normal") d = film_ ? vec3(p.dnx, p.dny) : columns(3, [](std::size_t, int) { return 0.0; });
+    else if (name == "jump_n" || name == "jump_t" || name == "ubar") {
+      const std::vector<double>& v = name == "jump_n" ? p.jump_n : name == "jump_t" ? p.jump_t : p.ubar;
+      d = film_ && p.has_film() ? v.data() : columns(1, [](std::size_t, int) { return 0.0; });
+    }
+    if (d) {
+      write_dataset(group.id, f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, d, n,
+                    static_cast<std::size_t>(f.components), path, gname, f.units);
+      continue;
+    }
+    if (name == "id") {
+      write_dataset(group.id, f.name, H5T_STD_U32LE, H5T_NATIVE_UINT32, p.id.data(), n, 1, path,
+                    gname, f.units);
+      continue;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      ibuf[i] = name == "body"    ? p.body[i]
+                : name == "state" ? (i < p.state.size() ? p.state[i] : 0)
+                                  : (layer ? (*layer)[i] : 0);
+    write_dataset(group.id, f.name, H5T_STD_I32LE, H5T_NATIVE_INT32, ibuf.data(), n, 1, path,
+                  gname, f.units);
+  }
 
   // The vertex connectivity 0 .. N-1 of the Polyvertex topology (XDMF 3 readers and meshio need
   // it): one dataset per particle count, shared by the snapshots of that count.
@@ -407,6 +474,12 @@ std::string SnapshotWriter::xdmf_head() const {
   s += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
   s += "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n";
   s += "  <Domain>\n";
+  std::string units;
+  for (const FieldInfo& f : kFields)
+    if ((fields_ & f.bit) && !(f.bit == kFieldFilm && !film_))
+      units += std::string(units.empty() ? "" : ", ") + f.name + " " + f.units;
+  s += "    <Information Name=\"units\" Value=\"" + xml_escape("xyz m" + (units.empty() ? "" : ", " + units)) +
+       "\"/>\n";
   s += "    <Grid Name=\"" + xml_escape(base_) +
        "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   return s;
@@ -434,13 +507,18 @@ std::string SnapshotWriter::xdmf_grid(std::size_t k) const {
                 g.c_str(), times_[k], n, n, h5.c_str(), vertices_name(n).c_str(), n, h5.c_str(),
                 g.c_str());
   s += buf;
-  for (const auto& f : kScalarFields) {
+  for (const FieldInfo& f : kFields) {
+    if (!(fields_ & f.bit) || (f.bit == kFieldFilm && !film_)) continue;
+    char dims[64];
+    if (f.components == 1) std::snprintf(dims, sizeof dims, "%zu", n);
+    else std::snprintf(dims, sizeof dims, "%zu %d", n, f.components);
     std::snprintf(buf, sizeof buf,
-                  "        <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-                  "          <DataItem Dimensions=\"%zu\" NumberType=\"%s\" Precision=\"%d\" "
+                  "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n"
+                  "          <DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
                   "Format=\"HDF\">%s:/%s/%s</DataItem>\n"
                   "        </Attribute>\n",
-                  f.name, n, f.number_type, f.precision, h5.c_str(), g.c_str(), f.name);
+                  f.name, attribute_type(f.components), dims, f.number_type, f.precision,
+                  h5.c_str(), g.c_str(), f.name);
     s += buf;
   }
   s += "      </Grid>\n";

@@ -54,8 +54,8 @@ def snapshot_at(h5path, t):
             "state": g["state"][:][order],
             "eps_p": g["eps_p"][:][order],
             "body": g["body"][:][order],
-            "nx": g["normal_x"][:][order],
-            "ny": g["normal_y"][:][order],
+            "nx": g["normal"][:][order, 0],
+            "ny": g["normal"][:][order, 1],
         }
     return d
 

@@ -116,21 +116,22 @@ TEST(FilmStudy, SnapshotCarriesStateNormalAndJump) {
     H5Dclose(ds);
   };
   std::vector<int32_t> state(np);
-  std::vector<double> nx(np), ny(np), jn(np), ub(np);
+  std::vector<double> normal(3 * np), jn(np), ub(np);  // normal: a 3-vector per particle
   read("state", H5T_NATIVE_INT32, state.data());
-  read("normal_x", H5T_NATIVE_DOUBLE, nx.data());
-  read("normal_y", H5T_NATIVE_DOUBLE, ny.data());
+  read("normal", H5T_NATIVE_DOUBLE, normal.data());
   read("jump_n", H5T_NATIVE_DOUBLE, jn.data());
   read("ubar", H5T_NATIVE_DOUBLE, ub.data());
   H5Fclose(f);
   std::size_t coh = 0;
   for (std::size_t k = 0; k < np; ++k) {
     ASSERT_EQ(state[k], s.p.state[k]) << k;
-    EXPECT_EQ(nx[k], s.p.dnx[k]);
-    EXPECT_EQ(ny[k], s.p.dny[k]);
+    const double nx = normal[3 * k], ny = normal[3 * k + 1];
+    EXPECT_EQ(normal[3 * k + 2], 0.0);
+    EXPECT_EQ(nx, s.p.dnx[k]);
+    EXPECT_EQ(ny, s.p.dny[k]);
     EXPECT_EQ(jn[k], s.p.jump_n[k]);
     EXPECT_EQ(ub[k], s.p.ubar[k]);
-    const double len = std::hypot(nx[k], ny[k]);
+    const double len = std::hypot(nx, ny);
     if (state[k] >= kDecohesion) {
       ++coh;
       EXPECT_NEAR(len, 1.0, 1e-12);

@@ -85,6 +85,8 @@ Particles small_set(std::size_t n, double shift) {
     const double s = static_cast<double>(i) + shift;
     p.x[i] = 0.1 * s;
     p.y[i] = -0.2 * s;
+    p.x0[i] = 0.1 * static_cast<double>(i);
+    p.y0[i] = -0.2 * static_cast<double>(i) + 1e-3;
     p.vx[i] = 1.0 + s;
     p.vy[i] = 2.0 - s;
     p.mass[i] = 3.0 + 0.5 * s;
@@ -230,16 +232,51 @@ TEST(HistoryRelativeL2, NormWindowApart) {
   }
 }
 
+// The units attribute of a dataset.
+std::string units_of(hid_t f, const std::string& path) {
+  const hid_t ds = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+  if (ds < 0) return "(no dataset)";
+  const hid_t a = H5Aopen(ds, "units", H5P_DEFAULT);
+  std::string out = "(no units)";
+  if (a >= 0) {
+    const hid_t t = H5Aget_type(a);
+    std::string buf(H5Tget_size(t), '\0');
+    H5Aread(a, t, buf.data());
+    out = buf;
+    H5Tclose(t);
+    H5Aclose(a);
+  }
+  H5Dclose(ds);
+  return out;
+}
+
+std::vector<int32_t> read_ints(hid_t f, const std::string& path) {
+  const hid_t ds = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+  if (ds < 0) return {};
+  const hid_t sp = H5Dget_space(ds);
+  std::vector<int32_t> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp)));
+  H5Dread(ds, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(sp);
+  H5Dclose(ds);
+  return v;
+}
+
+// Every field of a snapshot read back against the particles: vectors and the stress tensor in
+// their XDMF shapes, units on every dataset, the layer flags, the XDMF listing each field once
+// with its kind; the film block absent when no material has the film model.
 TEST(OutputSnapshot, WriteAndReadBack) {
   TempDir dir("snap");
   const std::size_t n = 7;
   const Particles p0 = small_set(n, 0.0), p1 = small_set(n, 0.25);
   const double t0 = 0.0, t1 = 1.5e-5;
+  std::vector<uint8_t> layer(n, 0);
+  layer[2] = kLayerSilent | kLayerSpring;
+  layer[5] = kLayerTraction;
   {
     SnapshotWriter w;
     w.open(dir.path.string());
-    w.write(p0, 0, t0);
-    w.write(p1, 123, t1);
+    w.write(p0, 0, t0, &layer);
+    w.write(p1, 123, t1, &layer);
     EXPECT_EQ(w.count(), 2);
     w.close();
   }
@@ -247,12 +284,13 @@ TEST(OutputSnapshot, WriteAndReadBack) {
   ASSERT_TRUE(fs::exists(h5));
   const hid_t f = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   ASSERT_GE(f, 0);
-  const char* fields[] = {"vx",  "vy",    "sxx",  "syy",    "szz",  "sxy",
-                          "J2",  "eps_p", "mass", "volume", "body", "id"};
+  const std::vector<std::pair<std::string, std::string>> units = {
+      {"xyz", "m"},     {"velocity", "m/s"}, {"displacement", "m"}, {"stress", "Pa"},
+      {"J2", "Pa^2"},   {"eps_p", "1"},      {"mass", "kg/m"},      {"volume", "m^2"},
+      {"body", "1"},    {"id", "1"},         {"state", "1"},        {"layer", "1"}};
   for (int s = 0; s < 2; ++s) {
     const Particles& p = s == 0 ? p0 : p1;
     const std::string g = s == 0 ? "/step_000000000" : "/step_000000123";
-    // time attribute
     const hid_t grp = H5Gopen2(f, g.c_str(), H5P_DEFAULT);
     ASSERT_GE(grp, 0) << g;
     const hid_t attr = H5Aopen(grp, "time", H5P_DEFAULT);
@@ -262,42 +300,50 @@ TEST(OutputSnapshot, WriteAndReadBack) {
     EXPECT_EQ(t, s == 0 ? t0 : t1);
     H5Aclose(attr);
     H5Gclose(grp);
+    for (const auto& [name, u] : units) EXPECT_EQ(units_of(f, g + "/" + name), u) << name;
+    EXPECT_LT(H5Lexists(f, (g + "/ubar").c_str(), H5P_DEFAULT), 1) << "film block without a film model";
 
     std::vector<hsize_t> dims;
     const auto xyz = read_doubles(f, g + "/xyz", dims);
     ASSERT_EQ(dims, (std::vector<hsize_t>{n, 3}));
+    const auto vel = read_doubles(f, g + "/velocity", dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{n, 3}));
+    const auto disp = read_doubles(f, g + "/displacement", dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{n, 3}));
+    const auto sig = read_doubles(f, g + "/stress", dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{n, 9}));
+    const auto j2 = read_doubles(f, g + "/J2", dims);
+    ASSERT_EQ(dims, (std::vector<hsize_t>{n}));
+    const auto eps = read_doubles(f, g + "/eps_p", dims);
+    const auto mass = read_doubles(f, g + "/mass", dims);
+    const auto vol = read_doubles(f, g + "/volume", dims);
+    const auto body = read_ints(f, g + "/body");
+    const auto lay = read_ints(f, g + "/layer");
+    ASSERT_EQ(body.size(), n);
+    ASSERT_EQ(lay.size(), n);
     for (std::size_t i = 0; i < n; ++i) {
       EXPECT_EQ(xyz[3 * i], p.x[i]);
       EXPECT_EQ(xyz[3 * i + 1], p.y[i]);
       EXPECT_EQ(xyz[3 * i + 2], 0.0);
+      EXPECT_EQ(vel[3 * i], p.vx[i]);
+      EXPECT_EQ(vel[3 * i + 1], p.vy[i]);
+      EXPECT_EQ(vel[3 * i + 2], 0.0);
+      EXPECT_EQ(disp[3 * i], p.x[i] - p.x0[i]);
+      EXPECT_EQ(disp[3 * i + 1], p.y[i] - p.y0[i]);
+      EXPECT_EQ(disp[3 * i + 2], 0.0);
+      const double want[9] = {p.sxx[i], p.sxy[i], 0, p.sxy[i], p.syy[i], 0, 0, 0, p.szz[i]};
+      for (int q = 0; q < 9; ++q) EXPECT_EQ(sig[9 * i + q], want[q]) << "stress " << q;
+      EXPECT_EQ(j2[i], j2_of(p.sxx[i], p.syy[i], p.szz[i], p.sxy[i]));
+      EXPECT_EQ(eps[i], p.eps_p[i]);
+      EXPECT_EQ(mass[i], p.mass[i]);
+      EXPECT_EQ(vol[i], p.vol[i]);
+      EXPECT_EQ(body[i], static_cast<int32_t>(p.body[i]));
+      EXPECT_EQ(lay[i], layer[i]);
     }
-    const std::vector<const std::vector<double>*> expect = {&p.vx,  &p.vy,  &p.sxx,   &p.syy,
-                                                            &p.szz, &p.sxy, nullptr,  &p.eps_p,
-                                                            &p.mass, &p.vol};
-    for (std::size_t k = 0; k < expect.size(); ++k) {
-      const auto v = read_doubles(f, g + "/" + fields[k], dims);
-      ASSERT_EQ(dims, (std::vector<hsize_t>{n})) << fields[k];
-      for (std::size_t i = 0; i < n; ++i) {
-        const double want =
-            expect[k] ? (*expect[k])[i] : j2_of(p.sxx[i], p.syy[i], p.szz[i], p.sxy[i]);
-        EXPECT_EQ(v[i], want) << fields[k] << " particle " << i;
-      }
-    }
-    // body is stored as 32-bit integers
-    const hid_t ds = H5Dopen2(f, (g + "/body").c_str(), H5P_DEFAULT);
-    ASSERT_GE(ds, 0);
-    const hid_t type = H5Dget_type(ds);
-    EXPECT_EQ(H5Tget_class(type), H5T_INTEGER);
-    EXPECT_EQ(H5Tget_size(type), 4u);
-    H5Tclose(type);
-    std::vector<int32_t> body(n, -1);
-    H5Dread(ds, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, body.data());
-    H5Dclose(ds);
-    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(body[i], static_cast<int32_t>(p.body[i]));
   }
   H5Fclose(f);
 
-  // XDMF sidecar: mentions every dataset, the particle count and each snapshot time.
+  // XDMF sidecar: every field once per snapshot with its kind, the count, each time, the units.
   const std::string xdmf = slurp(dir.str("particles.xdmf"));
   ASSERT_FALSE(xdmf.empty());
   EXPECT_NE(xdmf.find("CollectionType=\"Temporal\""), std::string::npos);
@@ -305,15 +351,47 @@ TEST(OutputSnapshot, WriteAndReadBack) {
   EXPECT_NE(xdmf.find("NumberOfElements=\"" + std::to_string(n) + "\""), std::string::npos);
   EXPECT_NE(xdmf.find("particles.h5:/step_000000000/xyz"), std::string::npos);
   EXPECT_NE(xdmf.find("particles.h5:/step_000000123/xyz"), std::string::npos);
-  for (const char* name : fields) {
-    EXPECT_NE(xdmf.find("Name=\"" + std::string(name) + "\""), std::string::npos) << name;
-    EXPECT_NE(xdmf.find("/step_000000123/" + std::string(name) + "<"), std::string::npos) << name;
+  EXPECT_NE(xdmf.find("<Information Name=\"units\" Value=\"xyz m, velocity m/s,"), std::string::npos);
+  EXPECT_NE(xdmf.find("Name=\"velocity\" AttributeType=\"Vector\""), std::string::npos);
+  EXPECT_NE(xdmf.find("Name=\"stress\" AttributeType=\"Tensor\""), std::string::npos);
+  EXPECT_NE(xdmf.find("Dimensions=\"7 9\""), std::string::npos);
+  for (std::size_t k = 1; k < units.size(); ++k) {
+    const std::string& name = units[k].first;
+    EXPECT_NE(xdmf.find("Name=\"" + name + "\""), std::string::npos) << name;
+    EXPECT_NE(xdmf.find("/step_000000123/" + name + "<"), std::string::npos) << name;
   }
+  EXPECT_EQ(xdmf.find("ubar"), std::string::npos);
   for (double t : {t0, t1}) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.9e", t);
     EXPECT_NE(xdmf.find("Time Value=\"" + std::string(buf) + "\""), std::string::npos) << buf;
   }
+}
+
+// output.fields: only the chosen fields are written and listed (positions always); a film
+// model's block comes with "film".
+TEST(OutputSnapshot, ChosenFieldsOnly) {
+  TempDir dir("snapf");
+  Particles p = small_set(5, 0.0);
+  p.enable_film();
+  {
+    SnapshotWriter w;
+    w.set_fields(snapshot_field("velocity") | snapshot_field("film"));
+    w.open(dir.path.string());
+    w.write(p, 0, 0.0);
+  }
+  const hid_t f = H5Fopen(dir.str("particles.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  for (const char* name : {"xyz", "velocity", "normal", "jump_n", "jump_t", "ubar"})
+    EXPECT_GT(H5Lexists(f, (std::string("/step_000000000/") + name).c_str(), H5P_DEFAULT), 0) << name;
+  for (const char* name : {"displacement", "stress", "J2", "mass", "id", "layer", "state"})
+    EXPECT_LT(H5Lexists(f, (std::string("/step_000000000/") + name).c_str(), H5P_DEFAULT), 1) << name;
+  H5Fclose(f);
+  const std::string xdmf = slurp(dir.str("particles.xdmf"));
+  EXPECT_NE(xdmf.find("Name=\"normal\" AttributeType=\"Vector\""), std::string::npos);
+  EXPECT_EQ(xdmf.find("Name=\"stress\""), std::string::npos);
+  EXPECT_EQ(snapshot_field("velocty"), 0u);
+  EXPECT_EQ(snapshot_field_names().size(), 12u);
 }
 
 TEST(OutputSnapshot, XdmfIsRewrittenAfterEverySnapshot) {

@@ -41,8 +41,14 @@ with open(sys.argv[2], 'w') as out:
                                              cells[0].type, r.num_steps))
             for k in range(r.num_steps):
                 t, pd, cd = r.read_data(k)
-                extra = pd['mass'].sum() if name == 'particles' else pd['displacement'].shape[1]
-                out.write('%s_step %.9e %.17g\n' % (name, t, extra))
+                if name == 'particles':
+                    sg = pd['stress']
+                    out.write('%s_step %.9e %.17g %d %d %d %.17g\n' % (
+                        name, t, pd['mass'].sum(), pd['velocity'].shape[1],
+                        pd['displacement'].shape[1], sg.shape[1],
+                        abs(sg[:, 1] - sg[:, 3]).max() + abs(sg[:, [2, 5, 6, 7]]).max()))
+                else:
+                    out.write('%s_step %.9e %.17g\n' % (name, t, pd['displacement'].shape[1]))
 )";
   ASSERT_EQ(std::system(("/usr/bin/python3 " + script.string() + " " + out.string() + " " +
                          result.string()).c_str()),
@@ -59,10 +65,16 @@ with open(sys.argv[2], 'w') as out:
   std::vector<double> tp, tf;
   for (long k = 0; k < steps; ++k) {
     std::string tag;
-    double t, m;
-    in >> tag >> t >> m;
+    double t, m, asym;
+    int vel, disp, sig;
+    in >> tag >> t >> m >> vel >> disp >> sig >> asym;
     tp.push_back(t);
     EXPECT_NEAR(m, mass, 1e-12 * mass) << "snapshot " << k;
+    // The same kinds as the FE file: 3-vectors; the stress a symmetric 3 x 3 tensor, plane.
+    EXPECT_EQ(vel, 3);
+    EXPECT_EQ(disp, 3);
+    EXPECT_EQ(sig, 9);
+    EXPECT_EQ(asym, 0.0);
   }
   long fsteps = 0;
   in >> name >> points >> ncells >> type >> fsteps;

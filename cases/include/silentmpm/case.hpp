@@ -53,6 +53,7 @@ struct OutputSpec {
   // each time the clock passes a multiple of checkpoint_time seconds (0: none).
   long checkpoint_every = 0;
   double checkpoint_time = 0;
+  unsigned fields = ~0u;    // particle snapshot fields (SnapshotField bits of output.hpp)
 };
 
 struct Case {

@@ -9,6 +9,7 @@ namespace smpm {
 
 struct Particles {
   std::vector<double> x, y;          // position
+  std::vector<double> x0, y0;        // position where it was seeded (displacement = x - x0)
   std::vector<double> vx, vy;        // velocity
   std::vector<double> mass;          // M_p (constant)
   std::vector<double> vol;           // current volume V_p (unit thickness)
@@ -36,6 +37,8 @@ struct Particles {
              double v_y, int body_id, int group_id) {
     x[k] = px;
     y[k] = py;
+    x0[k] = px;
+    y0[k] = py;
     vx[k] = v_x;
     vy[k] = v_y;
     vol[k] = volume;
@@ -48,7 +51,7 @@ struct Particles {
   void permute(const std::vector<uint32_t>& perm);
   // Bytes per particle of the arrays every run carries, and of the film block.
   static constexpr std::size_t bytes_per_particle() {
-    return 11 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t);
+    return 13 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t);
   }
   static constexpr std::size_t film_bytes_per_particle() { return 8 * sizeof(double) + sizeof(uint8_t); }
 

@@ -108,6 +108,9 @@ class Solver {
 
   // --- run ---------------------------------------------------------------------------------
   // One time step (the sequence at the top of this file).
+  // Per particle (current order): 1 silent layer, 2 traction, 4 Kelvin-Voigt springs, 8 damping
+  // layer, 16 perfectly matched layer (the snapshot field "layer").
+  std::vector<std::uint8_t> layer_flags() const;
   void step();
   // Hook sets: attach before the first step; a set must outlive its attachment.
   void attach(StepHooks* h);

@@ -4,6 +4,7 @@
 //   DIR/summary.json   steps, dt, t_end, wall_seconds, particles, particle_updates_per_second,
 //                      energy {kinetic, elastic, dissipated, absorbed, external_work, ...}
 //   DIR/particles.h5 + DIR/particles.xdmf   particle snapshots that open in ParaView
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -35,12 +36,28 @@ class HistoryWriter {
   std::string path_;
 };
 
-// Particle snapshots: one HDF5 file with a group per snapshot ("/step_000123") holding datasets
-// of length N (double unless noted): x, y (as a N x 3 "xyz" dataset for XDMF), vx, vy, sxx, syy,
-// szz, sxy, J2, eps_p, mass, volume, body (int32), id (uint32), and the film model's state
-// (int32: 0 elastic, 1 plastic, 2 decohesion, 3 separated), normal_x, normal_y, jump_n, jump_t,
-// ubar. The XDMF sidecar (temporal collection of
-// Polyvertex grids) is rewritten after every snapshot so a partial run still opens.
+// The fields a particle snapshot can hold (SnapshotWriter::set_fields; the layout is in
+// output.cpp). kFieldFilm: the film model's plane normal and jump, written only when a material
+// of the run has that model.
+enum SnapshotField : unsigned {
+  kFieldVelocity = 1u << 0, kFieldDisplacement = 1u << 1, kFieldStress = 1u << 2,
+  kFieldJ2 = 1u << 3, kFieldEpsP = 1u << 4, kFieldMass = 1u << 5, kFieldVolume = 1u << 6,
+  kFieldBody = 1u << 7, kFieldId = 1u << 8, kFieldState = 1u << 9, kFieldLayer = 1u << 10,
+  kFieldFilm = 1u << 11,
+  kFieldsAll = (1u << 12) - 1,
+};
+// The field of a name ("velocity", "displacement", "stress", "J2", "eps_p", "mass", "volume",
+// "body", "id", "state", "layer", "film"); 0 for an unknown name.
+unsigned snapshot_field(const std::string& name);
+const std::vector<std::string>& snapshot_field_names();
+// Bits of the per-particle "layer" field: the boundary conditions a particle carries.
+enum SnapshotLayer : std::uint8_t {
+  kLayerSilent = 1, kLayerTraction = 2, kLayerSpring = 4, kLayerDamping = 8, kLayerPml = 16,
+};
+
+// Particle snapshots: one HDF5 file with a group per snapshot ("/step_000123") holding the
+// positions and the chosen fields, and an XDMF 3 sidecar (a temporal collection of Polyvertex
+// grids) that grows by one grid per snapshot, so a partial run still opens.
 class SnapshotWriter {
  public:
   SnapshotWriter() = default;
@@ -49,7 +66,11 @@ class SnapshotWriter {
   SnapshotWriter& operator=(const SnapshotWriter&) = delete;
   // Creates DIR/<base>.h5 (truncating) and remembers DIR/<base>.xdmf. Throws std::runtime_error.
   void open(const std::string& dir, const std::string& base = "particles");
-  void write(const Particles& p, long step, double time);
+  // The fields to write (SnapshotField bits); before open() or resume().
+  void set_fields(unsigned fields) { fields_ = fields; }
+  // layer: per particle (in p's order) its SnapshotLayer bits, or null (all 0).
+  void write(const Particles& p, long step, double time,
+             const std::vector<std::uint8_t>* layer = nullptr);
   void close();
   int count() const { return static_cast<int>(times_.size()); }
   // Restart: reopens DIR/<base>.h5 of an earlier run that wrote the snapshots listed (their
@@ -69,6 +90,8 @@ class SnapshotWriter {
   std::vector<long> steps_;
   std::vector<std::size_t> sizes_;
   long long xdmf_end_ = -1;  // offset of the XDMF tail on disk (-1: write the file whole next)
+  unsigned fields_ = kFieldsAll;
+  bool film_ = false;        // the file carries the film block (fixed by the first snapshot)
   std::string xdmf_head() const;
   std::string xdmf_grid(std::size_t k) const;
   void write_xdmf();
