@@ -46,7 +46,9 @@ void remove_fem_snapshots(const std::string& out_dir, int keep) {
   const fs::path dir(out_dir);
   std::error_code ec;
   fs::remove(dir / "fem.xdmf", ec);
-  // FEM snapshots fem_NNNNN.h5: five digits or more (numbers past 99999 take six).
+  // A restart keeps fem.h5 (the FE solver reopens it and trims it to its checkpoint).
+  if (keep == 0) fs::remove(dir / "fem.h5", ec);
+  // Files of the earlier one-file-per-snapshot layout, fem_NNNNN.h5: five digits or more.
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string n = e.path().filename().string();
     if (n.size() < 12 || n.size() > 16 || n.compare(0, 4, "fem_") != 0 ||

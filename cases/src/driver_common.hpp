@@ -24,7 +24,8 @@ double seconds_since(Clock::time_point t0);
 // history, probes, snapshots). A restart (resuming) keeps the snapshot files: the regions keep
 // those of the steps before the checkpoint and drop the rest.
 std::filesystem::path prepare_output_dir(const std::string& out_dir, bool resuming);
-// Removes DIR/fem_NNNNN.h5 with NNNNN >= keep, and DIR/fem.xdmf.
+// Removes DIR/fem.xdmf, DIR/fem.h5 when keep is 0 (a restart keeps it), and the files of the
+// earlier one-file-per-snapshot layout, DIR/fem_NNNNN.h5 with NNNNN >= keep.
 void remove_fem_snapshots(const std::string& out_dir, int keep);
 
 // The particle snapshots a checkpoint lists (the run before a restart), and how the regions

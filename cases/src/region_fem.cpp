@@ -1,5 +1,5 @@
 // The FEM region of the run loop (a case with an FEM region and no MPM bodies): probes sampled
-// from the FE field, HDF5 + XDMF snapshots through deal.II's DataOut (fem_NNNNN.h5 + fem.xdmf).
+// from the FE field, HDF5 + XDMF snapshots (fem.h5 + fem.xdmf).
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -49,7 +49,10 @@ class FemRegion final : public Region {
     s_.resume_snapshots(out_dir, "fem");
   }
   void write_snapshot(const std::string& out_dir) override { s_.write_snapshot(out_dir, "fem"); }
-  void finish() override { s_.update_energies(); }
+  void finish() override {
+    s_.close_snapshots();
+    s_.update_energies();
+  }
 
   void rates(RunResult& r, long steps_run, double step_seconds) const override {
     r.dofs = s_.dofs();

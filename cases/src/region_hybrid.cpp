@@ -1,6 +1,6 @@
 // The hybrid region of the run loop (MPM + FEM coupled): each probe read from the region holding
 // its point, the energy terms of both regions summed, particle snapshots (particles.h5/.xdmf) and
-// FEM snapshots (fem_NNNNN.h5 + fem.xdmf), both regions' blocks in summary.json.
+// FEM snapshots (fem.h5 + fem.xdmf), both regions' blocks in summary.json.
 #include <algorithm>
 #include <array>
 #include <filesystem>
@@ -77,6 +77,7 @@ class HybridRegion final : public Region {
   }
   void finish() override {
     snap_.close();
+    fe_.close_snapshots();
     hy_.update_energies();
   }
 

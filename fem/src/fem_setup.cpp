@@ -1,6 +1,6 @@
 // FEM far-field setup with deal.II: mesh in, dofs numbered by node, lumped mass, stiffness in a
 // node-block CSR, LK dashpot blocks, traction load vectors, the element bound on the time step,
-// probes and DataOut snapshots. The time stepping itself is in fem_kernels.cpp (no deal.II).
+// probes and snapshots. The time stepping itself is in fem_kernels.cpp (no deal.II).
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/dofs/dof_handler.h>
@@ -14,9 +14,6 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria.h>
 #include <deal.II/lac/vector.h>
-#include <deal.II/numerics/data_out.h>
-#include <deal.II/numerics/data_postprocessor.h>
-#include <mpi.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -31,6 +28,8 @@
 
 #include "fem_impl.hpp"
 #include "silentmpm/dashpot.hpp"
+#include "silentmpm/material.hpp"
+#include "silentmpm/output.hpp"
 
 namespace smpm::fem {
 
@@ -41,46 +40,9 @@ struct Deal {
   std::unique_ptr<FESystem<2>> fe;
   DoFHandler<2> dofh;
   MappingQ<2> mapping{1};
-  std::vector<XDMFEntry> xdmf;
-  std::vector<double> xdmf_times;  // each entry's time, written with full precision (below)
+  MeshSnapshotWriter snap;  // DIR/BASE.h5 + BASE.xdmf (Solver::write_snapshot)
   Deal() : dofh(tria) {}
 };
-
-// deal.II writes the XDMF time values with 6 digits, the particles' file with 10: a reader
-// then pairs an FE snapshot with the wrong particle one. Rewrite them as the particles' file
-// does (%.9e), in order, through a temporary file and a rename. The file is also declared
-// XDMF 3 (its elements are valid XDMF 3; readers such as meshio refuse version 2.0), as the
-// particles' file is.
-static void rewrite_xdmf_times(const std::string& path, const std::vector<double>& times) {
-  std::ifstream in(path);
-  std::stringstream buf;
-  buf << in.rdbuf();
-  std::string text = buf.str(), outtext;
-  const std::string v2 = "<Xdmf Version=\"2.0\"";
-  if (const std::size_t v = text.find(v2); v != std::string::npos)
-    text.replace(v, v2.size(), "<Xdmf Version=\"3.0\"");
-  const std::string key = "<Time Value=\"";
-  std::size_t pos = 0, k = 0;
-  while (true) {
-    const std::size_t a = text.find(key, pos);
-    if (a == std::string::npos || k >= times.size()) break;
-    const std::size_t b = text.find('"', a + key.size());
-    if (b == std::string::npos) break;
-    char v[40];
-    std::snprintf(v, sizeof v, "%.9e", times[k++]);
-    outtext += text.substr(pos, a + key.size() - pos) + v;
-    pos = b;
-  }
-  outtext += text.substr(pos);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream o(tmp);
-    o << outtext;
-    o.flush();
-    if (!o) throw std::runtime_error(path + ": cannot write");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error(path + ": cannot rename");
-}
 
 Solver::Impl::Impl() = default;
 Solver::Impl::~Impl() = default;
@@ -116,21 +78,6 @@ std::string deal_message(const std::exception& e) {
   return out;
 }
 
-void ensure_mpi() {
-  int init = 0;
-  MPI_Initialized(&init);
-  if (init) return;
-  int fin = 0;
-  MPI_Finalized(&fin);
-  if (fin) return;
-  MPI_Init(nullptr, nullptr);
-  std::atexit([] {
-    int f = 0;
-    MPI_Finalized(&f);
-    if (!f) MPI_Finalize();
-  });
-}
-
 // Key of a cell's shape and material: cells with equal keys have equal element matrices.
 std::vector<long long> cell_key(const Triangulation<2>::active_cell_iterator& cell) {
   const Point<2> v0 = cell->vertex(0);
@@ -144,31 +91,6 @@ std::vector<long long> cell_key(const Triangulation<2>::active_cell_iterator& ce
   return k;
 }
 
-class StressPostprocessor : public DataPostprocessor<2> {
- public:
-  StressPostprocessor(const std::vector<Material>& mats, const std::map<int, int>& region)
-      : mats_(mats), region_(region) {}
-  void evaluate_vector_field(const DataPostprocessorInputs::Vector<2>& in,
-                             std::vector<Vector<double>>& out) const override {
-    const auto cell = in.template get_cell<2>();
-    const Material& m = mats_[region_.at(static_cast<int>(cell->material_id()))];
-    for (unsigned q = 0; q < in.solution_gradients.size(); ++q) {
-      const auto& g = in.solution_gradients[q];
-      const double exx = g[0][0], eyy = g[1][1], gxy = g[0][1] + g[1][0];
-      const double tr = exx + eyy;
-      out[q](0) = m.lambda * tr + 2 * m.mu * exx;
-      out[q](1) = m.lambda * tr + 2 * m.mu * eyy;
-      out[q](2) = m.lambda * tr;
-      out[q](3) = m.mu * gxy;
-    }
-  }
-  std::vector<std::string> get_names() const override { return {"sxx", "syy", "szz", "sxy"}; }
-  UpdateFlags get_needed_update_flags() const override { return update_gradients; }
-
- private:
-  const std::vector<Material>& mats_;
-  const std::map<int, int>& region_;
-};
 
 }  // namespace
 
@@ -367,8 +289,8 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
 }  // namespace
 
 Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
-  // No MPI here: the serial triangulation, dofs and matrices do not use it, and MPI_Init (it
-  // starts OpenMPI's orted) costs ~0.04 s CPU and ~0.35 s wall; write_snapshot starts it.
+  // No MPI: the serial triangulation, dofs and matrices do not use it, and MPI_Init (it starts
+  // OpenMPI's orted) costs ~0.04 s CPU and ~0.35 s wall; the snapshots are written without it.
   Impl& m = *impl_;
   m.spec = spec;
   m.deal = std::make_unique<Deal>();
@@ -793,52 +715,96 @@ int Solver::add_probe(double x, double y) {
   return static_cast<int>(m.probes.size()) - 1;
 }
 
-// The patches of a snapshot (displacement, velocity, stresses, material) and their filter. The
-// vectors and the postprocessor live in the struct because DataOut keeps references to them.
-struct SnapshotPatches {
-  Vector<double> u, v;
-  Vector<float> mat;
-  StressPostprocessor post;
-  DataOut<2> out;
-  DataOutBase::DataOutFilter filter{DataOutBase::DataOutFilterFlags(true, true)};
-  SnapshotPatches(const Solver::Impl& m, const Deal& d)
-      : u(m.u.begin(), m.u.end()), v(m.v.begin(), m.v.end()), mat(d.tria.n_active_cells()),
-        post(m.spec.materials, m.spec.region_material) {
-    for (const auto& cell : d.tria.active_cell_iterators())
-      mat[cell->active_cell_index()] = static_cast<float>(cell->material_id());
-    const std::vector<DataComponentInterpretation::DataComponentInterpretation> vec(
-        2, DataComponentInterpretation::component_is_part_of_vector);
-    out.attach_dof_handler(d.dofh);
-    out.add_data_vector(u, std::vector<std::string>(2, "displacement"), DataOut<2>::type_dof_data,
-                        vec);
-    out.add_data_vector(v, std::vector<std::string>(2, "velocity"), DataOut<2>::type_dof_data, vec);
-    out.add_data_vector(u, post);
-    out.add_data_vector(mat, "material", DataOut<2>::type_cell_data);
-    out.build_patches(d.mapping, m.degree);
-    out.write_filtered_data(filter);
+// Snapshots (MeshSnapshotWriter): the mesh once, a Q1 cell as it is and a Q2 cell as the four
+// quadrilaterals of its nine nodes (counter-clockwise; the base element's nodes: vertices
+// (0,0) (1,0) (0,1) (1,1), then the lines x = 0, x = 1, y = 0, y = 1, then the centre).
+static void snapshot_mesh(const Solver::Impl& m, const Deal& d, std::vector<double>& xyz,
+                          std::vector<std::int64_t>& cells, std::vector<std::int32_t>& material) {
+  const std::size_t nn = m.x.size();
+  xyz.assign(3 * nn, 0.0);
+  for (std::size_t i = 0; i < nn; ++i) {
+    xyz[3 * i] = m.x[i];
+    xyz[3 * i + 1] = m.y[i];
   }
-};
-
-static std::string snapshot_file(const std::string& base, int k) {
-  char num[16];
-  std::snprintf(num, sizeof num, "_%05d", k);
-  return base + num + ".h5";
+  static const int q1[1][4] = {{0, 1, 3, 2}};
+  static const int q2[4][4] = {{0, 6, 8, 4}, {6, 1, 5, 8}, {4, 8, 7, 2}, {8, 5, 3, 7}};
+  const int nb = (m.degree + 1) * (m.degree + 1), parts = m.degree == 1 ? 1 : 4;
+  const int(*sub)[4] = m.degree == 1 ? q1 : q2;
+  cells.clear();
+  material.clear();
+  std::size_t c = 0;
+  for (const auto& cell : d.tria.active_cell_iterators()) {
+    const std::uint32_t* cn = m.cell_nodes.data() + c * nb;
+    for (int s = 0; s < parts; ++s) {
+      for (int a = 0; a < 4; ++a) cells.push_back(cn[sub[s][a]]);
+      material.push_back(static_cast<std::int32_t>(cell->material_id()));
+    }
+    ++c;
+  }
 }
 
 void Solver::write_snapshot(const std::string& dir, const std::string& base) {
-  ensure_mpi();  // deal.II's HDF5/XDMF writers take MPI_COMM_WORLD
   Impl& m = *impl_;
   Deal& d = *m.deal;
-  namespace fs = std::filesystem;
-  const std::string h5 = snapshot_file(base, m.snapshots);
-  SnapshotPatches sp(m, d);
+  const std::size_t nn = m.x.size();
   try {
-    sp.out.write_hdf5_parallel(sp.filter, (fs::path(dir) / h5).string(), MPI_COMM_WORLD);
-    d.xdmf.push_back(sp.out.create_xdmf_entry(sp.filter, h5, t, MPI_COMM_WORLD));
-    d.xdmf_times.push_back(t);
-    const std::string path = (fs::path(dir) / (base + ".xdmf")).string();
-    sp.out.write_xdmf_file(d.xdmf, path, MPI_COMM_WORLD);
-    rewrite_xdmf_times(path, d.xdmf_times);
+    if (!d.snap.is_open()) {
+      std::vector<double> xyz;
+      std::vector<std::int64_t> cells;
+      std::vector<std::int32_t> material;
+      snapshot_mesh(m, d, xyz, cells, material);
+      d.snap.open(dir, base, xyz, cells, material);
+    }
+    // Displacement and velocity as 3-vectors; the stress and J2 at the nodes, each node's the
+    // mean of what its cells give there (their displacement gradients at the node).
+    std::vector<double> disp(3 * nn, 0.0), vel(3 * nn, 0.0), sig(9 * nn, 0.0), j2(nn, 0.0);
+    for (std::size_t i = 0; i < nn; ++i)
+      for (int k = 0; k < 2; ++k) {
+        disp[3 * i + k] = m.u[2 * i + k];
+        vel[3 * i + k] = m.v[2 * i + k];
+      }
+    const FiniteElement<2>& fe0 = d.fe->base_element(0);
+    const Quadrature<2> at_nodes(fe0.get_unit_support_points());
+    FEValues<2> fv(d.mapping, *d.fe, at_nodes, update_gradients);
+    const Vector<double> u(m.u.begin(), m.u.end());
+    const unsigned nb = fe0.n_dofs_per_cell();
+    std::vector<std::vector<Tensor<1, 2>>> grad(nb, std::vector<Tensor<1, 2>>(2));
+    std::vector<double> acc(4 * nn, 0.0);
+    std::vector<std::uint32_t> count(nn, 0);
+    std::size_t c = 0;
+    for (const auto& cell : d.dofh.active_cell_iterators()) {
+      fv.reinit(cell);
+      fv.get_function_gradients(u, grad);
+      const Material& mat = m.spec.materials[m.spec.region_material.at(
+          static_cast<int>(cell->material_id()))];
+      for (unsigned b = 0; b < nb; ++b) {
+        const std::uint32_t i = m.cell_nodes[c * nb + b];
+        const double exx = grad[b][0][0], eyy = grad[b][1][1], gxy = grad[b][0][1] + grad[b][1][0];
+        const double tr = exx + eyy;
+        acc[4 * i] += mat.lambda * tr + 2 * mat.mu * exx;
+        acc[4 * i + 1] += mat.lambda * tr + 2 * mat.mu * eyy;
+        acc[4 * i + 2] += mat.lambda * tr;
+        acc[4 * i + 3] += mat.mu * gxy;
+        ++count[i];
+      }
+      ++c;
+    }
+    for (std::size_t i = 0; i < nn; ++i) {
+      if (count[i] == 0) continue;
+      const double w = 1.0 / count[i];
+      const double sxx = acc[4 * i] * w, syy = acc[4 * i + 1] * w, szz = acc[4 * i + 2] * w,
+                   sxy = acc[4 * i + 3] * w;
+      double* S = sig.data() + 9 * i;
+      S[0] = sxx;
+      S[1] = S[3] = sxy;
+      S[4] = syy;
+      S[8] = szz;
+      j2[i] = j2_of(sxx, syy, szz, sxy);
+    }
+    d.snap.write(t, {{"displacement", 3, "m", disp.data()},
+                     {"velocity", 3, "m/s", vel.data()},
+                     {"stress", 9, "Pa", sig.data()},
+                     {"J2", 1, "Pa^2", j2.data()}});
   } catch (const std::exception& e) {
     throw FemError(dir + ": cannot write the FEM snapshot: " + deal_message(e));
   }
@@ -846,34 +812,21 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   ++m.snapshots;
 }
 
+void Solver::close_snapshots() {
+  try {
+    impl_->deal->snap.close();
+  } catch (const std::exception& e) {
+    throw FemError(std::string("cannot close the FEM snapshots: ") + e.what());
+  }
+}
+
 int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
-  Deal& d = *m.deal;
-  namespace fs = std::filesystem;
-  d.xdmf.clear();
-  d.xdmf_times.clear();
-  const std::vector<double>& times = m.snapshot_times;
-  if (times.empty()) return 0;
-  ensure_mpi();
-  SnapshotPatches sp(m, d);  // the same mesh and fields as every earlier snapshot
-  int found = 0;
-  for (std::size_t k = 0; k < times.size(); ++k) {
-    const std::string h5 = snapshot_file(base, static_cast<int>(k));
-    std::error_code ec;
-    if (!fs::is_regular_file(fs::path(dir) / h5, ec)) continue;
-    d.xdmf.push_back(sp.out.create_xdmf_entry(sp.filter, h5, times[k], MPI_COMM_WORLD));
-    d.xdmf_times.push_back(times[k]);
-    ++found;
-  }
-  if (found == 0) return 0;
-  const std::string path = (fs::path(dir) / (base + ".xdmf")).string();
   try {
-    sp.out.write_xdmf_file(d.xdmf, path, MPI_COMM_WORLD);
-    rewrite_xdmf_times(path, d.xdmf_times);
+    return m.deal->snap.resume(dir, base, m.snapshot_times);
   } catch (const std::exception& e) {
-    throw FemError(path + ": cannot write: " + deal_message(e));
+    throw FemError(dir + ": cannot reopen the FEM snapshots: " + deal_message(e));
   }
-  return found;
 }
 
 std::vector<std::string> Solver::describe() const {

@@ -22,6 +22,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -531,49 +532,286 @@ std::string SnapshotWriter::xdmf_text() const {
   return s + kXdmfTail;
 }
 
-void SnapshotWriter::write_xdmf() {
-  const std::string path = dir_ + "/" + base_ + ".xdmf";
+namespace {
+
+// The XDMF document `text` written whole through a temporary file and a rename; returns the
+// offset of its tail (the last tail_size bytes). Throws std::runtime_error.
+long long write_xdmf_whole(const std::string& path, const std::string& text, std::size_t tail_size) {
   const std::string tmp = path + ".tmp";
-  const std::string s = xdmf_text();
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f)
     throw std::runtime_error("cannot open XDMF file '" + tmp + "' for writing: " +
                              std::strerror(errno));
-  const bool ok = std::fwrite(s.data(), 1, s.size(), f) == s.size() && std::fflush(f) == 0;
+  const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0;
   const int err = errno;
   const bool closed = std::fclose(f) == 0;
   if (!ok || !closed) {
     const std::string why = std::strerror(ok ? errno : err);
     std::remove(tmp.c_str());
-    xdmf_end_ = -1;
     throw std::runtime_error("cannot write XDMF file '" + tmp + "': " + why);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string err = std::strerror(errno);
+    const std::string err2 = std::strerror(errno);
     std::remove(tmp.c_str());
-    xdmf_end_ = -1;
-    throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + err);
+    throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + err2);
   }
-  xdmf_end_ = static_cast<long long>(s.size() - std::strlen(kXdmfTail));
+  return static_cast<long long>(text.size() - tail_size);
 }
 
-void SnapshotWriter::append_xdmf() {
-  if (xdmf_end_ < 0) return write_xdmf();
-  const std::string path = dir_ + "/" + base_ + ".xdmf";
-  const std::string grid = xdmf_grid(steps_.size() - 1);
+// One more grid written over the tail at `end`, with the tail after it; `end` moves past the grid.
+// Returns false when the file is gone (write it whole instead). Throws std::runtime_error.
+bool append_xdmf_grid(const std::string& path, long long& end, const std::string& grid) {
   const std::string s = grid + kXdmfTail;
   std::FILE* f = std::fopen(path.c_str(), "r+b");
-  if (!f) return write_xdmf();  // removed meanwhile: write it whole again
-  const bool ok = std::fseek(f, static_cast<long>(xdmf_end_), SEEK_SET) == 0 &&
+  if (!f) return false;
+  const bool ok = std::fseek(f, static_cast<long>(end), SEEK_SET) == 0 &&
                   std::fwrite(s.data(), 1, s.size(), f) == s.size() && std::fflush(f) == 0;
   const int err = errno;
   const bool closed = std::fclose(f) == 0;
   if (!ok || !closed) {
-    xdmf_end_ = -1;  // the next snapshot rewrites the file whole
+    end = -1;  // the next snapshot rewrites the file whole
     throw std::runtime_error("cannot write XDMF file '" + path + "': " +
                              std::strerror(ok ? errno : err));
   }
-  xdmf_end_ += static_cast<long long>(grid.size());
+  end += static_cast<long long>(grid.size());
+  return true;
+}
+
+}  // namespace
+
+void SnapshotWriter::write_xdmf() {
+  xdmf_end_ = -1;
+  xdmf_end_ = write_xdmf_whole(dir_ + "/" + base_ + ".xdmf", xdmf_text(), std::strlen(kXdmfTail));
+}
+
+void SnapshotWriter::append_xdmf() {
+  if (xdmf_end_ < 0 ||
+      !append_xdmf_grid(dir_ + "/" + base_ + ".xdmf", xdmf_end_, xdmf_grid(steps_.size() - 1)))
+    write_xdmf();
+}
+
+// ------------------------------------------------------------------------------------------------
+// MeshSnapshotWriter
+
+namespace {
+std::string snapshot_group(std::size_t k) {
+  char b[32];
+  std::snprintf(b, sizeof b, "snapshot_%05zu", k);
+  return b;
+}
+
+hid_t open_unlocked(const std::string& path, bool create) {
+  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+#if H5_VERSION_GE(1, 10, 7)
+  H5Pset_file_locking(fapl.id, 0, 1);
+#endif
+  return create ? H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id)
+                : H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
+}
+
+// Rows and columns of a dataset (columns 1 for a 1-D one); false when it is missing.
+bool dataset_shape(hid_t f, const std::string& name, hsize_t& rows, hsize_t& cols) {
+  if (H5Lexists(f, name.c_str(), H5P_DEFAULT) <= 0) return false;
+  H5Handle ds(H5Dopen2(f, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (ds.id < 0) return false;
+  H5Handle sp(H5Dget_space(ds.id), H5Sclose);
+  hsize_t dims[2] = {0, 1};
+  const int rank = H5Sget_simple_extent_dims(sp.id, dims, nullptr);
+  if (rank < 1 || rank > 2) return false;
+  rows = dims[0];
+  cols = rank == 2 ? dims[1] : 1;
+  return true;
+}
+}  // namespace
+
+MeshSnapshotWriter::~MeshSnapshotWriter() {
+  try {
+    close();
+  } catch (...) {
+  }
+}
+
+void MeshSnapshotWriter::open(const std::string& dir, const std::string& base,
+                              const std::vector<double>& xyz, const std::vector<std::int64_t>& cells,
+                              const std::vector<std::int32_t>& material) {
+  close();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  dir_ = dir.empty() ? std::string(".") : dir;
+  base_ = base;
+  times_.clear();
+  names_.clear();
+  units_.clear();
+  components_.clear();
+  nodes_ = xyz.size() / 3;
+  cells_ = cells.size() / 4;
+  if (material.size() != cells_)
+    throw std::runtime_error("MeshSnapshotWriter: " + std::to_string(material.size()) +
+                             " materials for " + std::to_string(cells_) + " cells");
+  const std::string path = dir_ + "/" + base_ + ".h5";
+  const hid_t f = open_unlocked(path, true);
+  if (f < 0) h5_fail("cannot create the snapshot file (does the output directory exist?)", path);
+  file_ = f;
+  H5Handle mesh(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  if (mesh.id < 0) h5_fail("cannot create group '/mesh'", path);
+  write_dataset(mesh.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), nodes_, 3, path,
+                "mesh", "m");
+  write_dataset(mesh.id, "cells", H5T_STD_I64LE, H5T_NATIVE_INT64, cells.data(), cells_, 4, path,
+                "mesh", "1");
+  write_dataset(mesh.id, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, material.data(), cells_, 1,
+                path, "mesh", "1");
+  if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
+  xdmf_end_ = -1;
+}
+
+int MeshSnapshotWriter::resume(const std::string& dir, const std::string& base,
+                               const std::vector<double>& times) {
+  close();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const std::string path = (dir.empty() ? std::string(".") : dir) + "/" + base + ".h5";
+  if (times.empty()) return 0;
+  hid_t f = open_unlocked(path, false);
+  hsize_t rows = 0, cols = 0, crow = 0;
+  bool whole = f >= 0 && dataset_shape(f, "/mesh/xyz", rows, cols) &&
+               dataset_shape(f, "/mesh/cells", crow, cols);
+  for (std::size_t k = 0; whole && k < times.size(); ++k)
+    whole = H5Lexists(f, snapshot_group(k).c_str(), H5P_DEFAULT) > 0;
+  if (!whole) {
+    if (f >= 0) H5Fclose(f);
+    H5Eclear2(H5E_DEFAULT);
+    return 0;
+  }
+  dir_ = dir.empty() ? std::string(".") : dir;
+  base_ = base;
+  file_ = f;
+  nodes_ = rows;
+  cells_ = crow;
+  for (std::size_t k = times.size();; ++k) {  // the later snapshots of the run that stopped
+    const std::string g = snapshot_group(k);
+    if (H5Lexists(f, g.c_str(), H5P_DEFAULT) <= 0) break;
+    if (H5Ldelete(f, g.c_str(), H5P_DEFAULT) < 0) h5_fail("cannot remove '/" + g + "'", path);
+  }
+  // The fields, from the first snapshot, with their units: H5Literate goes by name, the order
+  // in which write() lists them.
+  names_.clear();
+  units_.clear();
+  components_.clear();
+  std::vector<std::string> names;
+  H5Handle g0(H5Gopen2(f, snapshot_group(0).c_str(), H5P_DEFAULT), H5Gclose);
+  if (g0.id < 0 || H5Literate(g0.id, H5_INDEX_NAME, H5_ITER_NATIVE, nullptr, collect_name, &names) < 0)
+    h5_fail("cannot list the fields of '/" + snapshot_group(0) + "'", path);
+  for (const auto& n : names) {
+    hsize_t r = 0, c = 0;
+    if (!dataset_shape(f, "/" + snapshot_group(0) + "/" + n, r, c)) continue;
+    names_.push_back(n);
+    components_.push_back(static_cast<int>(c));
+    std::string u;
+    H5Handle ds(H5Dopen2(f, ("/" + snapshot_group(0) + "/" + n).c_str(), H5P_DEFAULT), H5Dclose);
+    if (ds.id >= 0 && H5Aexists(ds.id, "units") > 0) {
+      H5Handle a(H5Aopen(ds.id, "units", H5P_DEFAULT), H5Aclose);
+      H5Handle t(H5Aget_type(a.id), H5Tclose);
+      u.assign(H5Tget_size(t.id), '\0');
+      if (H5Aread(a.id, t.id, u.data()) < 0) u.clear();
+      u.resize(std::strlen(u.c_str()));
+    }
+    units_.push_back(u);
+  }
+  if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
+  times_ = times;
+  xdmf_end_ = write_xdmf_whole(dir_ + "/" + base_ + ".xdmf", xdmf_text(), std::strlen(kXdmfTail));
+  return static_cast<int>(times.size());
+}
+
+void MeshSnapshotWriter::write(double time, const std::vector<Field>& fields) {
+  const std::string path = dir_ + "/" + base_ + ".h5";
+  if (file_ < 0) throw std::runtime_error("MeshSnapshotWriter::write called before open()");
+  const hid_t f = static_cast<hid_t>(file_);
+  if (times_.empty() && names_.empty()) {  // listed by name, as resume() finds them
+    std::vector<const Field*> order;
+    for (const Field& fd : fields) order.push_back(&fd);
+    std::sort(order.begin(), order.end(),
+              [](const Field* a, const Field* b) { return std::strcmp(a->name, b->name) < 0; });
+    for (const Field* fd : order) {
+      names_.push_back(fd->name);
+      units_.push_back(fd->units);
+      components_.push_back(fd->components);
+    }
+  }
+  const std::string g = snapshot_group(times_.size());
+  H5Handle grp(H5Gcreate2(f, g.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  if (grp.id < 0) h5_fail("cannot create group '/" + g + "'", path);
+  write_scalar_attribute(grp.id, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, time, path, g);
+  for (const Field& fd : fields)
+    write_dataset(grp.id, fd.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fd.data, nodes_,
+                  static_cast<std::size_t>(fd.components), path, g, fd.units);
+  if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
+  times_.push_back(time);
+  const std::string xpath = dir_ + "/" + base_ + ".xdmf";
+  if (xdmf_end_ < 0 || !append_xdmf_grid(xpath, xdmf_end_, xdmf_grid(times_.size() - 1))) {
+    xdmf_end_ = -1;
+    xdmf_end_ = write_xdmf_whole(xpath, xdmf_text(), std::strlen(kXdmfTail));
+  }
+}
+
+void MeshSnapshotWriter::close() {
+  if (file_ < 0) return;
+  const hid_t f = static_cast<hid_t>(file_);
+  file_ = -1;
+  if (H5Fclose(f) < 0) h5_fail("cannot close", dir_ + "/" + base_ + ".h5");
+}
+
+std::string MeshSnapshotWriter::xdmf_grid(std::size_t k) const {
+  const std::string h5 = xml_escape(base_ + ".h5");
+  const std::string g = snapshot_group(k);
+  char buf[2048];
+  std::snprintf(buf, sizeof buf,
+                "      <Grid Name=\"%s\" GridType=\"Uniform\">\n"
+                "        <Time Value=\"%.9e\"/>\n"
+                "        <Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"%zu\">\n"
+                "          <DataItem Dimensions=\"%zu 4\" NumberType=\"Int\" Precision=\"8\" "
+                "Format=\"HDF\">%s:/mesh/cells</DataItem>\n"
+                "        </Topology>\n"
+                "        <Geometry GeometryType=\"XYZ\">\n"
+                "          <DataItem Dimensions=\"%zu 3\" NumberType=\"Float\" Precision=\"8\" "
+                "Format=\"HDF\">%s:/mesh/xyz</DataItem>\n"
+                "        </Geometry>\n"
+                "        <Attribute Name=\"material\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
+                "          <DataItem Dimensions=\"%zu\" NumberType=\"Int\" Precision=\"4\" "
+                "Format=\"HDF\">%s:/mesh/material</DataItem>\n"
+                "        </Attribute>\n",
+                g.c_str(), times_[k], cells_, cells_, h5.c_str(), nodes_, h5.c_str(), cells_,
+                h5.c_str());
+  std::string s = buf;
+  for (std::size_t q = 0; q < names_.size(); ++q) {
+    const int c = components_[q];
+    char dims[64];
+    if (c == 1) std::snprintf(dims, sizeof dims, "%zu", nodes_);
+    else std::snprintf(dims, sizeof dims, "%zu %d", nodes_, c);
+    std::snprintf(buf, sizeof buf,
+                  "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n"
+                  "          <DataItem Dimensions=\"%s\" NumberType=\"Float\" Precision=\"8\" "
+                  "Format=\"HDF\">%s:/%s/%s</DataItem>\n"
+                  "        </Attribute>\n",
+                  names_[q].c_str(), attribute_type(c), dims, h5.c_str(), g.c_str(),
+                  names_[q].c_str());
+    s += buf;
+  }
+  return s + "      </Grid>\n";
+}
+
+std::string MeshSnapshotWriter::xdmf_text() const {
+  std::string s;
+  s += "<?xml version=\"1.0\" ?>\n";
+  s += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
+  s += "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n";
+  s += "  <Domain>\n";
+  std::string units = "xyz m";
+  for (std::size_t q = 0; q < names_.size(); ++q)
+    if (!units_[q].empty()) units += ", " + names_[q] + " " + units_[q];
+  s += "    <Information Name=\"units\" Value=\"" + xml_escape(units) + "\"/>\n";
+  s += "    <Grid Name=\"" + xml_escape(base_) +
+       "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (std::size_t k = 0; k < times_.size(); ++k) s += xdmf_grid(k);
+  return s + kXdmfTail;
 }
 
 }  // namespace smpm

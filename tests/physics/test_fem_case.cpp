@@ -4,6 +4,7 @@
 // uniaxial-strain plateau sigma_xx = -sigma0, sigma_yy = nu/(1-nu) sigma_xx, div u = -sigma0/M,
 // v_x = sigma0/(rho c_d); the energy balance closes.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <cmath>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "silentmpm/case.hpp"
 #include "silentmpm/driver.hpp"
 #include "silentmpm/history.hpp"
+#include "silentmpm/material.hpp"
 
 using namespace smpm;
 using namespace smpm::fem_testing;
@@ -80,18 +82,51 @@ TEST(FemCase, RunsThroughTheDriver) {
   EXPECT_NEAR(hst.column("A.curl")[last], 0.0, 1e-6 * sigma0 / w.M);
   EXPECT_NEAR(hst.column("A.vx")[last], sigma0 / (w.rho * w.cd), 0.02 * sigma0 / (w.rho * w.cd));
 
-  // Snapshots: fem.xdmf lists every HDF5 file, and they exist.
+  // Snapshots: one fem.h5 (the mesh once, a group per snapshot) listed in fem.xdmf; the last
+  // one's nodal stress on the plateau behind the front is the uniaxial-strain state.
   std::ifstream xf(out / "fem.xdmf");
   ASSERT_TRUE(xf.good());
   const std::string x((std::istreambuf_iterator<char>(xf)), std::istreambuf_iterator<char>());
   for (int i = 0; i < snaps; ++i) {
-    char name[32];
-    std::snprintf(name, sizeof name, "fem_%05d.h5", i);
+    char name[40];
+    std::snprintf(name, sizeof name, "fem.h5:/snapshot_%05d/stress", i);
     EXPECT_NE(x.find(name), std::string::npos) << name;
-    EXPECT_TRUE(fs::exists(out / name)) << name;
   }
-  for (const char* field : {"displacement", "velocity", "sxx", "sxy", "material"})
+  for (const char* field : {"displacement\" AttributeType=\"Vector", "velocity\" AttributeType=\"Vector",
+                            "stress\" AttributeType=\"Tensor", "J2\" AttributeType=\"Scalar",
+                            "material\" AttributeType=\"Scalar\" Center=\"Cell"})
     EXPECT_NE(x.find(std::string("Name=\"") + field + "\""), std::string::npos) << field;
+  const hid_t f = H5Fopen((out / "fem.h5").string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  auto read = [&](const std::string& name, std::size_t n) {
+    std::vector<double> v(n);
+    const hid_t ds = H5Dopen2(f, name.c_str(), H5P_DEFAULT);
+    EXPECT_GE(ds, 0) << name;
+    if (ds >= 0) {
+      EXPECT_GE(H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0) << name;
+      H5Dclose(ds);
+    }
+    return v;
+  };
+  const std::size_t nn = 121u * 3u;
+  char last_group[32];
+  std::snprintf(last_group, sizeof last_group, "/snapshot_%05d/", snaps - 1);
+  const auto xyz = read("/mesh/xyz", 3 * nn);
+  const auto sig = read(std::string(last_group) + "stress", 9 * nn);
+  const auto j2 = read(std::string(last_group) + "J2", nn);
+  H5Fclose(f);
+  int plateau = 0;
+  for (std::size_t i = 0; i < nn; ++i) {
+    const double* S = sig.data() + 9 * i;
+    EXPECT_EQ(S[1], S[3]);
+    EXPECT_EQ(S[2] + S[5] + S[6] + S[7], 0.0);
+    EXPECT_EQ(j2[i], j2_of(S[0], S[4], S[8], S[1]));
+    if (xyz[3 * i] < 0.03 || xyz[3 * i] > 0.04) continue;
+    ++plateau;
+    EXPECT_NEAR(S[0], -sigma0, 0.02 * sigma0) << "node at x = " << xyz[3 * i];
+    EXPECT_NEAR(S[4], w.nu / (1 - w.nu) * S[0], 0.02 * sigma0 * w.nu / (1 - w.nu));
+  }
+  EXPECT_GE(plateau, 30);
   fs::remove_all(out);
 }
 

@@ -152,16 +152,19 @@ class Solver {
   // Updates `energy` (kinetic, elastic; absorbed and external work accumulate in step()).
   void update_energies();
 
-  // HDF5 + XDMF snapshots through DataOut: DIR/BASE_NNNNN.h5 and DIR/BASE.xdmf (rewritten each
-  // call with every snapshot so far). Fields: displacement, velocity, stress (xx, yy, zz, xy),
-  // material id.
+  // Snapshots: DIR/BASE.h5 (the mesh once, then a group per snapshot) and DIR/BASE.xdmf, which
+  // grows by one grid per snapshot (MeshSnapshotWriter of output.hpp). Node fields:
+  // displacement and velocity (3-vectors, m and m/s), stress (3 x 3 tensor, Pa; each node's the
+  // mean over its cells) and J2 (Pa^2); cell field material. Q2 cells are written as 4 quads.
   void write_snapshot(const std::string& dir, const std::string& base);
+  // Closes DIR/BASE.h5 (a later snapshot starts a new file). Throws FemError.
+  void close_snapshots();
   int snapshot_count() const;
   // The times of the snapshots written so far.
   std::vector<double> snapshot_times() const;
-  // After load_state: the earlier run's snapshots DIR/BASE_00000.h5 ... are listed again in
-  // BASE.xdmf (those whose file is missing are left out; numbering continues after them).
-  // Returns how many were found (0, and nothing written, without a checkpoint).
+  // After load_state: reopens DIR/BASE.h5 and lists the earlier run's snapshots in BASE.xdmf
+  // again (later ones are removed). Returns how many: all, or 0 when the file or one of them is
+  // missing (the next snapshot then starts the file afresh).
   int resume_snapshots(const std::string& dir, const std::string& base);
 
   // Checkpoints: the state a later step reads (u, v, -K u^n, clock, energies, snapshot times) as

@@ -102,4 +102,45 @@ class SnapshotWriter {
   std::string xdmf_text() const;
 };
 
+// Snapshots of a fixed mesh of quadrilaterals (the FE far field): DIR/<base>.h5 holds the mesh
+// once (/mesh/xyz N x 3, /mesh/cells M x 4 int64 counter-clockwise, /mesh/material M int32) and a
+// group /snapshot_NNNNN per snapshot (attribute "time") with node fields of N rows; DIR/<base>.xdmf
+// is an XDMF 3 temporal collection that grows by one grid per snapshot (as SnapshotWriter's).
+// Every dataset has an HDF5 attribute "units".
+class MeshSnapshotWriter {
+ public:
+  struct Field {
+    const char* name;
+    int components;  // 1 scalar, 3 vector, 9 tensor (row by row)
+    const char* units;
+    const double* data;  // N x components
+  };
+  MeshSnapshotWriter() = default;
+  ~MeshSnapshotWriter();
+  MeshSnapshotWriter(const MeshSnapshotWriter&) = delete;
+  MeshSnapshotWriter& operator=(const MeshSnapshotWriter&) = delete;
+  // Creates DIR/<base>.h5 (truncating) with the mesh. Throws std::runtime_error.
+  void open(const std::string& dir, const std::string& base, const std::vector<double>& xyz,
+            const std::vector<std::int64_t>& cells, const std::vector<std::int32_t>& material);
+  // Restart: reopens an earlier run's file, keeps its first `times.size()` snapshots and removes
+  // later ones; returns how many were kept: all, or 0 when the file or one of them is missing
+  // (then nothing is open: call open()). The fields of every snapshot are those of the first.
+  int resume(const std::string& dir, const std::string& base, const std::vector<double>& times);
+  bool is_open() const { return file_ >= 0; }
+  void write(double time, const std::vector<Field>& fields);
+  void close();
+  int count() const { return static_cast<int>(times_.size()); }
+
+ private:
+  long long file_ = -1;  // hid_t
+  std::string dir_, base_;
+  std::size_t nodes_ = 0, cells_ = 0;
+  std::vector<double> times_;
+  std::vector<std::string> names_, units_;  // the fields, as the first snapshot wrote them
+  std::vector<int> components_;
+  long long xdmf_end_ = -1;
+  std::string xdmf_grid(std::size_t k) const;
+  std::string xdmf_text() const;
+};
+
 }  // namespace smpm
