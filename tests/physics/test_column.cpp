@@ -2,6 +2,7 @@
 // reflects (free, LK silent layer in both its forms).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -621,3 +622,36 @@ TEST(HealthCheck, StretchedParticleStopsAtTheStabilityLimit) {
   }
 }
 
+
+// The snapshot's "layer" field: Solver::layer_flags marks exactly the particles of each boundary
+// condition, by their current place after re-sorting (bits: 1 silent, 2 traction, 4 springs,
+// 8 damping layer, 16 perfectly matched layer).
+TEST(Column, LayerFlagsMarkTheLayers) {
+  for (const End end : {End::Silent, End::KelvinVoigt}) {
+    ColumnSpec c;
+    c.cells = 40;
+    c.end = end;
+    c.delta = 1e-2;
+    c.damp_cells = 3;
+    c.scheme = Scheme::USL;
+    c.pml_cells = 5;
+    c.fn = sin2_pulse(1e-6, 0.5e-6);
+    auto s = make_column(c);
+    for (int n = 0; n < 20; ++n) s->step();
+    const auto f = s->layer_flags();
+    ASSERT_EQ(f.size(), s->p.size());
+    auto count = [&](std::uint8_t bit) {
+      return static_cast<std::size_t>(std::count_if(f.begin(), f.end(), [&](std::uint8_t v) { return (v & bit) != 0; }));
+    };
+    EXPECT_EQ(count(1), s->silents[0].layer.ids.size());
+    EXPECT_EQ(count(2), s->tractions[0].layer.ids.size());
+    EXPECT_EQ(count(4), end == End::KelvinVoigt ? s->silents[0].layer.ids.size() : 0u);
+    EXPECT_EQ(count(8), s->dampers[0].layer.ids.size());
+    EXPECT_EQ(count(16), s->pml.layer.ids.size());
+    EXPECT_GT(count(16), 0u);
+    for (std::size_t q = 0; q < s->pml.layer.idx.size(); ++q)
+      EXPECT_EQ(s->pml.layer.ids[q], s->p.id[s->pml.layer.idx[q]]);
+    for (std::size_t k = 0; k < f.size(); ++k)  // the traction acts on the left end only
+      if (f[k] & 2) EXPECT_LT(s->p.x[k], 2 * c.h) << k;
+  }
+}
