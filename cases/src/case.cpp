@@ -462,14 +462,29 @@ ProbeSpec parse_probe(Obj& o, const GridSpec& g, const std::vector<std::string>&
     if (o.has("at")) o.fail("at", "give either at (a point) or curve (points along a curve), not both");
     o.allow({"name", "curve", "count", "spacing", "reverse", "fields", "body"}, "for a probe along a curve");
   } else {
-    o.allow({"name", "at", "curve", "fields", "body"});
+    o.allow({"name", "at", "region", "curve", "fields", "body"});
+    if (o.has("at") && o.has("region"))
+      o.fail("region", "give either at (a point) or region (a box), not both");
   }
   ProbeSpec p;
   p.name = o.str("name");
   static const std::regex ok("[A-Za-z0-9_]+");
   if (!std::regex_match(p.name, ok))
     o.fail("name", "must be letters, digits and _ only, got \"" + p.name + "\"");
-  if (!along_curve) {
+  if (!along_curve && o.has("region")) {
+    const auto r = o.nums("region", 4);
+    if (!(r[0] < r[2] && r[1] < r[3]))
+      o.fail("region", "must be [x0, y0, x1, y1] with x0 < x1 and y0 < y1, got " + fmt_list(r));
+    if (!(r[0] < g.x1() && r[2] > g.x0 && r[1] < g.y1() && r[3] > g.y0))
+      o.fail("region", "outside the grid " + g.describe() + ": " + fmt_list(r));
+    p.region = true;
+    p.rx0 = r[0];
+    p.ry0 = r[1];
+    p.rx1 = r[2];
+    p.ry1 = r[3];
+    p.x = 0.5 * (r[0] + r[2]);
+    p.y = 0.5 * (r[1] + r[3]);
+  } else if (!along_curve) {
     const auto at = o.nums("at", 2);
     p.x = at[0];
     p.y = at[1];
@@ -586,6 +601,14 @@ class Builder {
     for (std::size_t q = 0; q < c.probes.size(); ++q) {
       const ProbeSpec& pr = c.probes[q];
       if (!pr.along.empty()) continue;
+      if (pr.region) {
+        if (!s_->region_mean(pr.rx0, pr.ry0, pr.rx1, pr.ry1, pr.body).valid)
+          ctx_.fail(index_path("probes", probe_doc_[q]) + ".region",
+                    fmt_list({pr.rx0, pr.ry0, pr.rx1, pr.ry1}) + " holds no particle" +
+                        (pr.body >= 0 ? " of body \"" + bodies_[pr.body].name + "\"" : std::string()) +
+                        ", so it would record zeros");
+        continue;
+      }
       const auto smp = s_->sample({{pr.x, pr.y}}, {pr.body});
       if (!smp[0].valid)
         ctx_.fail(index_path("probes", probe_doc_[q]) + ".at",

@@ -44,7 +44,9 @@ class HybridRegion final : public Region {
     std::size_t k = 0, q_mpm = 0;
     for (const auto& pr : c_.probes) {
       if (pr.fem_index < 0) {
-        const ProbeSample& sm = ms[q_mpm++];
+        const ProbeSample sm =
+            pr.region ? s_.region_mean(pr.rx0, pr.ry0, pr.rx1, pr.ry1, pr.body) : ms[q_mpm];
+        ++q_mpm;
         for (const auto& f : pr.fields) row[k++] = probe_field(sm, f);
       } else {
         for (const auto& f : pr.fields) row[k++] = probe_field(fs[pr.fem_index], f);

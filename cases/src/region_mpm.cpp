@@ -35,11 +35,14 @@ class MpmRegion final : public Region {
   void step() override { s_.step(); }
 
   void record(std::vector<double>& row) override {
-    const auto samples = s_.sample(pts_, bodies_);
+    auto samples = s_.sample(pts_, bodies_);
     s_.update_energies();
     std::size_t k = 0;
-    for (std::size_t q = 0; q < c_.probes.size(); ++q)
-      for (const auto& f : c_.probes[q].fields) row[k++] = probe_field(samples[q], f);
+    for (std::size_t q = 0; q < c_.probes.size(); ++q) {
+      const ProbeSpec& pr = c_.probes[q];
+      if (pr.region) samples[q] = s_.region_mean(pr.rx0, pr.ry0, pr.rx1, pr.ry1, pr.body);
+      for (const auto& f : pr.fields) row[k++] = probe_field(samples[q], f);
+    }
     put_energies(s_.energy, row, k);
     if (!energies_finite(s_.energy))
       throw std::runtime_error("the run diverged at step " + std::to_string(s_.steps) + " (t = " +

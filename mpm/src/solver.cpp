@@ -1306,4 +1306,33 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
 
 ProbeSample Solver::sample(double x, double y) const { return sample({{x, y}})[0]; }
 
+ProbeSample Solver::region_mean(double x0, double y0, double x1, double y1, int body) const {
+  double m = 0, v = 0, px = 0, py = 0, sxx = 0, syy = 0, szz = 0, sxy = 0, j2 = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if (!(p.x[k] >= x0 && p.x[k] <= x1 && p.y[k] >= y0 && p.y[k] <= y1)) continue;
+    if (body >= 0 && p.body[k] != body) continue;
+    const double mk = p.mass[k], vk = p.vol[k];
+    m += mk;
+    v += vk;
+    px += mk * p.vx[k];
+    py += mk * p.vy[k];
+    sxx += vk * p.sxx[k];
+    syy += vk * p.syy[k];
+    szz += vk * p.szz[k];
+    sxy += vk * p.sxy[k];
+    j2 += vk * j2_of(p.sxx[k], p.syy[k], p.szz[k], p.sxy[k]);
+  }
+  ProbeSample out;
+  if (!(m > 0 && v > 0)) return out;
+  out.valid = true;
+  out.vx = px / m;
+  out.vy = py / m;
+  out.sxx = sxx / v;
+  out.syy = syy / v;
+  out.szz = szz / v;
+  out.sxy = sxy / v;
+  out.j2 = j2 / v;
+  return out;
+}
+
 }  // namespace smpm

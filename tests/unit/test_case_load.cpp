@@ -10,6 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "silentmpm/case.hpp"
+#include "silentmpm/driver.hpp"
+#include "silentmpm/history.hpp"
+#include "silentmpm/material.hpp"
 #include "test_case_common.hpp"
 
 #ifndef SMPM_SOURCE_DIR
@@ -135,6 +138,46 @@ TEST(CaseLoad, TractionOnAnInterval) {
   bool noted = false;
   for (const auto& n : c.notes) noted = noted || n.find("over x in [0.002, 0.0055]") != std::string::npos;
   EXPECT_TRUE(noted);
+}
+
+// A region probe: the mean over the particles in its box, stresses and J2 by volume, velocity by
+// mass, recorded in history.csv as a point probe is. Checked at the last step against the sums
+// over the final particles (to the file's 10 digits); a probe without stress fields has none.
+TEST(CaseLoad, RegionProbeIsTheMeanOverItsParticles) {
+  nlohmann::json j = nlohmann::json::parse(kValid);
+  j["output"]["history_every"] = 1;
+  j["probes"].push_back({{"name", "R"}, {"region", {0.002, 0.001, 0.0065, 0.004}}});
+  j["probes"].push_back({{"name", "W"}, {"region", {-1.0, -1.0, 1.0, 1.0}}, {"body", "plate"},
+                         {"fields", {"vx", "vy"}}});
+  smpm::Case c = smpm::build_case(j, "region.json");
+  const fs::path out = scratch() / "region_probe";
+  fs::remove_all(out);
+  smpm::run_case(c, out.string());
+  const smpm::History h = smpm::read_history((out / "history.csv").string());
+  const std::size_t last = h.time.size() - 1;
+  const smpm::Solver& s = *c.solver;
+  double m = 0, v = 0, py = 0, sxx = 0, j2 = 0, mw = 0, pwy = 0;
+  std::size_t inside = 0;
+  for (std::size_t k = 0; k < s.p.size(); ++k) {
+    mw += s.p.mass[k];
+    pwy += s.p.mass[k] * s.p.vy[k];
+    if (!(s.p.x[k] >= 0.002 && s.p.x[k] <= 0.0065 && s.p.y[k] >= 0.001 && s.p.y[k] <= 0.004)) continue;
+    ++inside;
+    m += s.p.mass[k];
+    v += s.p.vol[k];
+    py += s.p.mass[k] * s.p.vy[k];
+    sxx += s.p.vol[k] * s.p.sxx[k];
+    j2 += s.p.vol[k] * smpm::j2_of(s.p.sxx[k], s.p.syy[k], s.p.szz[k], s.p.sxy[k]);
+  }
+  ASSERT_GT(inside, 50u);
+  const double tol = 1e-9;  // history.csv holds 10 significant digits
+  EXPECT_NEAR(h.column("R.vy")[last], py / m, tol * std::abs(py / m));
+  EXPECT_NEAR(h.column("R.sxx")[last], sxx / v, tol * std::abs(sxx / v));
+  EXPECT_NEAR(h.column("R.J2")[last], j2 / v, tol * std::abs(j2 / v));
+  // The whole body: its momentum over its mass.
+  EXPECT_NEAR(h.column("W.vy")[last], pwy / mw, tol * std::abs(pwy / mw) + 1e-300);
+  EXPECT_THROW(h.column("W.sxx"), std::runtime_error);
+  fs::remove_all(out);
 }
 
 TEST(CaseLoad, Gravity) {

@@ -36,6 +36,10 @@ struct ProbeSpec {
   std::string along;   // empty for a point probe
   std::string curve;
   double s = 0;
+  // A region probe ("region": [x0, y0, x1, y1]): the mean over the particles in the box
+  // (Solver::region_mean); x, y are then its centre.
+  bool region = false;
+  double rx0 = 0, ry0 = 0, rx1 = 0, ry1 = 0;
 };
 
 // One body as built (summary.json "bodies"): name, material, extent [x0, y0, x1, y1] (its box,

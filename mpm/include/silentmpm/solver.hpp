@@ -125,6 +125,10 @@ class Solver {
   // bilinear interpolation at the point.
   ProbeSample sample(double x, double y) const;
   // Several points in one pass over the particles.
+  // The mean over the particles (of `body`, or all for -1) whose centres lie in the box
+  // [x0, x1] x [y0, y1]: stresses and J2 weighted by volume, velocity by mass (the region's
+  // momentum over its mass). Not valid when no particle is inside.
+  ProbeSample region_mean(double x0, double y0, double x1, double y1, int body = -1) const;
   std::vector<ProbeSample> sample(const std::vector<std::array<double, 2>>& points) const;
   // Same, each point sampling only the particles of body bodies[q] (-1: every body).
   std::vector<ProbeSample> sample(const std::vector<std::array<double, 2>>& points,
