@@ -454,8 +454,8 @@ TimeFunction parse_time_function(Obj o) {
   return f;
 }
 
-// A point probe ("at"), or with along_curve the keys a probe along a curve shares with it (the
-// caller reads the curve keys and calls o.done()).
+// A point probe ("at"), a region probe ("region"), or with along_curve the keys a probe along a
+// curve shares with them (the caller reads the curve keys and calls o.done()).
 ProbeSpec parse_probe(Obj& o, const GridSpec& g, const std::vector<std::string>& body_names,
                       bool along_curve = false) {
   if (along_curve) {
@@ -485,6 +485,7 @@ ProbeSpec parse_probe(Obj& o, const GridSpec& g, const std::vector<std::string>&
     p.x = 0.5 * (r[0] + r[2]);
     p.y = 0.5 * (r[1] + r[3]);
   } else if (!along_curve) {
+    if (!o.has("at")) o.fail("at", "missing required key (at [x, y], or region [x0, y0, x1, y1])");
     const auto at = o.nums("at", 2);
     p.x = at[0];
     p.y = at[1];
@@ -492,15 +493,23 @@ ProbeSpec parse_probe(Obj& o, const GridSpec& g, const std::vector<std::string>&
       o.fail("at", "outside the grid " + g.describe() + ": (" + fmt(p.x) + ", " + fmt(p.y) + ")");
   }
   static const std::vector<std::string> all = {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"};
+  // A region probe also has the momentum and mass of its particles.
+  static const std::vector<std::string> all_region = {"sxx", "syy", "szz", "sxy", "J2", "vx",
+                                                      "vy",  "px",  "py",  "mass"};
   if (const ojson* f = o.find("fields")) {
     const std::string path = o.at("fields");
     if (!f->is_array()) o.fail("fields", "expected an array of strings, got " + a_type(*f));
     if (f->empty()) o.fail("fields", "must name at least one field (or leave it out for all)");
+    const std::vector<std::string>& allowed = p.region ? all_region : all;
     for (std::size_t i = 0; i < f->size(); ++i) {
       const std::string s = as_string(o.ctx(), (*f)[i], index_path(path, i));
-      if (std::find(all.begin(), all.end(), s) == all.end())
-        o.ctx().fail(index_path(path, i),
-                     "must be one of " + quoted_list(all) + ", got \"" + s + "\"" + suggestion(s, all));
+      if (!p.region && std::find(all_region.begin(), all_region.end(), s) != all_region.end() &&
+          std::find(all.begin(), all.end(), s) == all.end())
+        o.ctx().fail(index_path(path, i), "\"" + s + "\" is a field of region probes (give "
+                                          "region instead of at)");
+      if (std::find(allowed.begin(), allowed.end(), s) == allowed.end())
+        o.ctx().fail(index_path(path, i), "must be one of " + quoted_list(allowed) + ", got \"" +
+                                              s + "\"" + suggestion(s, allowed));
       if (std::find(p.fields.begin(), p.fields.end(), s) != p.fields.end())
         o.ctx().fail(index_path(path, i), "field \"" + s + "\" listed twice");
       p.fields.push_back(s);
@@ -1132,9 +1141,22 @@ class Builder {
           o.fail("alpha", "every pml must have the same alpha (\"" + other.name + "\" has " +
                               fmt(other.alpha) + ", this one " + fmt(band.alpha) + ")");
       o.done();
+      std::size_t inside = 0;  // particles inside the band (its depth > 0 at their centre)
+      if (!checking_) {
+        const Particles& P = s_->p;
+        for (std::size_t k = 0; k < P.size(); ++k) {
+          if (P.body[k] != band.body) continue;
+          const double pos = band.axis == 0 ? P.x[k] : P.y[k];
+          if ((pos - (band.c - band.side * band.width)) * band.side > 0) ++inside;
+        }
+        if (inside == 0)
+          o.fail("width", "selects no particle: no particle centre of body \"" + b.name +
+                              "\" lies within " + fmt(band.width) + " m of its " + side + " side");
+      }
       c.notes.push_back("pml \"" + name + "\" inside the " + side + " side of body \"" + b.name +
                         "\": " + fmt(band.width) + " m, r0 " + fmt(band.r0) + ", power " +
-                        fmt(band.power) + ", alpha " + fmt(band.alpha) + " 1/s");
+                        fmt(band.power) + ", alpha " + fmt(band.alpha) + " 1/s, " +
+                        std::to_string(inside) + " particles");
       s_->pml_bands.push_back(std::move(band));
       return;
     }

@@ -128,6 +128,8 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   // output
   if (top.has("output")) {
     Obj o = top.obj("output");
+    if (o.has("fields"))
+      o.fail("fields", "chooses the particle snapshot's fields; an FEM case has no particles");
     parse_output_section(o, c.output, 100000);
   }
 

@@ -112,6 +112,9 @@ double probe_field(const ProbeSample& s, const std::string& f) {
   if (f == "J2") return s.j2;
   if (f == "vx") return s.vx;
   if (f == "vy") return s.vy;
+  if (f == "px") return s.px;
+  if (f == "py") return s.py;
+  if (f == "mass") return s.mass;
   throw std::runtime_error("unknown probe field " + f);
 }
 

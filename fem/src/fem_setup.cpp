@@ -822,11 +822,22 @@ void Solver::close_snapshots() {
 
 int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
+  int found = 0;
   try {
-    return m.deal->snap.resume(dir, base, m.snapshot_times);
+    found = m.deal->snap.resume(dir, base, m.snapshot_times);
   } catch (const std::exception& e) {
     throw FemError(dir + ": cannot reopen the FEM snapshots: " + deal_message(e));
   }
+  if (found == 0 && !m.snapshot_times.empty()) {
+    // The earlier snapshots are gone: the file starts afresh and the count with it, so that a
+    // later checkpoint lists only what the file holds.
+    std::fprintf(stderr, "note: %s/%s.h5 does not hold the %zu FE snapshot(s) written before the "
+                         "checkpoint; %s.xdmf lists the snapshots from the restart on\n",
+                 dir.c_str(), base.c_str(), m.snapshot_times.size(), base.c_str());
+    m.snapshot_times.clear();
+    m.snapshots = 0;
+  }
+  return found;
 }
 
 std::vector<std::string> Solver::describe() const {

@@ -1034,7 +1034,6 @@ void Solver::check_outside() {
   throw std::runtime_error(o.str());
 }
 
-// The time step: see the sequence at the top of solver.hpp.
 std::vector<std::uint8_t> Solver::layer_flags() const {
   std::vector<std::uint8_t> f(p.size(), 0);
   auto mark = [&](const BoundaryLayer& L, std::uint8_t bit) {
@@ -1047,6 +1046,7 @@ std::vector<std::uint8_t> Solver::layer_flags() const {
   return f;
 }
 
+// The time step: see the sequence at the top of solver.hpp.
 void Solver::step() {
   switch (opt.shape) {
     case ShapeKind::Bilinear: return step_with<Bilinear>();
@@ -1325,6 +1325,9 @@ ProbeSample Solver::region_mean(double x0, double y0, double x1, double y1, int 
   ProbeSample out;
   if (!(m > 0 && v > 0)) return out;
   out.valid = true;
+  out.px = px;
+  out.py = py;
+  out.mass = m;
   out.vx = px / m;
   out.vy = py / m;
   out.sxx = sxx / v;

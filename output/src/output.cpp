@@ -408,7 +408,7 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
     else if (name == "eps_p") d = p.eps_p.data();
     else if (name == "mass") d = p.mass.data();
     else if (name == "volume") d = p.vol.data();
-    else if (name == "normal") d = film_ ? vec3(p.dnx, p.dny) : columns(3, [](std::size_t, int) { return 0.0; });
+    else if (name == "normal") d = film_ && p.has_film() ? vec3(p.dnx, p.dny) : columns(3, [](std::size_t, int) { return 0.0; });
     else if (name == "jump_n" || name == "jump_t" || name == "ubar") {
       const std::vector<double>& v = name == "jump_n" ? p.jump_n : name == "jump_t" ? p.jump_t : p.ubar;
       d = film_ && p.has_film() ? v.data() : columns(1, [](std::size_t, int) { return 0.0; });
@@ -650,16 +650,22 @@ void MeshSnapshotWriter::open(const std::string& dir, const std::string& base,
   const std::string path = dir_ + "/" + base_ + ".h5";
   const hid_t f = open_unlocked(path, true);
   if (f < 0) h5_fail("cannot create the snapshot file (does the output directory exist?)", path);
+  try {  // the writer counts as open only with the mesh written
+    H5Handle mesh(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    if (mesh.id < 0) h5_fail("cannot create group '/mesh'", path);
+    write_dataset(mesh.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), nodes_, 3, path,
+                  "mesh", "m");
+    write_dataset(mesh.id, "cells", H5T_STD_I64LE, H5T_NATIVE_INT64, cells.data(), cells_, 4,
+                  path, "mesh", "1");
+    write_dataset(mesh.id, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, material.data(), cells_,
+                  1, path, "mesh", "1");
+    if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
+  } catch (...) {
+    H5Fclose(f);
+    std::remove(path.c_str());
+    throw;
+  }
   file_ = f;
-  H5Handle mesh(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
-  if (mesh.id < 0) h5_fail("cannot create group '/mesh'", path);
-  write_dataset(mesh.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), nodes_, 3, path,
-                "mesh", "m");
-  write_dataset(mesh.id, "cells", H5T_STD_I64LE, H5T_NATIVE_INT64, cells.data(), cells_, 4, path,
-                "mesh", "1");
-  write_dataset(mesh.id, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, material.data(), cells_, 1,
-                path, "mesh", "1");
-  if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
   xdmf_end_ = -1;
 }
 

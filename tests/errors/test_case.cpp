@@ -180,6 +180,16 @@ std::vector<Bad> bad_cases() {
       {"probe_region_three_numbers",
        [](ojson& j) { j["probes"][0] = {{"name", "R"}, {"region", {0.002, 0.007, 0.003}}}; },
        "probes[0].region"},
+      {"pml_selects_no_particle",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 1e-4}};
+       },
+       "boundaries[2].width: selects no particle"},
+      {"probe_neither_at_nor_region", [](ojson& j) { j["probes"][0].erase("at"); },
+       "probes[0].at: missing required key (at [x, y], or region [x0, y0, x1, y1])"},
+      {"probe_point_momentum", [](ojson& j) { j["probes"][0]["fields"] = {"sxx", "px"}; },
+       "probes[0].fields[1]: \"px\" is a field of region probes (give region instead of at)"},
       {"output_field_unknown", [](ojson& j) { j["output"]["fields"] = {"velocity", "stres"}; },
        "output.fields[1]: unknown field \"stres\" (did you mean \"stress\"?)"},
       {"output_field_twice", [](ojson& j) { j["output"]["fields"] = {"J2", "J2"}; },

@@ -175,6 +175,14 @@ TEST(FemErrors, BadInputs) {
   EXPECT_ERROR(error_of(c), "probes[0].fields[1]", "div");
 
   c = good_case();
+  c["output"]["fields"] = {"velocity"};
+  EXPECT_ERROR(error_of(c), "output.fields", "an FEM case has no particles");
+
+  c = good_case();
+  c["probes"][0] = {{"name", "R"}, {"region", {0.0, 0.0, 0.01, 0.001}}};
+  EXPECT_ERROR(error_of(c), "probes[0].region", "unknown key");
+
+  c = good_case();
   c["fem"]["degree"] = 3;
   EXPECT_ERROR(error_of(c), "fem.degree", "1 or 2");
 

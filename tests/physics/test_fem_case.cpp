@@ -1,6 +1,6 @@
 // An FEM case through the same interface as MPM (case file -> run_case): history.csv with the
 // probe fields (div and curl included), summary.json with dofs and the energy terms, and the
-// DataOut HDF5 + XDMF snapshots. The physics asserted: a step load on a roller column reaches the
+// HDF5 + XDMF snapshots. The physics asserted: a step load on a roller column reaches the
 // uniaxial-strain plateau sigma_xx = -sigma0, sigma_yy = nu/(1-nu) sigma_xx, div u = -sigma0/M,
 // v_x = sigma0/(rho c_d); the energy balance closes.
 #include <gtest/gtest.h>

@@ -142,13 +142,14 @@ TEST(CaseLoad, TractionOnAnInterval) {
 
 // A region probe: the mean over the particles in its box, stresses and J2 by volume, velocity by
 // mass, recorded in history.csv as a point probe is. Checked at the last step against the sums
-// over the final particles (to the file's 10 digits); a probe without stress fields has none.
+// over the final particles (to the file's 10 digits); a region probe's momentum and mass (the
+// body's mass in every row); a probe without stress fields has none.
 TEST(CaseLoad, RegionProbeIsTheMeanOverItsParticles) {
   nlohmann::json j = nlohmann::json::parse(kValid);
   j["output"]["history_every"] = 1;
   j["probes"].push_back({{"name", "R"}, {"region", {0.002, 0.001, 0.0065, 0.004}}});
   j["probes"].push_back({{"name", "W"}, {"region", {-1.0, -1.0, 1.0, 1.0}}, {"body", "plate"},
-                         {"fields", {"vx", "vy"}}});
+                         {"fields", {"vx", "vy", "px", "py", "mass"}}});
   smpm::Case c = smpm::build_case(j, "region.json");
   const fs::path out = scratch() / "region_probe";
   fs::remove_all(out);
@@ -174,8 +175,11 @@ TEST(CaseLoad, RegionProbeIsTheMeanOverItsParticles) {
   EXPECT_NEAR(h.column("R.vy")[last], py / m, tol * std::abs(py / m));
   EXPECT_NEAR(h.column("R.sxx")[last], sxx / v, tol * std::abs(sxx / v));
   EXPECT_NEAR(h.column("R.J2")[last], j2 / v, tol * std::abs(j2 / v));
-  // The whole body: its momentum over its mass.
+  // The whole body: its momentum, its mass (the same in every row), and their ratio.
   EXPECT_NEAR(h.column("W.vy")[last], pwy / mw, tol * std::abs(pwy / mw) + 1e-300);
+  EXPECT_NEAR(h.column("W.py")[last], pwy, tol * std::abs(pwy) + 1e-300);
+  for (const double mr : h.column("W.mass")) EXPECT_NEAR(mr, mw, tol * mw);
+  EXPECT_NE(h.column("W.py")[last], 0.0);
   EXPECT_THROW(h.column("W.sxx"), std::runtime_error);
   fs::remove_all(out);
 }

@@ -157,14 +157,15 @@ class Solver {
   // displacement and velocity (3-vectors, m and m/s), stress (3 x 3 tensor, Pa; each node's the
   // mean over its cells) and J2 (Pa^2); cell field material. Q2 cells are written as 4 quads.
   void write_snapshot(const std::string& dir, const std::string& base);
-  // Closes DIR/BASE.h5 (a later snapshot starts a new file). Throws FemError.
+  // Closes DIR/BASE.h5 at the end of a run. Throws FemError.
   void close_snapshots();
   int snapshot_count() const;
   // The times of the snapshots written so far.
   std::vector<double> snapshot_times() const;
   // After load_state: reopens DIR/BASE.h5 and lists the earlier run's snapshots in BASE.xdmf
   // again (later ones are removed). Returns how many: all, or 0 when the file or one of them is
-  // missing (the next snapshot then starts the file afresh).
+  // missing (a note says so; the snapshot count restarts at 0 and the next snapshot starts the
+  // file afresh).
   int resume_snapshots(const std::string& dir, const std::string& base);
 
   // Checkpoints: the state a later step reads (u, v, -K u^n, clock, energies, snapshot times) as

@@ -94,11 +94,11 @@ struct PmlBand {
   double c = 0, width = 0, r0 = 1e-3, power = 2, alpha = 0;
 };
 
-// The particles of every band of a solver, with their stretchings and memories (built by
-// Solver::finalize; a particle in two bands, at a corner, has both d_x and d_y).
 // The power of the layer particles' PIC share in their depth (Solver::pml_pic).
 inline constexpr double kPmlPicPower = 2.5;
 
+// The particles of every band of a solver, with their stretchings and memories (built by
+// Solver::finalize; a particle in two bands, at a corner, has both d_x and d_y).
 struct PmlLayer {
   BoundaryLayer layer;            // ids and idx of the particles
   double alpha = 0;

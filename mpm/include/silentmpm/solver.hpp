@@ -60,6 +60,7 @@ struct SolverOptions {
 
 struct ProbeSample {
   double sxx = 0, syy = 0, szz = 0, sxy = 0, j2 = 0, vx = 0, vy = 0;
+  double px = 0, py = 0, mass = 0;  // region probes: momentum and mass in the box (per unit thickness)
   bool valid = false;  // false when no particle is near the point
 };
 
@@ -108,9 +109,6 @@ class Solver {
 
   // --- run ---------------------------------------------------------------------------------
   // One time step (the sequence at the top of this file).
-  // Per particle (current order): 1 silent layer, 2 traction, 4 Kelvin-Voigt springs, 8 damping
-  // layer, 16 perfectly matched layer (the snapshot field "layer").
-  std::vector<std::uint8_t> layer_flags() const;
   void step();
   // Hook sets: attach before the first step; a set must outlive its attachment.
   void attach(StepHooks* h);
@@ -125,14 +123,17 @@ class Solver {
   // bilinear interpolation at the point.
   ProbeSample sample(double x, double y) const;
   // Several points in one pass over the particles.
-  // The mean over the particles (of `body`, or all for -1) whose centres lie in the box
-  // [x0, x1] x [y0, y1]: stresses and J2 weighted by volume, velocity by mass (the region's
-  // momentum over its mass). Not valid when no particle is inside.
-  ProbeSample region_mean(double x0, double y0, double x1, double y1, int body = -1) const;
   std::vector<ProbeSample> sample(const std::vector<std::array<double, 2>>& points) const;
   // Same, each point sampling only the particles of body bodies[q] (-1: every body).
   std::vector<ProbeSample> sample(const std::vector<std::array<double, 2>>& points,
                                   const std::vector<int>& bodies) const;
+  // The mean over the particles (of `body`, or all for -1) whose centres lie in the box
+  // [x0, x1] x [y0, y1]: stresses and J2 weighted by volume, velocity by mass (the region's
+  // momentum over its mass), with that momentum and mass. Not valid when no particle is inside.
+  ProbeSample region_mean(double x0, double y0, double x1, double y1, int body = -1) const;
+  // Per particle (current order): 1 silent layer, 2 traction, 4 Kelvin-Voigt springs, 8 damping
+  // layer, 16 perfectly matched layer (the snapshot field "layer").
+  std::vector<std::uint8_t> layer_flags() const;
   int thread_count() const { return nthreads_; }
   // Nodes lighter than this are void (opt.mass_tolerance times the lightest particle).
   double mass_floor() const { return mass_floor_; }
