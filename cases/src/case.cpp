@@ -494,8 +494,8 @@ ProbeSpec parse_probe(Obj& o, const GridSpec& g, const std::vector<std::string>&
   }
   static const std::vector<std::string> all = {"sxx", "syy", "szz", "sxy", "J2", "vx", "vy"};
   // A region probe also has the momentum and mass of its particles.
-  static const std::vector<std::string> all_region = {"sxx", "syy", "szz", "sxy", "J2", "vx",
-                                                      "vy",  "px",  "py",  "mass"};
+  static const std::vector<std::string> all_region = {"sxx", "syy", "szz", "sxy", "J2",  "vx",
+                                                      "vy",  "px",  "py",  "mass", "fcx", "fcy"};
   if (const ojson* f = o.find("fields")) {
     const std::string path = o.at("fields");
     if (!f->is_array()) o.fail("fields", "expected an array of strings, got " + a_type(*f));
@@ -803,6 +803,12 @@ class Builder {
       Obj o(ctx_, arr[i], index_path("probes", i));
       const bool along = o.has("curve");
       ProbeSpec p = parse_probe(o, grid_, body_names(), along);
+      for (std::size_t f = 0; f < p.fields.size(); ++f)
+        if ((p.fields[f] == "fcx" || p.fields[f] == "fcy") &&
+            (p.body < 0 || s_->contact.type != ContactType::Multi))
+          ctx_.fail(index_path(o.at("fields"), f),
+                    "\"" + p.fields[f] + "\" is the contact force on the probe's body: it needs "
+                    "\"body\" and contact.type \"multi\"");
       std::vector<ProbeSpec> points;
       if (along) points = curve_probe(o, p);
       else points.push_back(std::move(p));

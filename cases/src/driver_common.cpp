@@ -115,6 +115,8 @@ double probe_field(const ProbeSample& s, const std::string& f) {
   if (f == "px") return s.px;
   if (f == "py") return s.py;
   if (f == "mass") return s.mass;
+  if (f == "fcx") return s.fcx;
+  if (f == "fcy") return s.fcy;
   throw std::runtime_error("unknown probe field " + f);
 }
 

@@ -1325,6 +1325,10 @@ ProbeSample Solver::region_mean(double x0, double y0, double x1, double y1, int 
   ProbeSample out;
   if (!(m > 0 && v > 0)) return out;
   out.valid = true;
+  if (body >= 0 && static_cast<std::size_t>(body) < contact.force.size()) {
+    out.fcx = contact.force[body][0];
+    out.fcy = contact.force[body][1];
+  }
   out.px = px;
   out.py = py;
   out.mass = m;

@@ -188,6 +188,13 @@ std::vector<Bad> bad_cases() {
        "boundaries[2].width: selects no particle"},
       {"probe_neither_at_nor_region", [](ojson& j) { j["probes"][0].erase("at"); },
        "probes[0].at: missing required key (at [x, y], or region [x0, y0, x1, y1])"},
+      {"probe_contact_force_single_field",
+       [](ojson& j) {
+         j["probes"][0] = {{"name", "R"}, {"region", {0.0, 0.0, 0.01, 0.005}}, {"body", "plate"},
+                           {"fields", {"fcx"}}};
+       },
+       "probes[0].fields[0]: \"fcx\" is the contact force on the probe's body: it needs \"body\" "
+       "and contact.type \"multi\""},
       {"probe_point_momentum", [](ojson& j) { j["probes"][0]["fields"] = {"sxx", "px"}; },
        "probes[0].fields[1]: \"px\" is a field of region probes (give region instead of at)"},
       {"output_field_unknown", [](ojson& j) { j["output"]["fields"] = {"velocity", "stres"}; },

@@ -184,6 +184,48 @@ TEST(CaseLoad, RegionProbeIsTheMeanOverItsParticles) {
   fs::remove_all(out);
 }
 
+// Contact force on a body (region probe fields fcx, fcy under multi-field contact): two free
+// blocks collide head-on. Newton's third law: the two bodies' forces cancel at every row; and
+// each body's momentum changes by the contact impulse, sum of fcx dt (internal forces sum to
+// zero over a body), to the file's 10 digits summed over the rows.
+TEST(CaseLoad, RegionProbeContactForceIsTheMomentumRate) {
+  const double dt = 2e-8;
+  nlohmann::json j = {
+      {"grid", {{"origin", {0.0, 0.0}}, {"size", {0.012, 0.004}}, {"cell", 0.0005}}},
+      {"time", {{"end", 2e-5}, {"dt", dt}}},
+      {"scheme", {{"update", "MUSL"}, {"threads", 1}}},
+      {"contact", {{"type", "multi"}}},
+      {"materials", {{"al", {{"model", "elastic"}, {"young", 70e9}, {"poisson", 0.33},
+                             {"density", 2700}}}}},
+      {"bodies", {{{"name", "a"}, {"material", "al"}, {"box", {0.001, 0.001, 0.005, 0.003}},
+                   {"velocity", {20.0, 0.0}}},
+                  {{"name", "b"}, {"material", "al"}, {"box", {0.0055, 0.001, 0.0095, 0.003}},
+                   {"velocity", {-20.0, 0.0}}}}},
+      {"probes", {{{"name", "A"}, {"region", {0.0, 0.0, 0.012, 0.004}}, {"body", "a"},
+                   {"fields", {"px", "fcx", "fcy"}}},
+                  {{"name", "B"}, {"region", {0.0, 0.0, 0.012, 0.004}}, {"body", "b"},
+                   {"fields", {"px", "fcx"}}}}},
+      {"output", {{"history_every", 1}, {"snapshots", 0}, {"progress", false}}}};
+  smpm::Case c = smpm::build_case(j, "contact.json");
+  const fs::path out = scratch() / "contact_force_probe";
+  fs::remove_all(out);
+  smpm::run_case(c, out.string());
+  const smpm::History h = smpm::read_history((out / "history.csv").string());
+  const auto& pa = h.column("A.px");
+  const auto& fa = h.column("A.fcx");
+  const auto& fb = h.column("B.fcx");
+  double fmax = 0, impulse = 0;
+  for (std::size_t r = 0; r < fa.size(); ++r) {
+    fmax = std::max(fmax, std::abs(fa[r]));
+    EXPECT_NEAR(fa[r] + fb[r], 0.0, 1e-9 * std::abs(fa[r]) + 1e-300) << "row " << r;
+    if (r > 0) impulse += fa[r] * dt;
+  }
+  EXPECT_GT(fmax, 0.0) << "the blocks must touch";
+  EXPECT_LT(pa.back(), 0.9 * pa.front()) << "body a must be slowed down";
+  EXPECT_NEAR(pa.back() - pa.front(), impulse, 1e-6 * std::abs(pa.front()));
+  fs::remove_all(out);
+}
+
 TEST(CaseLoad, Gravity) {
   const fs::path file = write_file("valid_g.json", kValid);
   const smpm::Case c = smpm::load_case(file.string(), {"gravity=[0.5, -9.81]"});

@@ -61,6 +61,7 @@ struct SolverOptions {
 struct ProbeSample {
   double sxx = 0, syy = 0, szz = 0, sxy = 0, j2 = 0, vx = 0, vy = 0;
   double px = 0, py = 0, mass = 0;  // region probes: momentum and mass in the box (per unit thickness)
+  double fcx = 0, fcy = 0;          // region probes of a body: the contact force on it (multi-field)
   bool valid = false;  // false when no particle is near the point
 };
 
@@ -129,7 +130,8 @@ class Solver {
                                   const std::vector<int>& bodies) const;
   // The mean over the particles (of `body`, or all for -1) whose centres lie in the box
   // [x0, x1] x [y0, y1]: stresses and J2 weighted by volume, velocity by mass (the region's
-  // momentum over its mass), with that momentum and mass. Not valid when no particle is inside.
+  // momentum over its mass), with that momentum and mass, and for a body under multi-field
+  // contact the contact force on it in the last step. Not valid when no particle is inside.
   ProbeSample region_mean(double x0, double y0, double x1, double y1, int body = -1) const;
   // Per particle (current order): 1 silent layer, 2 traction, 4 Kelvin-Voigt springs, 8 damping
   // layer, 16 perfectly matched layer (the snapshot field "layer").
