@@ -1114,8 +1114,8 @@ class Builder {
 
     if (type == "pml") {
       // A band inside a side of a box body: the stretching acts along the side's normal, which
-      // must be an axis (docs/physics.md section 9.3). Under MUSL and USF a shear wave's energy
-      // in the layer still grows after 5e4-8e4 steps (measured): USL only.
+      // must be an axis (docs/physics.md section 9.3). Under MUSL a shear wave's energy in the
+      // layer still grows after 5e4-8e4 steps (measured; USF behaves as MUSL): USL only.
       if (s_->opt.scheme != Scheme::USL)
         o.fail("type", "a pml on particles needs scheme.update \"USL\" (under MUSL and USF the "
                        "layer grows in long runs; see docs/physics.md section 9.3)");
