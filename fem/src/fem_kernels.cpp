@@ -145,15 +145,8 @@ namespace {
 // convolution of u and I2 that of I1 with exp(-alpha t).
 void pml_forces(Solver::Impl& m, double dt) {
   Solver::Impl::Pml& P = m.pml;
-  const std::size_t nqp = P.kl.size();
   if (P.dt_coef != dt) {
-    P.cx.resize(3 * nqp);
-    P.cy.resize(3 * nqp);
-    for (std::size_t k = 0; k < nqp; ++k) {
-      convolution_coefficients(P.alpha + P.dx[k], dt, P.cx[3 * k], P.cx[3 * k + 1], P.cx[3 * k + 2]);
-      convolution_coefficients(P.alpha + P.dy[k], dt, P.cy[3 * k], P.cy[3 * k + 1], P.cy[3 * k + 2]);
-    }
-    convolution_coefficients(P.alpha, dt, P.e_a, P.ca_a, P.cb_a);
+    convolution_tables(P.alpha, P.dx, P.dy, dt, P.cx, P.cy, P.e_a, P.ca_a, P.cb_a);
     P.dt_coef = dt;
   }
   double* __restrict f = m.dash_force.data();

@@ -591,13 +591,7 @@ void Solver::pml_loads() {
   PmlLayer& P = pml;
   const std::size_t n = P.layer.idx.size();
   if (P.dt_coef != dt) {
-    P.cx.resize(3 * n);
-    P.cy.resize(3 * n);
-    for (std::size_t q = 0; q < n; ++q) {
-      convolution_coefficients(P.alpha + P.dx[q], dt, P.cx[3 * q], P.cx[3 * q + 1], P.cx[3 * q + 2]);
-      convolution_coefficients(P.alpha + P.dy[q], dt, P.cy[3 * q], P.cy[3 * q + 1], P.cy[3 * q + 2]);
-    }
-    convolution_coefficients(P.alpha, dt, P.e_a, P.ca_a, P.cb_a);
+    convolution_tables(P.alpha, P.dx, P.dy, dt, P.cx, P.cy, P.e_a, P.ca_a, P.cb_a);
     P.dt_coef = dt;
   }
   // USF strains the particles with the start-of-step velocity, before the forces.

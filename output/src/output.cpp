@@ -171,6 +171,18 @@ void write_scalar_attribute(hid_t obj, const char* name, hid_t file_type, hid_t 
     h5_fail("cannot write attribute '" + group_name + "@" + name + "'", file);
 }
 
+// A snapshot file created (truncating) or opened for writing without a file lock, so that h5py
+// or ParaView can look at a running simulation's snapshots (each is flushed); readers still
+// lock as usual. Returns the file, or a negative id.
+hid_t open_unlocked(const std::string& path, bool create) {
+  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+#if H5_VERSION_GE(1, 10, 7)
+  H5Pset_file_locking(fapl.id, 0, 1);
+#endif
+  return create ? H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id)
+                : H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
+}
+
 std::string step_name(long step) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "step_%09ld", step);
@@ -259,14 +271,7 @@ void SnapshotWriter::open(const std::string& dir, const std::string& base) {
   sizes_.clear();
   const std::string path = dir_ + "/" + base_ + ".h5";
 
-  // The writer takes no file lock, so h5py or ParaView can look at a running simulation's
-  // snapshots (every snapshot is flushed); readers still lock as usual.
-  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-  if (fapl.id < 0) h5_fail("cannot create a file-access property list", path);
-#if H5_VERSION_GE(1, 10, 7)
-  H5Pset_file_locking(fapl.id, 0, 1);
-#endif
-  const hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id);
+  const hid_t f = open_unlocked(path, true);
   if (f < 0)
     h5_fail("cannot create the snapshot file (does the output directory exist and is it "
             "writable?)",
@@ -289,13 +294,7 @@ int SnapshotWriter::resume(const std::string& dir, const std::string& base,
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   const std::string path = (dir.empty() ? std::string(".") : dir) + "/" + base + ".h5";
   hid_t f = -1;
-  if (!steps.empty()) {  // a missing or unreadable file: f < 0
-    H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-#if H5_VERSION_GE(1, 10, 7)
-    H5Pset_file_locking(fapl.id, 0, 1);
-#endif
-    f = H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
-  }
+  if (!steps.empty()) f = open_unlocked(path, false);  // a missing or unreadable file: f < 0
   bool whole = f >= 0;
   for (std::size_t k = 0; whole && k < steps.size(); ++k)
     whole = H5Lexists(f, step_name(steps[k]).c_str(), H5P_DEFAULT) > 0;
@@ -469,21 +468,28 @@ namespace {
 const char* const kXdmfTail = "    </Grid>\n  </Domain>\n</Xdmf>\n";
 }
 
-std::string SnapshotWriter::xdmf_head() const {
+namespace {
+// The XDMF document up to its first grid: the temporal collection `base`, and the units of the
+// fields ("xyz m, velocity m/s, ...") in an Information element of the Domain.
+std::string xdmf_document_head(const std::string& base, const std::string& units) {
   std::string s;
   s += "<?xml version=\"1.0\" ?>\n";
   s += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
   s += "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n";
   s += "  <Domain>\n";
-  std::string units;
-  for (const FieldInfo& f : kFields)
-    if ((fields_ & f.bit) && !(f.bit == kFieldFilm && !film_))
-      units += std::string(units.empty() ? "" : ", ") + f.name + " " + f.units;
-  s += "    <Information Name=\"units\" Value=\"" + xml_escape("xyz m" + (units.empty() ? "" : ", " + units)) +
-       "\"/>\n";
-  s += "    <Grid Name=\"" + xml_escape(base_) +
+  s += "    <Information Name=\"units\" Value=\"" + xml_escape(units) + "\"/>\n";
+  s += "    <Grid Name=\"" + xml_escape(base) +
        "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   return s;
+}
+}  // namespace
+
+std::string SnapshotWriter::xdmf_head() const {
+  std::string units = "xyz m";
+  for (const FieldInfo& f : kFields)
+    if ((fields_ & f.bit) && !(f.bit == kFieldFilm && !film_))
+      units += std::string(", ") + f.name + " " + f.units;
+  return xdmf_document_head(base_, units);
 }
 
 std::string SnapshotWriter::xdmf_grid(std::size_t k) const {
@@ -598,15 +604,6 @@ std::string snapshot_group(std::size_t k) {
   char b[32];
   std::snprintf(b, sizeof b, "snapshot_%05zu", k);
   return b;
-}
-
-hid_t open_unlocked(const std::string& path, bool create) {
-  H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-#if H5_VERSION_GE(1, 10, 7)
-  H5Pset_file_locking(fapl.id, 0, 1);
-#endif
-  return create ? H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id)
-                : H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
 }
 
 // Rows and columns of a dataset (columns 1 for a 1-D one); false when it is missing.
@@ -805,17 +802,10 @@ std::string MeshSnapshotWriter::xdmf_grid(std::size_t k) const {
 }
 
 std::string MeshSnapshotWriter::xdmf_text() const {
-  std::string s;
-  s += "<?xml version=\"1.0\" ?>\n";
-  s += "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
-  s += "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n";
-  s += "  <Domain>\n";
   std::string units = "xyz m";
   for (std::size_t q = 0; q < names_.size(); ++q)
     if (!units_[q].empty()) units += ", " + names_[q] + " " + units_[q];
-  s += "    <Information Name=\"units\" Value=\"" + xml_escape(units) + "\"/>\n";
-  s += "    <Grid Name=\"" + xml_escape(base_) +
-       "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  std::string s = xdmf_document_head(base_, units);
   for (std::size_t k = 0; k < times_.size(); ++k) s += xdmf_grid(k);
   return s + kXdmfTail;
 }

@@ -6,6 +6,7 @@
 // the nodal form) and by the hybrid step (FE dashpots, at shared and FE-only nodes alike).
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace smpm {
 
@@ -55,6 +56,21 @@ inline void convolution_coefficients(double beta, double dt, double& e, double& 
     ca = dt * (1 - e * (1 + x)) / (x * x);
     cb = dt * (1 - e) / x - ca;
   }
+}
+
+// The coefficients for one time step dt of every point of a layer, 3 per point: cx for alpha +
+// d_x, cy for alpha + d_y (the memories of the x and y derivatives), and (e, ca, cb) for alpha.
+inline void convolution_tables(double alpha, const std::vector<double>& dx,
+                               const std::vector<double>& dy, double dt, std::vector<double>& cx,
+                               std::vector<double>& cy, double& e, double& ca, double& cb) {
+  const std::size_t n = dx.size();
+  cx.resize(3 * n);
+  cy.resize(3 * n);
+  for (std::size_t k = 0; k < n; ++k) {
+    convolution_coefficients(alpha + dx[k], dt, cx[3 * k], cx[3 * k + 1], cx[3 * k + 2]);
+    convolution_coefficients(alpha + dy[k], dt, cy[3 * k], cy[3 * k + 1], cy[3 * k + 2]);
+  }
+  convolution_coefficients(alpha, dt, e, ca, cb);
 }
 
 // The mass term of a layer point's component u (less its damping part m (d_x + d_y) v, which
