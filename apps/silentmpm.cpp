@@ -201,13 +201,9 @@ int main(int argc, char** argv) {
     smpm::RunOptions ropt;
     ropt.restart = restart;
     if (!c.solver && c.fem) {  // FEM-only case
-      const smpm::fem::Solver& f = *c.fem;
       if (*check) {
         std::printf("%s: ok\n", case_path.c_str());
-        std::printf("  FEM: %zu cells, Q%d, %zu dofs, dt %g s (CFL %.3f of the element bound), "
-                    "%ld steps, %zu probe(s)\n", f.cells(), f.degree(), f.dofs(), f.dt,
-                    f.dt / f.critical_dt(), static_cast<long>(std::ceil(c.t_end / f.dt - 1e-9)),
-                    c.probes.size());
+        std::printf("  %s\n", smpm::fem_check_line(c).c_str());
         for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
         return 0;
       }

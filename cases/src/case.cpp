@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "case_util.hpp"
+#include "modules.hpp"
 #include "silentmpm/geometry.hpp"
 
 #include <algorithm>
@@ -554,11 +555,18 @@ class Builder {
   Case build() {
     if (!doc_.is_object())
       ctx_.fail("", "a case file must be a JSON object {...}, got " + a_type(doc_));
-    // A case with an FEM region is built by case_fem.cpp.
-    if (doc_.contains("fem"))
+    // A case with an FEM region is built by the far-field module (cases/fe/).
+    if (doc_.contains("fem")) {
+      const detail::FarFieldModule* fe = nullptr;
+      try {
+        fe = &detail::far_field_module();
+      } catch (const std::runtime_error& e) {
+        ctx_.fail("fem", std::string("the far field's module: ") + e.what());
+      }
       return doc_.contains("bodies") || doc_.contains("grid")
-                 ? detail::build_hybrid_case(ctx_, doc_)  // case_hybrid.cpp
-                 : detail::build_fem_case(ctx_, doc_);
+                 ? fe->build_hybrid_case(ctx_, doc_)  // cases/fe/case_hybrid.cpp
+                 : fe->build_fem_case(ctx_, doc_);    // cases/fe/case_fem.cpp
+    }
     if (!checking_ && doc_.contains("geometry")) Builder(ctx_, doc_, true).build();
     Obj top(ctx_, doc_, "");
     top.allow({"title", "grid", "time", "scheme", "materials", "bodies", "boundaries", "probes", "geometry",
@@ -1233,9 +1241,16 @@ class Builder {
     o.gt("size", size, 0);
     const auto params = read_geo_parameters(o);
     o.done();
+    const GmshModule* gm = nullptr;
     try {
-      geo_ = std::make_unique<Geometry>(checking_ ? load_geometry_groups(file, size, params)
-                                                  : load_geometry(file, size, params, load_limits().mesh_cells));
+      gm = &detail::gmsh_module();
+    } catch (const std::runtime_error& e) {
+      o.fail("file", std::string("the gmsh module: ") + e.what());
+    }
+    try {
+      geo_ = std::make_unique<Geometry>(
+          checking_ ? gm->load_geometry_groups(file, size, params)
+                    : gm->load_geometry(file, size, params, load_limits().mesh_cells));
     } catch (const GeometryError& e) {
       o.fail("file", e.what());
     }

@@ -1,6 +1,6 @@
 #pragma once
-// Internal: the FEM and hybrid sides of case files (case_fem.cpp, case_hybrid.cpp) and the
-// section parsers case.cpp shares with them.
+// Internal: the FEM and hybrid sides of case files (cases/fe/case_fem.cpp and case_hybrid.cpp,
+// in the far-field module) and the section parsers case.cpp shares with them.
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "driver_common.hpp"
+#include "modules.hpp"
 #include "run_loop.hpp"
 #include "silentmpm/output.hpp"
 #include "silentmpm/state_io.hpp"
@@ -288,9 +289,9 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
 
 RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt) {
   const std::unique_ptr<detail::Region> region =
-      c.hybrid     ? detail::hybrid_region(c)
+      c.hybrid     ? detail::far_field_module().hybrid_region(c)
       : c.solver   ? detail::mpm_region(c)
-                   : detail::fem_region(c);
+                   : detail::far_field_module().fem_region(c);
   return run_region(c, *region, out_dir, opt);
 }
 

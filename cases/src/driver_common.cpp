@@ -120,14 +120,6 @@ double probe_field(const ProbeSample& s, const std::string& f) {
   throw std::runtime_error("unknown probe field " + f);
 }
 
-double probe_field(const fem::Sample& s, const std::string& f) {
-  if (f == "div") return s.div;
-  if (f == "curl") return s.curl;
-  ProbeSample p;
-  p.sxx = s.sxx; p.syy = s.syy; p.szz = s.szz; p.sxy = s.sxy; p.j2 = s.j2; p.vx = s.vx; p.vy = s.vy;
-  return probe_field(p, f);
-}
-
 Progress::Progress(bool on, long total, Clock::time_point t0, long first)
     : on_(on), total_(total), first_(first), tty_(isatty(2)), t0_(t0) {}
 
@@ -188,14 +180,6 @@ nlohmann::ordered_json silents_json(const Solver& s) {
                    {"b", sl.b},
                    {"layer_width", sl.layer.width}});
   return sil;
-}
-
-nlohmann::ordered_json fem_json(const fem::Solver& s) {
-  return nlohmann::ordered_json{{"nodes", s.nodes()},
-                                {"cells", s.cells()},
-                                {"degree", s.degree()},
-                                {"critical_dt", s.critical_dt()},
-                                {"dashpot_nodes", s.dashpots().size()}};
 }
 
 void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {

@@ -1,7 +1,7 @@
 #pragma once
 // Internal: the run loop of every case (driver.cpp) and the regions it steps. A region is what a
 // case advances in time: the MPM bodies (region_mpm.cpp), the FEM far field (region_fem.cpp) or
-// both coupled (region_hybrid.cpp). The loop owns the output folder, history.csv, probes.csv, the
+// both coupled (region_hybrid.cpp; the last two in cases/fe/, the far-field module). The loop owns the output folder, history.csv, probes.csv, the
 // step loop with its progress line and summary.json; a region samples its probes and energies,
 // writes its own snapshots and adds its blocks to summary.json.
 #include <memory>
@@ -53,6 +53,7 @@ class Region {
 };
 
 std::unique_ptr<Region> mpm_region(Case& c);     // region_mpm.cpp
+// In the far-field module (cases/fe/; the core reaches them through modules.hpp).
 std::unique_ptr<Region> fem_region(Case& c);     // region_fem.cpp
 std::unique_ptr<Region> hybrid_region(Case& c);  // region_hybrid.cpp
 

@@ -141,12 +141,6 @@ std::string fmt17(double v) {
 }
 }  // namespace
 
-bool geo_parameter_name_ok(const std::string& name) {
-  return !name.empty() && name != "h" &&
-         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
-             std::string::npos;
-}
-
 GeoParameters::GeoParameters(const std::string& file, double h,
                              const std::vector<std::pair<std::string, double>>& parameters)
     : path_(file) {

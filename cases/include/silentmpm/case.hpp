@@ -70,9 +70,12 @@ struct Case {
   std::unique_ptr<Solver> solver;  // seeded, boundary conditions added, finalize() called
   // FEM region (a case with "fem"): mesh read, boundaries added, dt set; probes added in the
   // order of `probes`. Null for an MPM-only case; solver is null for an FEM-only case.
-  std::unique_ptr<fem::Solver> fem;
-  // Both an MPM and an FEM region (case_hybrid.cpp): the coupled step over solver and fem.
-  std::unique_ptr<Hybrid> hybrid;
+  // Shared pointers: the far field lives in a module the process loads only for such a case
+  // (cases/src/modules.hpp), and a shared pointer destroys it with the deleter of the code that
+  // made it, so that the rest of the program never names the module's destructors.
+  std::shared_ptr<fem::Solver> fem;
+  // Both an MPM and an FEM region (cases/fe/case_hybrid.cpp): the coupled step over solver and fem.
+  std::shared_ptr<Hybrid> hybrid;
   std::vector<std::string> notes;  // human-readable description of the loads (time functions...)
   // Hash of the validated document without the keys a restart may change (checkpoints carry it).
   std::uint64_t fingerprint = 0;
@@ -102,5 +105,9 @@ const LoadLimits& load_limits();
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
 // Same from an already parsed document; `source` names it in messages.
 Case build_case(const nlohmann::json& doc, const std::string& source);
+
+// The FE region's line of `silentmpm check` ("FEM: <cells> cells, Q<k>, ..."): a case with an
+// FEM region and no MPM bodies.
+std::string fem_check_line(const Case& c);
 
 }  // namespace smpm

@@ -60,7 +60,11 @@ std::string gmsh_mesh_size_problem(double h, double max_cells);
 // std::runtime_error "<file>: ..." for a parameter name that is not letters, digits and _ (or is
 // h, which the mesh size sets) and when the wrapper cannot be written.
 // A name GeoParameters accepts: letters, digits and _, and not h.
-bool geo_parameter_name_ok(const std::string& name);
+inline bool geo_parameter_name_ok(const std::string& name) {
+  return !name.empty() && name != "h" &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+             std::string::npos;
+}
 
 class GeoParameters {
  public:

@@ -1,0 +1,22 @@
+// The run loop's pieces for the FE region (driver_common.hpp) that call the far field.
+#include "driver_common.hpp"
+
+namespace smpm::detail {
+
+double probe_field(const fem::Sample& s, const std::string& f) {
+  if (f == "div") return s.div;
+  if (f == "curl") return s.curl;
+  ProbeSample p;
+  p.sxx = s.sxx; p.syy = s.syy; p.szz = s.szz; p.sxy = s.sxy; p.j2 = s.j2; p.vx = s.vx; p.vy = s.vy;
+  return probe_field(p, f);
+}
+
+nlohmann::ordered_json fem_json(const fem::Solver& s) {
+  return nlohmann::ordered_json{{"nodes", s.nodes()},
+                                {"cells", s.cells()},
+                                {"degree", s.degree()},
+                                {"critical_dt", s.critical_dt()},
+                                {"dashpot_nodes", s.dashpots().size()}};
+}
+
+}  // namespace smpm::detail

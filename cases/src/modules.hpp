@@ -1,0 +1,49 @@
+#pragma once
+// Internal: the two modules a process loads only when a case needs them, so that an MPM case
+// on boxes (and --help, --version, a check of such a case) starts without gmsh or deal.II:
+//
+//   libsilentmpm_gmsh.so  gmsh/      the gmsh session and the reading of gmsh geometries
+//   libsilentmpm_fe.so    fem/, coupling/, cases/fe/
+//                                    the deal.II far field, the coupling and their cases and
+//                                    run-loop regions (it needs the gmsh module)
+//
+// Each module gives the core one table of functions through an extern "C" entry point. Its own
+// references to the core (materials, the case parsers, the output writers) are resolved against
+// the program that loads it, which exports its symbols (CMakeLists.txt: smpm_program).
+//
+// A module is looked for, in order: already in the process (a test or a study linked it), in
+// the folder of $SILENTMPM_MODULE_DIR, then in the folder of the running program. A module that
+// cannot be loaded is a std::runtime_error naming the file and the loader's reason.
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "case_keys.hpp"
+#include "run_loop.hpp"
+#include "silentmpm/case.hpp"
+#include "silentmpm/geometry.hpp"
+#include "silentmpm/gmsh_module.hpp"
+
+namespace smpm::detail {
+
+// Bumped whenever the table or a signature in it changes (as kGmshModuleApi).
+inline constexpr int kFarFieldModuleApi = 1;
+
+struct FarFieldModule {
+  int api;
+  Case (*build_fem_case)(const Ctx& ctx, const ojson& doc);     // cases/fe/case_fem.cpp
+  Case (*build_hybrid_case)(const Ctx& ctx, const ojson& doc);  // cases/fe/case_hybrid.cpp
+  std::unique_ptr<Region> (*fem_region)(Case& c);               // cases/fe/region_fem.cpp
+  std::unique_ptr<Region> (*hybrid_region)(Case& c);            // cases/fe/region_hybrid.cpp
+  // The FE region's line of `silentmpm check`.
+  std::string (*fem_check_line)(const Case& c);
+};
+
+const GmshModule& gmsh_module();  // loads libsilentmpm_gmsh.so on first use
+const FarFieldModule& far_field_module();  // loads libsilentmpm_fe.so on first use
+
+}  // namespace smpm::detail
+
+// The far-field module's entry point (cases/fe/module.cpp).
+extern "C" const smpm::detail::FarFieldModule* silentmpm_fe_module();
