@@ -1,5 +1,6 @@
-// The two modules (cases/src/modules.hpp): an MPM case on boxes, --help and --version start
-// without gmsh or deal.II; a case with a geometry loads gmsh only; an FE case loads both. A
+// The two modules (cases/src/modules.hpp) and HDF5 (output/src/hdf5_lazy.cpp): an MPM case on
+// boxes and --help start without gmsh, deal.II or HDF5; a case with a geometry loads gmsh only;
+// an FE case loads both modules; the first snapshot loads HDF5. A
 // program that cannot find a module says which file it looked for, where, and how to point it
 // there, and exits 1 (a case error).
 //
@@ -57,17 +58,22 @@ TEST(Modules, EachCommandLoadsOnlyWhatItsCaseNeeds) {
   const fs::path box = write_file("modules_box.json", kValid);
   struct Expect {
     std::string tag, args;
-    bool gmsh, fe;
+    bool gmsh, fe, hdf5;
   };
+  const std::string box_run =
+      "run \"" + box.string() + "\" --out \"" + (scratch() / "modules_box_out").string() + "\" -q";
   const Expect cases[] = {
-      {"help", "--help", false, false},
-      {"box", "check \"" + box.string() + "\"", false, false},
-      {"box_run", "run \"" + box.string() + "\" --out \"" + (scratch() / "modules_box_out").string() +
-                      "\" -q", false, false},
-      {"geometry", "check \"" + source("studies/film/cases/fixed.json") + "\"", true, false},
-      {"fem", "check \"" + source("studies/pulse/cases/shear_fem_dashpot.json") + "\"", true, true},
-      {"hybrid", "check \"" + source("studies/hybrid/cases/film_hybrid_dashpot.json") + "\"", true,
+      {"help", "--help", false, false, false},
+      {"box", "check \"" + box.string() + "\"", false, false, false},
+      {"box_run", box_run, false, false, false},
+      // A snapshot loads HDF5 (and the MPI libraries it links), nothing else.
+      {"box_snapshot", box_run + " --set output.snapshots=1", false, false, true},
+      {"geometry", "check \"" + source("studies/film/cases/fixed.json") + "\"", true, false, false},
+      // deal.II links HDF5.
+      {"fem", "check \"" + source("studies/pulse/cases/shear_fem_dashpot.json") + "\"", true, true,
        true},
+      {"hybrid", "check \"" + source("studies/hybrid/cases/film_hybrid_dashpot.json") + "\"", true,
+       true, true},
   };
   for (const Expect& e : cases) {
     const Proc r = run("LD_DEBUG=files ", SMPM_CLI, e.args, e.tag);
@@ -77,6 +83,8 @@ TEST(Modules, EachCommandLoadsOnlyWhatItsCaseNeeds) {
     // The modules themselves are opened by path.
     EXPECT_EQ(r.err.find("libsilentmpm_gmsh.so") != std::string::npos, e.gmsh) << e.tag;
     EXPECT_EQ(r.err.find("libsilentmpm_fe.so") != std::string::npos, e.fe) << e.tag;
+    EXPECT_EQ(r.err.find("libhdf5_openmpi.so") != std::string::npos, e.hdf5) << e.tag;
+    EXPECT_EQ(loaded(r, "libmpi.so"), e.hdf5) << e.tag;
   }
 }
 
