@@ -46,6 +46,7 @@ class FemRegion final : public Region {
   }
 
   void open_snapshots(const std::string& out_dir) override {
+    s_.set_snapshot_compression(c_.output.compression);
     s_.resume_snapshots(out_dir, "fem");
   }
   void write_snapshot(const std::string& out_dir) override { s_.write_snapshot(out_dir, "fem"); }

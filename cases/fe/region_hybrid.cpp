@@ -69,7 +69,9 @@ class HybridRegion final : public Region {
 
   void open_snapshots(const std::string& out_dir) override {
     snap_.set_fields(c_.output.fields);
+    snap_.set_compression(c_.output.compression);
     earlier_.open(snap_, out_dir);
+    fe_.set_snapshot_compression(c_.output.compression);
     fe_.resume_snapshots(out_dir, "fem");
   }
   void write_snapshot(const std::string& out_dir) override {

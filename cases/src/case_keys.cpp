@@ -207,7 +207,7 @@ void Obj::le(const std::string& key, double v, double hi) const {
 
 void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots) {
   o.allow({"history_every", "snapshots", "progress", "checkpoint_every", "checkpoint_time",
-           "fields"});
+           "fields", "compression"});
   out.history_every = o.integer("history_every", 1);
   o.ge("history_every", static_cast<double>(out.history_every), 1);
   const long snaps = o.integer("snapshots", 10);
@@ -221,6 +221,10 @@ void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots) {
   o.ge("checkpoint_every", static_cast<double>(out.checkpoint_every), 0);
   out.checkpoint_time = o.num("checkpoint_time", 0.0);
   o.ge("checkpoint_time", out.checkpoint_time, 0);
+  const long level = o.integer("compression", 0);
+  o.ge("compression", static_cast<double>(level), 0);
+  o.le("compression", static_cast<double>(level), 9);
+  out.compression = static_cast<int>(level);
   if (o.has("fields")) {  // the particle snapshot's fields (positions are always written)
     out.fields = 0;
     const ojson& a = o.array("fields");

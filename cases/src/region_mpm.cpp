@@ -60,6 +60,7 @@ class MpmRegion final : public Region {
 
   void open_snapshots(const std::string& out_dir) override {
     snap_.set_fields(c_.output.fields);
+    snap_.set_compression(c_.output.compression);
     earlier_.open(snap_, out_dir);
   }
   void write_snapshot(const std::string&) override {

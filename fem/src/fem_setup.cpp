@@ -812,6 +812,8 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   ++m.snapshots;
 }
 
+void Solver::set_snapshot_compression(int level) { impl_->deal->snap.set_compression(level); }
+
 void Solver::close_snapshots() {
   try {
     impl_->deal->snap.close();

@@ -23,7 +23,8 @@
 // Every function of hdf5.h that output.cpp calls (directly or through hdf5.h's macros).
 #define SMPM_H5_FUNCTIONS(X)                                                                      \
   X(H5open) X(H5check_version) X(H5Eset_auto2) X(H5Eclear2) X(H5Ewalk2) X(H5Fcreate) X(H5Fopen) \
-  X(H5Fflush) X(H5Fclose) X(H5Pcreate) X(H5Pclose) X(H5Pset_file_locking) X(H5Gcreate2)         \
+  X(H5Fflush) X(H5Fclose) X(H5Pcreate) X(H5Pclose) X(H5Pset_file_locking) X(H5Pset_chunk)       \
+  X(H5Pset_deflate) X(H5Pset_shuffle) X(H5Gcreate2)                                              \
   X(H5Gopen2) X(H5Gclose) X(H5Lexists) X(H5Ldelete) X(H5Literate) X(H5Screate)                  \
   X(H5Screate_simple) X(H5Sget_simple_extent_dims) X(H5Sclose) X(H5Dcreate2) X(H5Dopen2)        \
   X(H5Dwrite) X(H5Dget_space) X(H5Dclose) X(H5Acreate2) X(H5Aopen) X(H5Aexists) X(H5Awrite)     \
@@ -33,7 +34,7 @@
 #define SMPM_H5_GLOBALS(X)                                                                         \
   X(H5T_NATIVE_DOUBLE_g) X(H5T_IEEE_F64LE_g) X(H5T_STD_I64LE_g) X(H5T_NATIVE_INT64_g)              \
   X(H5T_STD_I32LE_g) X(H5T_NATIVE_INT32_g) X(H5T_STD_U32LE_g) X(H5T_NATIVE_UINT32_g) X(H5T_C_S1_g) \
-  X(H5P_CLS_FILE_ACCESS_ID_g)
+  X(H5P_CLS_FILE_ACCESS_ID_g) X(H5P_CLS_DATASET_CREATE_ID_g)
 
 namespace {
 
@@ -115,6 +116,11 @@ herr_t H5Pclose(hid_t plist_id) { return lib().H5Pclose(plist_id); }
 herr_t H5Pset_file_locking(hid_t fapl_id, hbool_t use_file_locking, hbool_t ignore_when_disabled) {
   return lib().H5Pset_file_locking(fapl_id, use_file_locking, ignore_when_disabled);
 }
+herr_t H5Pset_chunk(hid_t plist_id, int ndims, const hsize_t dim[]) {
+  return lib().H5Pset_chunk(plist_id, ndims, dim);
+}
+herr_t H5Pset_deflate(hid_t plist_id, unsigned level) { return lib().H5Pset_deflate(plist_id, level); }
+herr_t H5Pset_shuffle(hid_t plist_id) { return lib().H5Pset_shuffle(plist_id); }
 hid_t H5Gcreate2(hid_t loc_id, const char* name, hid_t lcpl_id, hid_t gcpl_id, hid_t gapl_id) {
   return lib().H5Gcreate2(loc_id, name, lcpl_id, gcpl_id, gapl_id);
 }

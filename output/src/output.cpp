@@ -140,13 +140,25 @@ herr_t innermost_error(unsigned n, const H5E_error2_t* e, void* out) {
                            (detail.empty() ? std::string() : " (" + detail + ")"));
 }
 
+// compression: the deflate level (0: stored as is, contiguous; 1-9: chunks of up to 65 536 rows,
+// byte-shuffled and deflated, which every HDF5 reader undoes).
 void write_dataset(hid_t group, const char* name, hid_t file_type, hid_t mem_type,
                    const void* data, std::size_t n, std::size_t ncomp, const std::string& file,
-                   const std::string& group_name, const char* units = nullptr) {
+                   const std::string& group_name, const char* units = nullptr,
+                   int compression = 0) {
+  const int rank = ncomp > 1 ? 2 : 1;
   hsize_t dims[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(ncomp)};
-  H5Handle space(H5Screate_simple(ncomp > 1 ? 2 : 1, dims, nullptr), H5Sclose);
+  H5Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose);
   if (space.id < 0) h5_fail("cannot create dataspace for '" + group_name + "/" + name + "'", file);
-  H5Handle ds(H5Dcreate2(group, name, file_type, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+  const bool deflate = compression > 0 && n > 0;
+  H5Handle dcpl(deflate ? H5Pcreate(H5P_DATASET_CREATE) : H5P_DEFAULT, deflate ? H5Pclose : nullptr);
+  if (deflate) {
+    const hsize_t chunk[2] = {std::min<hsize_t>(dims[0], 65536), dims[1]};
+    if (dcpl.id < 0 || H5Pset_chunk(dcpl.id, rank, chunk) < 0 || H5Pset_shuffle(dcpl.id) < 0 ||
+        H5Pset_deflate(dcpl.id, static_cast<unsigned>(compression)) < 0)
+      h5_fail("cannot set compression of '" + group_name + "/" + name + "'", file);
+  }
+  H5Handle ds(H5Dcreate2(group, name, file_type, space.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT),
               H5Dclose);
   if (ds.id < 0) h5_fail("cannot create dataset '" + group_name + "/" + name + "'", file);
   if (n > 0 && H5Dwrite(ds.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
@@ -381,7 +393,7 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
     return columns(3, [&](std::size_t i, int q) { return q == 0 ? a[i] : q == 1 ? b[i] : 0.0; });
   };
   write_dataset(group.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, vec3(p.x, p.y), n, 3, path,
-                gname, "m");
+                gname, "m", compression_);
   std::vector<int32_t> ibuf(n);
   for (const FieldInfo& f : kFields) {
     if (!(fields_ & f.bit) || (f.bit == kFieldFilm && !film_)) continue;
@@ -414,12 +426,12 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
     }
     if (d) {
       write_dataset(group.id, f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, d, n,
-                    static_cast<std::size_t>(f.components), path, gname, f.units);
+                    static_cast<std::size_t>(f.components), path, gname, f.units, compression_);
       continue;
     }
     if (name == "id") {
       write_dataset(group.id, f.name, H5T_STD_U32LE, H5T_NATIVE_UINT32, p.id.data(), n, 1, path,
-                    gname, f.units);
+                    gname, f.units, compression_);
       continue;
     }
     for (std::size_t i = 0; i < n; ++i)
@@ -427,7 +439,7 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
                 : name == "state" ? (i < p.state.size() ? p.state[i] : 0)
                                   : (layer ? (*layer)[i] : 0);
     write_dataset(group.id, f.name, H5T_STD_I32LE, H5T_NATIVE_INT32, ibuf.data(), n, 1, path,
-                  gname, f.units);
+                  gname, f.units, compression_);
   }
 
   // The vertex connectivity 0 .. N-1 of the Polyvertex topology (XDMF 3 readers and meshio need
@@ -436,7 +448,8 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
   if (H5Lexists(file, vname.c_str(), H5P_DEFAULT) <= 0) {
     std::vector<int64_t> v(n);
     for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<int64_t>(i);
-    write_dataset(file, vname.c_str(), H5T_STD_I64LE, H5T_NATIVE_INT64, v.data(), n, 1, path, "");
+    write_dataset(file, vname.c_str(), H5T_STD_I64LE, H5T_NATIVE_INT64, v.data(), n, 1, path, "",
+                  nullptr, compression_);
   }
 
   if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
@@ -651,11 +664,11 @@ void MeshSnapshotWriter::open(const std::string& dir, const std::string& base,
     H5Handle mesh(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     if (mesh.id < 0) h5_fail("cannot create group '/mesh'", path);
     write_dataset(mesh.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), nodes_, 3, path,
-                  "mesh", "m");
+                  "mesh", "m", compression_);
     write_dataset(mesh.id, "cells", H5T_STD_I64LE, H5T_NATIVE_INT64, cells.data(), cells_, 4,
-                  path, "mesh", "1");
+                  path, "mesh", "1", compression_);
     write_dataset(mesh.id, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, material.data(), cells_,
-                  1, path, "mesh", "1");
+                  1, path, "mesh", "1", compression_);
     if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
   } catch (...) {
     H5Fclose(f);
@@ -745,7 +758,7 @@ void MeshSnapshotWriter::write(double time, const std::vector<Field>& fields) {
   write_scalar_attribute(grp.id, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, time, path, g);
   for (const Field& fd : fields)
     write_dataset(grp.id, fd.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fd.data, nodes_,
-                  static_cast<std::size_t>(fd.components), path, g, fd.units);
+                  static_cast<std::size_t>(fd.components), path, g, fd.units, compression_);
   if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
   times_.push_back(time);
   const std::string xpath = dir_ + "/" + base_ + ".xdmf";

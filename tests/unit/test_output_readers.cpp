@@ -93,5 +93,60 @@ with open(sys.argv[2], 'w') as out:
   EXPECT_EQ(tp, tf) << "the particle and FE snapshots must carry the same times";
 }
 
+// output.compression: the same run written plain and deflated (level 1) holds the same values
+// in every dataset of particles.h5 and fem.h5, the deflated one in shuffled, deflated chunks,
+// and meshio reads it through the XDMF.
+TEST(OutputReaders, CompressedSnapshotsHoldTheSameValues) {
+  if (std::system("/usr/bin/python3 -c 'import meshio, h5py' 2>/dev/null") != 0)
+    GTEST_SKIP() << "python3-meshio or python3-h5py is not installed (scripts/setup.sh installs them)";
+  json c = hybrid_case_testing::plate_case("hybrid");
+  c["output"]["snapshots"] = 3;
+  fs::path out[2];
+  for (int level : {0, 1}) {
+    c["output"]["compression"] = level;
+    const std::string file = write_case("compressed_" + std::to_string(level), c);
+    out[level] = scratch() / ("compressed_out_" + std::to_string(level));
+    fs::remove_all(out[level]);
+    Case cs = load_case(file);
+    run_case(cs, out[level].string());
+  }
+  const fs::path script = scratch() / "compressed.py", result = scratch() / "compressed.txt";
+  std::ofstream(script) << R"(import sys, h5py, numpy, meshio
+plain, packed, res = sys.argv[1], sys.argv[2], sys.argv[3]
+n = same = deflated = nonempty = 0
+for name in ('particles.h5', 'fem.h5'):
+    with h5py.File(plain + '/' + name, 'r') as a, h5py.File(packed + '/' + name, 'r') as b:
+        def visit(path, obj):
+            global n, same, deflated, nonempty
+            if not isinstance(obj, h5py.Dataset):
+                return
+            n += 1
+            same += int(path in b and numpy.array_equal(obj[()], b[path][()]))
+            if obj.size > 0:
+                nonempty += 1
+                deflated += int(b[path].compression == 'gzip' and b[path].shuffle and a[path].compression is None)
+        a.visititems(visit)
+with meshio.xdmf.TimeSeriesReader(packed + '/particles.xdmf') as r:
+    pts, cells = r.read_points_cells()
+    t, pd, cd = r.read_data(r.num_steps - 1)
+    masses = pd['mass'].sum()
+with open(res, 'w') as f:
+    f.write('%d %d %d %d %d %.17g\n' % (n, same, nonempty, deflated, len(pts), masses))
+)";
+  ASSERT_EQ(std::system(("/usr/bin/python3 " + script.string() + " " + out[0].string() + " " +
+                         out[1].string() + " " + result.string()).c_str()),
+            0);
+  std::ifstream in(result);
+  long n = 0, same = 0, nonempty = 0, deflated = 0, points = 0;
+  double mass = 0;
+  in >> n >> same >> nonempty >> deflated >> points >> mass;
+  EXPECT_GT(n, 20) << "datasets compared";
+  EXPECT_EQ(same, n) << "datasets with the same values";
+  EXPECT_EQ(deflated, nonempty) << "non-empty datasets stored deflated";
+  const json s = json::parse(read_file(out[1] / "summary.json"));
+  EXPECT_EQ(points, s["particles"].get<long>());
+  EXPECT_GT(mass, 0);
+}
+
 }  // namespace
 }  // namespace smpm

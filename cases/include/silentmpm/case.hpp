@@ -58,6 +58,7 @@ struct OutputSpec {
   long checkpoint_every = 0;
   double checkpoint_time = 0;
   unsigned fields = ~0u;    // particle snapshot fields (SnapshotField bits of output.hpp)
+  int compression = 0;      // deflate level of the snapshot datasets, 0 (none) to 9
 };
 
 struct Case {

@@ -157,6 +157,8 @@ class Solver {
   // displacement and velocity (3-vectors, m and m/s), stress (3 x 3 tensor, Pa; each node's the
   // mean over its cells) and J2 (Pa^2); cell field material. Q2 cells are written as 4 quads.
   void write_snapshot(const std::string& dir, const std::string& base);
+  // The deflate level of the snapshot datasets (0, the default: none; 1-9: deflated chunks).
+  void set_snapshot_compression(int level);
   // Closes DIR/BASE.h5 at the end of a run. Throws FemError.
   void close_snapshots();
   int snapshot_count() const;

@@ -68,6 +68,9 @@ class SnapshotWriter {
   void open(const std::string& dir, const std::string& base = "particles");
   // The fields to write (SnapshotField bits); before open() or resume().
   void set_fields(unsigned fields) { fields_ = fields; }
+  // Deflate level of the datasets written from now on: 0 (default) stores them as they are,
+  // 1-9 in byte-shuffled, deflated chunks (OutputSpec::compression).
+  void set_compression(int level) { compression_ = level; }
   // layer: per particle (in p's order) its SnapshotLayer bits, or null (all 0).
   void write(const Particles& p, long step, double time,
              const std::vector<std::uint8_t>* layer = nullptr);
@@ -91,6 +94,7 @@ class SnapshotWriter {
   std::vector<std::size_t> sizes_;
   long long xdmf_end_ = -1;  // offset of the XDMF tail on disk (-1: write the file whole next)
   unsigned fields_ = kFieldsAll;
+  int compression_ = 0;
   bool film_ = false;        // the file carries the film block (fixed by the first snapshot)
   std::string xdmf_head() const;
   std::string xdmf_grid(std::size_t k) const;
@@ -127,6 +131,7 @@ class MeshSnapshotWriter {
   // (then nothing is open: call open()). The fields of every snapshot are those of the first.
   int resume(const std::string& dir, const std::string& base, const std::vector<double>& times);
   bool is_open() const { return file_ >= 0; }
+  void set_compression(int level) { compression_ = level; }  // as SnapshotWriter's
   void write(double time, const std::vector<Field>& fields);
   void close();
   int count() const { return static_cast<int>(times_.size()); }
@@ -138,6 +143,7 @@ class MeshSnapshotWriter {
   std::vector<double> times_;
   std::vector<std::string> names_, units_;  // the fields, as the first snapshot wrote them
   std::vector<int> components_;
+  int compression_ = 0;
   long long xdmf_end_ = -1;
   std::string xdmf_grid(std::size_t k) const;
   std::string xdmf_text() const;
