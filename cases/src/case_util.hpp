@@ -16,7 +16,10 @@ namespace smpm::detail {
 // Shortest form that reads back as v (so a value the user typed prints as typed), else 6 digits.
 inline std::string fmt(double v) {
   char b[40];
-  for (int p = 1; p <= 12; ++p) {
+  // Whole digits of a number below 10^4 are all printed (10, not 1e+01).
+  int p0 = 1;
+  for (double a = std::fabs(v); a >= 10 && a < 1e4; a /= 10) ++p0;
+  for (int p = p0; p <= 12; ++p) {
     std::snprintf(b, sizeof b, "%.*g", p, v);
     if (std::strtod(b, nullptr) == v) return b;
   }
