@@ -130,6 +130,8 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
     Obj o = top.obj("output");
     if (o.has("fields"))
       o.fail("fields", "chooses the particle snapshot's fields; an FEM case has no particles");
+    if (o.has("grid") && o.boolean("grid", false))
+      o.fail("grid", "writes the MPM grid's nodal snapshots; an FEM case has no MPM grid");
     parse_output_section(o, c.output, 100000);
   }
 

@@ -62,6 +62,10 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
   ojson dfe = ojson::object();
   for (const char* k : {"title", "time", "materials", "fem", "output", "gravity"})
     if (doc.contains(k)) dfe[k] = doc[k];
+  // The particle snapshot's fields and the MPM grid's snapshots are the MPM region's keys (its
+  // parser below reads them).
+  if (dfe.contains("output") && dfe["output"].is_object())
+    for (const char* k : {"fields", "grid"}) dfe["output"].erase(k);
   // The FEM region gets the materials its regions name (the particles' may be plastic).
   if (doc["fem"].is_object() && doc["fem"].contains("regions") && doc["fem"]["regions"].is_object() &&
       doc["materials"].is_object()) {

@@ -71,16 +71,19 @@ class HybridRegion final : public Region {
     snap_.set_fields(c_.output.fields);
     snap_.set_compression(c_.output.compression);
     earlier_.open(snap_, out_dir);
+    if (c_.output.grid) grid_.open(s_, out_dir, c_.output.compression, earlier_.times);
     fe_.set_snapshot_compression(c_.output.compression);
     fe_.resume_snapshots(out_dir, "fem");
   }
   void write_snapshot(const std::string& out_dir) override {
     const auto layer = s_.layer_flags();
     snap_.write(s_.p, s_.steps, s_.t, &layer);
+    if (c_.output.grid) grid_.write(s_);
     fe_.write_snapshot(out_dir, "fem");
   }
   void finish() override {
     snap_.close();
+    grid_.close();
     fe_.close_snapshots();
     hy_.update_energies();
   }
@@ -118,7 +121,8 @@ class HybridRegion final : public Region {
                     {"snapshots", snapshots ? snap_.count() : 0},
                     {"xdmf", snapshots ? "particles.xdmf" : ""},
                     {"fem_snapshots", fe_.snapshot_count()},
-                    {"fem_xdmf", snapshots ? "fem.xdmf" : ""}};
+                    {"fem_xdmf", snapshots ? "fem.xdmf" : ""},
+                    {"grid_xdmf", snapshots && c_.output.grid ? "grid.xdmf" : ""}};
   }
 
  private:
@@ -130,6 +134,7 @@ class HybridRegion final : public Region {
   std::vector<int> bodies_;
   SnapshotWriter snap_;
   SnapshotList earlier_;
+  GridSnapshots grid_;  // output.grid
 };
 
 }  // namespace

@@ -207,7 +207,7 @@ void Obj::le(const std::string& key, double v, double hi) const {
 
 void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots) {
   o.allow({"history_every", "snapshots", "progress", "checkpoint_every", "checkpoint_time",
-           "fields", "compression"});
+           "fields", "compression", "grid"});
   out.history_every = o.integer("history_every", 1);
   o.ge("history_every", static_cast<double>(out.history_every), 1);
   const long snaps = o.integer("snapshots", 10);
@@ -225,6 +225,7 @@ void parse_output_section(Obj& o, OutputSpec& out, long max_snapshots) {
   o.ge("compression", static_cast<double>(level), 0);
   o.le("compression", static_cast<double>(level), 9);
   out.compression = static_cast<int>(level);
+  out.grid = o.boolean("grid", false);
   if (o.has("fields")) {  // the particle snapshot's fields (positions are always written)
     out.fields = 0;
     const ojson& a = o.array("fields");

@@ -32,7 +32,9 @@ fs::path prepare_output_dir(const std::string& out_dir, bool resuming) {
                                     "failed.smpm"};
   // A restart keeps the snapshots (trimmed to the checkpoint later) and the checkpoint it read
   // until it writes its own.
-  if (!resuming) owned.insert(owned.end(), {"particles.h5", "particles.xdmf", "checkpoint.smpm"});
+  if (!resuming)
+    owned.insert(owned.end(), {"particles.h5", "particles.xdmf", "grid.h5", "grid.xdmf",
+                               "checkpoint.smpm"});
   for (const char* f : owned) {
     fs::remove(dir / f, ec);
     if (ec) throw std::runtime_error((dir / f).string() + ": cannot remove the earlier run's file: " +
@@ -82,6 +84,50 @@ void SnapshotList::open(SnapshotWriter& w, const std::string& out_dir) const {
     std::fprintf(stderr, "note: %s/particles.h5 does not hold the %zu snapshot(s) written before "
                          "the checkpoint; particles.xdmf lists the snapshots from the restart on\n",
                  out_dir.c_str(), steps.size());
+}
+
+void GridSnapshots::open(const Solver& s, const std::string& out_dir, int compression,
+                         const std::vector<double>& earlier) {
+  w_.set_compression(compression);
+  if (!earlier.empty() && w_.resume(out_dir, "grid", earlier) == static_cast<int>(earlier.size()))
+    return;
+  if (!earlier.empty())
+    std::fprintf(stderr, "note: %s/grid.h5 does not hold the %zu snapshot(s) written before the "
+                         "checkpoint; grid.xdmf lists the snapshots from the restart on\n",
+                 out_dir.c_str(), earlier.size());
+  const Grid& g = s.grid;
+  std::vector<double> xyz(3 * g.nodes());
+  for (int j = 0; j < g.nny; ++j)
+    for (int i = 0; i < g.nnx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * g.nnx + i;
+      xyz[3 * k] = g.node_x(i);
+      xyz[3 * k + 1] = g.node_y(j);
+    }
+  std::vector<std::int64_t> cells;
+  cells.reserve(4 * static_cast<std::size_t>(g.nx) * g.ny);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      const std::int64_t n0 = static_cast<std::int64_t>(j) * g.nnx + i;
+      cells.insert(cells.end(), {n0, n0 + 1, n0 + 1 + g.nnx, n0 + g.nnx});  // counter-clockwise
+    }
+  w_.open(out_dir, "grid", xyz, cells, std::vector<std::int32_t>(static_cast<std::size_t>(g.nx) * g.ny, 0));
+}
+
+void GridSnapshots::write(const Solver& s) {
+  const Solver::NodalProjection P = s.nodal_projection();
+  const std::size_t n = P.mass.size();
+  std::vector<double> v(3 * n, 0.0), sig(9 * n, 0.0), j2(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    v[3 * i] = P.vx[i];
+    v[3 * i + 1] = P.vy[i];
+    double* t = &sig[9 * i];
+    t[0] = P.sxx[i]; t[1] = t[3] = P.sxy[i]; t[4] = P.syy[i]; t[8] = P.szz[i];
+    j2[i] = j2_of(P.sxx[i], P.syy[i], P.szz[i], P.sxy[i]);
+  }
+  w_.write(s.t, {{"mass", 1, "kg/m", P.mass.data()},
+                 {"velocity", 3, "m/s", v.data()},
+                 {"stress", 9, "Pa", sig.data()},
+                 {"J2", 1, "Pa^2", j2.data()}});
 }
 
 void save_snapshot_list(StateWriter& w, const SnapshotWriter& snap) {

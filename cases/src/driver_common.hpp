@@ -40,6 +40,23 @@ struct SnapshotList {
 };
 void save_snapshot_list(StateWriter& w, const SnapshotWriter& snap);
 
+// The MPM grid's snapshots (output.grid): DIR/grid.h5 + grid.xdmf, the grid's nodes and cells
+// once, then per snapshot the particles projected onto the nodes (Solver::nodal_projection):
+// mass, velocity (3-vector) and stress (3 x 3 tensor), J2 of that stress. Written beside the
+// particle snapshots, at the same times.
+class GridSnapshots {
+ public:
+  // `earlier`: the times of the snapshots before a restart (empty: a new file).
+  void open(const Solver& s, const std::string& out_dir, int compression,
+            const std::vector<double>& earlier);
+  void write(const Solver& s);
+  void close() { w_.close(); }
+  int count() const { return w_.count(); }
+
+ private:
+  MeshSnapshotWriter w_;
+};
+
 // Writes `bytes` to `dst` whole or not at all: a temporary file beside it, every write, the
 // flush, fsync and close checked, then a rename. Throws naming dst and the cause.
 void write_file_atomically(const std::filesystem::path& dst, const std::string& bytes);

@@ -62,13 +62,16 @@ class MpmRegion final : public Region {
     snap_.set_fields(c_.output.fields);
     snap_.set_compression(c_.output.compression);
     earlier_.open(snap_, out_dir);
+    if (c_.output.grid) grid_.open(s_, out_dir, c_.output.compression, earlier_.times);
   }
   void write_snapshot(const std::string&) override {
     const auto layer = s_.layer_flags();
     snap_.write(s_.p, s_.steps, s_.t, &layer);
+    if (c_.output.grid) grid_.write(s_);
   }
   void finish() override {
     snap_.close();
+    grid_.close();
     s_.update_energies();
   }
 
@@ -90,7 +93,8 @@ class MpmRegion final : public Region {
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
                     {"snapshots", snapshots ? snap_.count() : 0},
-                    {"xdmf", snapshots ? "particles.xdmf" : ""}};
+                    {"xdmf", snapshots ? "particles.xdmf" : ""},
+                    {"grid_xdmf", snapshots && c_.output.grid ? "grid.xdmf" : ""}};
   }
 
  private:
@@ -100,6 +104,7 @@ class MpmRegion final : public Region {
   std::vector<int> bodies_;
   SnapshotWriter snap_;
   SnapshotList earlier_;  // a restart's snapshots of the run before it
+  GridSnapshots grid_;    // output.grid
 };
 
 }  // namespace

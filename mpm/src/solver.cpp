@@ -1040,6 +1040,49 @@ std::vector<std::uint8_t> Solver::layer_flags() const {
   return f;
 }
 
+Solver::NodalProjection Solver::nodal_projection() const {
+  NodalProjection out;
+  switch (opt.shape) {
+    case ShapeKind::Bilinear: project<Bilinear>(out); break;
+    case ShapeKind::UGimp: project<UGimp>(out); break;
+    case ShapeKind::BSpline2: project<BSpline2>(out); break;
+  }
+  return out;
+}
+
+template <class S>
+void Solver::project(NodalProjection& o) const {
+  const std::size_t n = grid.nodes();
+  for (auto* v : {&o.mass, &o.vx, &o.vy, &o.sxx, &o.syy, &o.szz, &o.sxy}) v->assign(n, 0.0);
+  S sf;
+  long nodes[S::kNodes];
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if constexpr (S::kSized) sf.size(p.mass[k], 1.0 / materials[p.group[k]].rho, grid.inv_h);
+    sf.eval(grid, p.x[k], p.y[k]);
+    sf.node_indices(grid.nnx, nodes);
+    for (int a = 0; a < S::kNodes; ++a) {
+      const double w = sf.N[a] * p.mass[k];
+      const auto i = static_cast<std::size_t>(nodes[a]);
+      o.mass[i] += w;
+      o.vx[i] += w * p.vx[k];
+      o.vy[i] += w * p.vy[k];
+      o.sxx[i] += w * p.sxx[k];
+      o.syy[i] += w * p.syy[k];
+      o.szz[i] += w * p.szz[k];
+      o.sxy[i] += w * p.sxy[k];
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(o.mass[i] > 0)) {
+      o.mass[i] = o.vx[i] = o.vy[i] = o.sxx[i] = o.syy[i] = o.szz[i] = o.sxy[i] = 0;
+      continue;
+    }
+    const double inv = 1.0 / o.mass[i];
+    o.vx[i] *= inv; o.vy[i] *= inv;
+    o.sxx[i] *= inv; o.syy[i] *= inv; o.szz[i] *= inv; o.sxy[i] *= inv;
+  }
+}
+
 // The time step: see the sequence at the top of solver.hpp.
 void Solver::step() {
   switch (opt.shape) {

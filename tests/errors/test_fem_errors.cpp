@@ -179,6 +179,10 @@ TEST(FemErrors, BadInputs) {
   EXPECT_ERROR(error_of(c), "output.fields", "an FEM case has no particles");
 
   c = good_case();
+  c["output"]["grid"] = true;
+  EXPECT_ERROR(error_of(c), "output.grid", "an FEM case has no MPM grid");
+
+  c = good_case();
   c["probes"][0] = {{"name", "R"}, {"region", {0.0, 0.0, 0.01, 0.001}}};
   EXPECT_ERROR(error_of(c), "probes[0].region", "unknown key");
 

@@ -652,6 +652,8 @@ TEST(Column, LayerFlagsMarkTheLayers) {
     for (std::size_t q = 0; q < s->pml.layer.idx.size(); ++q)
       EXPECT_EQ(s->pml.layer.ids[q], s->p.id[s->pml.layer.idx[q]]);
     for (std::size_t k = 0; k < f.size(); ++k)  // the traction acts on the left end only
-      if (f[k] & 2) EXPECT_LT(s->p.x[k], 2 * c.h) << k;
+      if (f[k] & 2) {
+        EXPECT_LT(s->p.x[k], 2 * c.h) << k;
+      }
   }
 }

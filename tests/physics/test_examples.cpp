@@ -7,7 +7,8 @@
 // is the applied traction (one-dimensional strain: sigma_yy = -t), and the particle velocity
 // -t / (rho c_p) (docs/physics.md, the column's closed forms); once the pulse has left through
 // the silent bottom, the energy left in the column is a small fraction of its peak.
-// Half-space (examples/half-space.json): the energy balance closes at the end of the run.
+// Half-space (examples/half-space.json): the energy balance closes at the end of the run; with
+// output.grid it writes the grid's snapshots too.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -94,8 +95,12 @@ TEST(Examples, HalfSpaceEnergyBalanceCloses) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path out = scratch() / "example_half_space";
   ASSERT_EQ(cli("run \"" + source("examples/half-space.json") + "\" --out \"" + out.string() +
-                "\" -q --set output.snapshots=0", "half_space"), 0)
+                "\" -q --set output.snapshots=2 --set output.grid=true", "half_space"), 0)
       << read_file(scratch() / "half_space.out");
+  // The grid's snapshots beside the particles' (their content: tests/unit/test_output_readers.cpp).
+  const std::string summary = read_file(out / "summary.json");
+  EXPECT_NE(summary.find("\"grid_xdmf\": \"grid.xdmf\""), std::string::npos) << summary;
+  EXPECT_TRUE(fs::exists(out / "grid.h5"));
   const smpm::History h = smpm::read_history((out / "history.csv").string());
   const double work = h.column("energy.external_work").back();
   const double stored = h.column("energy.kinetic").back() + h.column("energy.elastic").back();

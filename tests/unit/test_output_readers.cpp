@@ -93,6 +93,68 @@ with open(sys.argv[2], 'w') as out:
   EXPECT_EQ(tp, tf) << "the particle and FE snapshots must carry the same times";
 }
 
+// output.grid: the MPM grid's snapshots (grid.xdmf) open in meshio with one node per grid node and
+// one quad per cell, at the particle snapshots' times, and every snapshot's nodal mass sums to
+// the particles' mass (the projection's partition of unity).
+TEST(OutputReaders, MeshioReadsGridSnapshots) {
+  if (std::system("/usr/bin/python3 -c 'import meshio' 2>/dev/null") != 0)
+    GTEST_SKIP() << "python3-meshio is not installed (scripts/setup.sh installs it)";
+  json c = hybrid_case_testing::plate_case("hybrid");
+  c["output"]["snapshots"] = 3;
+  c["output"]["grid"] = true;
+  const std::string file = write_case("readers_grid", c);
+  const fs::path out = scratch() / "readers_grid_out";
+  fs::remove_all(out);
+  Case cs = load_case(file);
+  double mass = 0;
+  for (double m : cs.solver->p.mass) mass += m;
+  const long nodes = static_cast<long>(cs.solver->grid.nodes());
+  const long cells = static_cast<long>(cs.solver->grid.nx) * cs.solver->grid.ny;
+  run_case(cs, out.string());
+  const fs::path script = scratch() / "readers_grid.py", result = scratch() / "readers_grid.txt";
+  std::ofstream(script) << R"(import sys, meshio
+d = sys.argv[1]
+with open(sys.argv[2], 'w') as out:
+    with meshio.xdmf.TimeSeriesReader(d + '/grid.xdmf') as r:
+        pts, cells = r.read_points_cells()
+        out.write('%d %d %s %d\n' % (len(pts), sum(len(c.data) for c in cells), cells[0].type, r.num_steps))
+        for k in range(r.num_steps):
+            t, pd, cd = r.read_data(k)
+            out.write('%.9e %.17g %d %d\n' % (t, pd['mass'].sum(), pd['velocity'].shape[1], pd['stress'].shape[1]))
+    with meshio.xdmf.TimeSeriesReader(d + '/particles.xdmf') as r:
+        r.read_points_cells()
+        for k in range(r.num_steps):
+            out.write('%.9e\n' % r.read_data(k)[0])
+)";
+  ASSERT_EQ(std::system(("/usr/bin/python3 " + script.string() + " " + out.string() + " " +
+                         result.string()).c_str()),
+            0);
+  std::ifstream in(result);
+  long points = 0, ncells = 0, steps = 0;
+  std::string type;
+  in >> points >> ncells >> type >> steps;
+  EXPECT_EQ(points, nodes);
+  EXPECT_EQ(ncells, cells);
+  EXPECT_EQ(type, "quad");
+  EXPECT_EQ(steps, 4);  // t = 0 and 3 snapshots
+  std::vector<double> tg, tp;
+  for (long k = 0; k < steps; ++k) {
+    double t, m;
+    int v, sig;
+    in >> t >> m >> v >> sig;
+    tg.push_back(t);
+    EXPECT_NEAR(m, mass, 1e-12 * mass) << "snapshot " << k;
+    EXPECT_EQ(v, 3);
+    EXPECT_EQ(sig, 9);
+  }
+  for (long k = 0; k < steps; ++k) {
+    double t;
+    in >> t;
+    tp.push_back(t);
+  }
+  EXPECT_EQ(tg, tp) << "grid and particle snapshots at the same times";
+}
+
 // output.compression: the same run written plain and deflated (level 1) holds the same values
 // in every dataset of particles.h5 and fem.h5, the deflated one in shuffled, deflated chunks,
 // and meshio reads it through the XDMF.

@@ -59,6 +59,7 @@ struct OutputSpec {
   double checkpoint_time = 0;
   unsigned fields = ~0u;    // particle snapshot fields (SnapshotField bits of output.hpp)
   int compression = 0;      // deflate level of the snapshot datasets, 0 (none) to 9
+  bool grid = false;        // also the MPM grid's nodal snapshots (grid.h5 + grid.xdmf)
 };
 
 struct Case {

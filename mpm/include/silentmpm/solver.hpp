@@ -133,6 +133,14 @@ class Solver {
   // momentum over its mass), with that momentum and mass, and for a body under multi-field
   // contact the contact force on it in the last step. Not valid when no particle is inside.
   ProbeSample region_mean(double x0, double y0, double x1, double y1, int body = -1) const;
+  // The particles projected onto the grid nodes with the run's shape functions, mass-weighted:
+  // m_I = sum N_I m_p, and v_I, sigma_I = sum N_I m_p (v_p, sigma_p) / m_I (0 where m_I is 0).
+  // The grid's picture of the particles at this instant, for snapshots (output.grid); node
+  // (i, j) is entry j * nnx + i.
+  struct NodalProjection {
+    std::vector<double> mass, vx, vy, sxx, syy, szz, sxy;
+  };
+  NodalProjection nodal_projection() const;
   // Per particle (current order): 1 silent layer, 2 traction, 4 Kelvin-Voigt springs, 8 damping
   // layer, 16 perfectly matched layer (the snapshot field "layer").
   std::vector<std::uint8_t> layer_flags() const;
@@ -186,6 +194,7 @@ class Solver {
   double stretch_limit(int group) const;  // V/m past which dt is above the stability limit
   // The step and its stages, on the shape S of opt.shape.
   template <class S> void step_with();
+  template <class S> void project(NodalProjection& out) const;
   template <class S>
   void load_weights(const BoundaryLayer& L, std::size_t q, Anchor anchor, S& sf, long* nodes) const;
   template <class S> void p2g(unsigned what);
