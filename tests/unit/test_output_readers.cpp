@@ -155,6 +155,77 @@ with open(sys.argv[2], 'w') as out:
   EXPECT_EQ(tg, tp) << "grid and particle snapshots at the same times";
 }
 
+// ParaView's default reader for .xdmf (Xdmf3ReaderS in 5.11) on a hybrid run's three files:
+// particles with one vertex cell each, the FE mesh, the MPM grid; every snapshot listed, the same
+// last time in the three, the fields with their components. Runs where ParaView's pvbatch is
+// installed (Debian's paraview and python3-paraview; not by scripts/setup.sh: it is large), and is
+// skipped elsewhere.
+TEST(OutputReaders, ParaViewOpensEveryOutput) {
+  if (std::system("test -x /usr/bin/pvbatch && /usr/bin/pvbatch --version >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "ParaView's pvbatch is not installed";
+  json c = hybrid_case_testing::plate_case("hybrid");
+  c["output"]["snapshots"] = 3;
+  c["output"]["grid"] = true;
+  const std::string file = write_case("paraview_hybrid", c);
+  const fs::path out = scratch() / "paraview_out";
+  fs::remove_all(out);
+  Case cs = load_case(file);
+  const long particles = static_cast<long>(cs.solver->p.size());
+  const long nodes = static_cast<long>(cs.solver->grid.nodes());
+  const long cells = static_cast<long>(cs.solver->grid.nx) * cs.solver->grid.ny;
+  run_case(cs, out.string());
+  const json s = json::parse(read_file(out / "summary.json"));
+  const fs::path script = scratch() / "pv_readers.py", result = scratch() / "pv_readers.txt";
+  std::ofstream(script) << R"(import sys
+from paraview.simple import OpenDataFile, UpdatePipeline, servermanager
+d, res = sys.argv[1], sys.argv[2]
+with open(res, 'w') as out:
+    for name in ('particles', 'fem', 'grid'):
+        r = OpenDataFile(d + '/' + name + '.xdmf')
+        times = list(r.TimestepValues)
+        UpdatePipeline(time=times[-1], proxy=r)
+        b = servermanager.Fetch(r)
+        pd = b.GetPointData()
+        arrays = ','.join(sorted('%s:%d' % (pd.GetArrayName(i), pd.GetArray(i).GetNumberOfComponents())
+                                 for i in range(pd.GetNumberOfArrays())))
+        out.write('%s %s %d %d %d %.9e %s\n' % (name, r.GetXMLName(), b.GetNumberOfPoints(),
+                                                 b.GetNumberOfCells(), len(times), times[-1], arrays))
+)";
+  ASSERT_EQ(std::system(("cd \"" + scratch().string() + "\" && /usr/bin/pvbatch " +
+                         script.string() + " " + out.string() + " " + result.string() +
+                         " >/dev/null 2>&1").c_str()),
+            0);
+  std::ifstream in(result);
+  struct Expect {
+    const char* name;
+    long points, cells;
+    const char* arrays;
+  };
+  const Expect expect[] = {
+      {"particles", particles, particles,
+       "J2:1,body:1,displacement:3,eps_p:1,id:1,layer:1,mass:1,state:1,stress:9,velocity:3,volume:1"},
+      {"fem", s["fem"]["nodes"].get<long>(), s["fem"]["cells"].get<long>(),
+       "J2:1,displacement:3,stress:9,velocity:3"},
+      {"grid", nodes, cells, "J2:1,mass:1,stress:9,velocity:3"}};
+  double last = -1;
+  for (const Expect& e : expect) {
+    std::string name, reader, arrays;
+    long points = 0, ncells = 0, steps = 0;
+    double t = 0;
+    in >> name >> reader >> points >> ncells >> steps >> t >> arrays;
+    EXPECT_EQ(name, e.name);
+    EXPECT_EQ(reader, "Xdmf3ReaderS") << name;
+    EXPECT_EQ(points, e.points) << name;
+    EXPECT_EQ(ncells, e.cells) << name;
+    EXPECT_EQ(steps, 4) << name;
+    EXPECT_EQ(arrays, e.arrays) << name;
+    if (last >= 0) {
+      EXPECT_EQ(t, last) << name << ": the last snapshot's time";
+    }
+    last = t;
+  }
+}
+
 // output.compression: the same run written plain and deflated (level 1) holds the same values
 // in every dataset of particles.h5 and fem.h5, the deflated one in shuffled, deflated chunks,
 // and meshio reads it through the XDMF.
