@@ -1,12 +1,24 @@
 // bench: particle-updates per second of the MPM step on the pulse plate (tungsten, elastic,
-// MUSL, 1 particle per cell), refined to about 1e5 and 1e6 particles, on one thread and on all
-// threads, with a free and with a silent right boundary; and bytes per particle.
+// MUSL, 1 particle per cell), refined to about 1e5, 1e6 and 4e6 particles, on one thread and on
+// all threads, with a free and with a silent right boundary; and how close each rate comes to
+// the host's memory bandwidth.
+//
+// Against the limit: the bench measures the host's streaming bandwidth in the same run (a
+// STREAM-like triad a = b + s c over three arrays of 512 MiB, far beyond any L3; best of five,
+// counted as STREAM counts it, 24 bytes per element), and counts the bytes one step of its case
+// moves: each particle array and each grid field a pass of the step reads is counted once per
+// pass, each one it writes once more (the same convention, no write-allocate; the table of
+// passes is printed). Bytes per update times updates per second is the bandwidth the step
+// would need if every byte came from memory; its fraction of the triad says how far the step is
+// from the limit. Where the problem fits in the last-level cache the fraction can pass 1.
 //
 //   build/bench [--quick] [--shape bilinear|gimp|bspline|all]
 //     --quick: only the 1e5 size, fewer steps; --shape: the grid shape functions (default
-//     bilinear; all: the three, alternating per size and thread count)
+//     bilinear; all: the three, alternating per size and thread count; the byte count is that of
+//     the bilinear step)
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,6 +62,56 @@ std::unique_ptr<Solver> pulse_plate(double h, bool silent, int threads,
   return s;
 }
 
+// The bytes one MUSL step of an elastic bilinear case moves, per particle and per grid node
+// (kernels.hpp and Solver::step_with; doubles 8 bytes, the node's fix flags 1).
+struct PassBytes {
+  const char* pass;
+  const char* arrays;
+  double particle, node;
+};
+const PassBytes kMuslStep[] = {
+    {"reset_grid", "W m px py fx fy qx qy", 0, 7 * 8},
+    {"p2g", "R x y m vx vy vol sxx syy sxy; RW m px py fx fy", 9 * 8, 5 * 16},
+    {"nodal_velocity", "R m fix px py; W vx vy", 0, 3 * 8 + 1 + 2 * 8},
+    {"grid_update", "R m fix vx vy fx fy; W vnx vny", 0, 5 * 8 + 1 + 2 * 8},
+    {"g2p + re-map", "R x y m, RW vx vy; R vx vy vnx vny, RW qx qy", 3 * 8 + 2 * 16, 4 * 8 + 2 * 16},
+    {"re-mapped velocity", "R m fix; RW qx qy", 0, 8 + 1 + 2 * 16},
+    {"stress + move", "RW x y vol sxx syy szz sxy; R qx qy vnx vny", 7 * 16, 4 * 8},
+};
+
+double step_bytes(double nodes_per_particle) {
+  double b = 0;
+  for (const PassBytes& p : kMuslStep) b += p.particle + p.node * nodes_per_particle;
+  return b;
+}
+
+// STREAM-like triad bandwidth (GB/s, 24 bytes per element) on `threads` threads: best of five.
+double triad_gbs(int threads) {
+  const std::size_t n = std::size_t(1) << 26;  // 3 x 512 MiB
+  std::unique_ptr<double[]> a(new double[n]), b(new double[n]), c(new double[n]);
+  const long N = static_cast<long>(n);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long i = 0; i < N; ++i) {  // first touch by the threads that use the pages
+    a[i] = 0;
+    b[i] = 1.0 + i % 7;
+    c[i] = 2.0 - i % 5;
+  }
+  double best = 1e30;
+  const double s = 0.5;
+  for (int r = 0; r < 5; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    double* A = a.get();
+    const double* B = b.get();
+    const double* C = c.get();
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long i = 0; i < N; ++i) A[i] = B[i] + s * C[i];
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  volatile double sink = a[n / 3];  // the result is used
+  (void)sink;
+  return 24.0 * static_cast<double>(n) / best / 1e9;
+}
+
 double rate(double h, bool silent, int threads, int steps, ShapeKind shape) {
   auto s = pulse_plate(h, silent, threads, shape);
   for (int i = 0; i < 3; ++i) s->step();  // warm-up
@@ -87,23 +149,34 @@ int main(int argc, char** argv) {
   const int all = omp_get_max_threads();
   std::printf("silentmpm bench: pulse plate 50 x 200 mm, tungsten, elastic, MUSL, 1 ppc\n");
   std::printf("bytes per particle (particle arrays): %zu\n", Particles::bytes_per_particle());
-  std::printf("%10s %9s %8s %8s %14s %9s\n", "particles", "boundary", "threads", "steps",
-              "updates/s", "shape");
-  for (double h : {1e-4 * std::sqrt(10.0), 1e-4}) {
+  std::printf("bytes one step moves (R read, W written, RW both; per particle + per grid node):\n");
+  for (const PassBytes& p : kMuslStep)
+    std::printf("  %-20s %4.0f + %4.0f  %s\n", p.pass, p.particle, p.node, p.arrays);
+  const double triad1 = triad_gbs(1), triad_all = all > 1 ? triad_gbs(all) : triad1;
+  std::printf("triad (3 x 512 MiB, best of 5): %.1f GB/s on 1 thread, %.1f GB/s on %d\n", triad1,
+              triad_all, all);
+  std::printf("%10s %9s %8s %8s %14s %9s %8s %8s %9s\n", "particles", "boundary", "threads",
+              "steps", "updates/s", "shape", "B/update", "GB/s", "of triad");
+  for (double h : {1e-4 * std::sqrt(10.0), 1e-4, 5e-5}) {
     if (quick && h < 2e-4) continue;
     auto probe = pulse_plate(h, false, 1);
     const std::size_t n = probe->p.size();
     const std::size_t grid_bytes = probe->grid.nodes() * (14 * sizeof(double) + 1);
-    std::printf("# %zu particles, %zu grid nodes: %.0f bytes per particle including the grid\n", n,
-                probe->grid.nodes(), Particles::bytes_per_particle() + double(grid_bytes) / n);
+    const double per_update = step_bytes(double(probe->grid.nodes()) / n);
+    std::printf("# %zu particles, %zu grid nodes: %.0f bytes per particle including the grid, "
+                "%.0f MB in all\n", n, probe->grid.nodes(),
+                Particles::bytes_per_particle() + double(grid_bytes) / n,
+                (Particles::bytes_per_particle() * double(n) + grid_bytes) / 1e6);
     probe.reset();
-    const int steps = quick ? 20 : (n > 500000 ? 30 : 200);
+    const int steps = quick ? 20 : (n > 2000000 ? 10 : n > 500000 ? 30 : 200);
     for (int th : {1, all}) {
       for (bool silent : {false, true})
         for (ShapeKind shape : shapes) {
           const double r = rate(h, silent, th, steps, shape);
-          std::printf("%10zu %9s %8d %8d %14.3e %9s\n", n, silent ? "silent" : "free", th, steps, r,
-                      shape_name(shape));
+          const double gbs = r * per_update / 1e9;
+          std::printf("%10zu %9s %8d %8d %14.3e %9s %8.0f %8.1f %8.0f%%\n", n,
+                      silent ? "silent" : "free", th, steps, r, shape_name(shape), per_update, gbs,
+                      100 * gbs / (th == 1 ? triad1 : triad_all));
           std::fflush(stdout);
         }
       if (all == 1) break;
