@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "silentmpm/solver.hpp"
+#include "triad.hpp"
 
 using namespace smpm;
 
@@ -85,33 +86,6 @@ double step_bytes(double nodes_per_particle) {
   return b;
 }
 
-// STREAM-like triad bandwidth (GB/s, 24 bytes per element) on `threads` threads: best of five.
-double triad_gbs(int threads) {
-  const std::size_t n = std::size_t(1) << 26;  // 3 x 512 MiB
-  std::unique_ptr<double[]> a(new double[n]), b(new double[n]), c(new double[n]);
-  const long N = static_cast<long>(n);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (long i = 0; i < N; ++i) {  // first touch by the threads that use the pages
-    a[i] = 0;
-    b[i] = 1.0 + i % 7;
-    c[i] = 2.0 - i % 5;
-  }
-  double best = 1e30;
-  const double s = 0.5;
-  for (int r = 0; r < 5; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    double* A = a.get();
-    const double* B = b.get();
-    const double* C = c.get();
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (long i = 0; i < N; ++i) A[i] = B[i] + s * C[i];
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-  volatile double sink = a[n / 3];  // the result is used
-  (void)sink;
-  return 24.0 * static_cast<double>(n) / best / 1e9;
-}
-
 double rate(double h, bool silent, int threads, int steps, ShapeKind shape) {
   auto s = pulse_plate(h, silent, threads, shape);
   for (int i = 0; i < 3; ++i) s->step();  // warm-up
@@ -152,7 +126,8 @@ int main(int argc, char** argv) {
   std::printf("bytes one step moves (R read, W written, RW both; per particle + per grid node):\n");
   for (const PassBytes& p : kMuslStep)
     std::printf("  %-20s %4.0f + %4.0f  %s\n", p.pass, p.particle, p.node, p.arrays);
-  const double triad1 = triad_gbs(1), triad_all = all > 1 ? triad_gbs(all) : triad1;
+  const double triad1 = benchmarks::triad_gbs(1);
+  const double triad_all = all > 1 ? benchmarks::triad_gbs(all) : triad1;
   std::printf("triad (3 x 512 MiB, best of 5): %.1f GB/s on 1 thread, %.1f GB/s on %d\n", triad1,
               triad_all, all);
   std::printf("%10s %9s %8s %8s %14s %9s %8s %8s %9s\n", "particles", "boundary", "threads",

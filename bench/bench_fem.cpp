@@ -6,7 +6,13 @@
 //
 // A square plate of side 1 m, square cells (Q1: 707^2 cells, Q2: 354^2 cells for 1e6 dofs),
 // traction on the left, LK dashpots on the right, rollers on top and bottom. Prints one line per
-// (degree, threads) and the speed-up.
+// (degree, threads) and the speed-up, and how close the rate comes to the host's memory
+// bandwidth: the triad measured in the same run (bench/triad.hpp) against the bytes a step moves,
+// counted as bench counts them (each array a pass reads once, each it writes once more):
+//   K u      R rowptr (8 per node), the blocks (32 values + 4 column per block), u (16 per node,
+//            its neighbours' entries from cache); W -K u (16 per node)
+//   advance  R -K u, f_ext (16 + 16), constraint mask (1), dashpot index (4), 1/m (8);
+//            RW v, u (32 + 32) per node
 #include <omp.h>
 
 #include <chrono>
@@ -21,6 +27,7 @@
 #include <vector>
 
 #include "silentmpm/fem.hpp"
+#include "triad.hpp"
 
 using namespace smpm;
 namespace fs = std::filesystem;
@@ -95,10 +102,14 @@ int main(int argc, char** argv) {
       return a == "--help" || a == "-h" ? 0 : 1;
     }
   }
+  std::vector<double> triad;
+  for (int th : threads) triad.push_back(benchmarks::triad_gbs(th));
+  for (std::size_t k = 0; k < threads.size(); ++k)
+    std::printf("triad (3 x 512 MiB, best of 5) on %d thread(s): %.1f GB/s\n", threads[k], triad[k]);
   try {
     for (int degree : {1, 2}) {
       double base = 0;
-      for (int th : threads) {
+      for (const int& th : threads) {
         fem::Spec spec = plate(degree, target);
         spec.threads = th;
         const auto t_setup = std::chrono::steady_clock::now();
@@ -116,10 +127,15 @@ int main(int argc, char** argv) {
         for (int k = 0; k < steps; ++k) s.internal_force(s.displacement().data(), f.data());
         const double mv = static_cast<double>(s.dofs()) * steps / seconds(t1);
         if (th == threads.front()) base = rate;
+        const double bytes = 36.0 * s.matrix_blocks() + (8 + 16 + 16 + 109.0) * s.nodes();
+        const double per_dof = bytes / s.dofs();
+        const double gbs = rate * per_dof / 1e9;
+        const std::size_t k = static_cast<std::size_t>(&th - threads.data());
         std::printf("Q%d  %8zu dofs  %zu cells  threads %d  setup %.2f s  step %.3f ms  "
-                    "%.1f M dof-updates/s (K u alone %.1f M/s)  speed-up %.2f\n",
+                    "%.1f M dof-updates/s (K u alone %.1f M/s)  speed-up %.2f  %.0f B/dof-update  "
+                    "%.1f GB/s, %.0f%% of the triad\n",
                     degree, s.dofs(), s.cells(), th, setup, 1e3 * el / steps, rate / 1e6, mv / 1e6,
-                    rate / base);
+                    rate / base, per_dof, gbs, 100 * gbs / triad[k]);
       }
     }
   } catch (const std::exception& e) {

@@ -55,6 +55,7 @@ double symmetric_max_eigenvalue(std::vector<double>& a, int n) {
 }
 
 std::size_t Solver::nodes() const { return impl_->x.size(); }
+std::size_t Solver::matrix_blocks() const { return impl_->col.size(); }
 std::size_t Solver::cells() const { return impl_->n_cells; }
 int Solver::degree() const { return impl_->degree; }
 int Solver::thread_count() const { return impl_->threads; }

@@ -131,6 +131,8 @@ class Solver {
   // Sizes.
   std::size_t nodes() const;
   std::size_t dofs() const { return 2 * nodes(); }
+  // 2 x 2 blocks of the stiffness (node-block CSR: a node and each node it shares a cell with).
+  std::size_t matrix_blocks() const;
   std::size_t cells() const;
   int degree() const;
   int thread_count() const;
