@@ -13,14 +13,15 @@ import json
 import math
 import os
 
-import matplotlib
+import sys
+
 import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import style  # noqa: E402
 from history import compare, read_history as read  # noqa: E402
+
+import matplotlib.pyplot as plt  # noqa: E402
 
 CELLS = ["0.01", "0.005", "0.002"]
 EXTRA_CELLS = ["0.001"]  # a further level beyond the paper's, when present
@@ -95,19 +96,23 @@ def series(out, binary, runs, sizes):
 
 
 def figure(out, runs, labels, path, title):
+    style.apply()
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    styles = [("tab:red", "--"), ("tab:green", "-."), ("tab:blue", "-"), ("black", ":")]
-    for (r, lab), (c, ls) in zip(zip(runs, labels), styles):
-        h = read(os.path.join(out, r, "history.csv"))
-        ax.plot([t * 1e6 for t in h["time"]], [s / 1e6 for s in h["D.sxx"]], color=c, ls=ls,
-                lw=1.3, label=lab)
-    ax.set_xlabel("time (µs)")
-    ax.set_ylabel(r"$\sigma_{xx}$ at D (MPa)")
-    ax.set_title(title, fontsize=11)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=9)
+    # Coarse to fine: each level its colour of style.COLOURS and its own dashes (grey print).
+    c = style.COLOURS
+    styles = [(c[1], "--"), (c[2], "-."), (c[0], "-"), (c[6], ":")]
+    hs = [read(os.path.join(out, r, "history.csv")) for r in runs]
+    ts, tu = style.time_scale(max(h["time"][-1] for h in hs))
+    vs, vu = style.field_scale("D.sxx")
+    for h, lab, (col, ls) in zip(hs, labels, styles):
+        ax.plot([t * ts for t in h["time"]], [s * vs for s in h["D.sxx"]], color=col, ls=ls,
+                label=lab)
+    ax.set_xlabel(f"time ({tu})")
+    ax.set_ylabel(rf"$\sigma_{{xx}}$ at D ({vu})")
+    ax.set_title(title)
+    ax.legend(loc="best")
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    fig.savefig(path)
     plt.close(fig)
 
 

@@ -11,17 +11,19 @@ import os
 import sys
 
 import h5py
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import style  # noqa: E402
+
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 
 T_FIG = 2.88e-9      # time of the deformed configurations (paper Figs. 16-18)
 T_CMP = 3.2e-9       # comparison window end (extended bottom reflection returns at 3.25 ns)
 MAGNIFY = 10.0
 STATE_NAMES = ["elastic", "plastic", "decohesion", "separated"]
-STATE_COLOURS = ["#c8c8c8", "#4a90d9", "#f28e2b", "#d62728"]
+# Elastic particles a neutral light grey (the bulk), the others colours of style.COLOURS.
+STATE_COLOURS = ["#c8c8c8", style.COLOURS[0], style.COLOURS[4], style.COLOURS[1]]
 
 
 def history(path):
@@ -41,7 +43,10 @@ def rel_l2(a, b, col, t1):
 
 def snapshot_at(h5path, t):
     with h5py.File(h5path, "r") as f:
-        names = sorted(f.keys())
+        # The snapshot groups (step_<n>, each with its time); other entries (the XDMF
+        # topology's vertices_<n>) are not snapshots.
+        names = sorted(n for n in f.keys()
+                       if isinstance(f[n], h5py.Group) and "time" in f[n].attrs)
         times = np.array([f[n].attrs["time"] for n in names])
         k = int(np.argmin(np.abs(times - t)))
         g0, g = f[names[0]], f[names[k]]
@@ -91,32 +96,35 @@ def figure_deformed(snap, title, path, cell):
         ax.plot(np.vstack([X - h * tx, X + h * tx]), np.vstack([Y - h * ty, Y + h * ty]),
                 color="k", lw=0.35, alpha=0.6)
     ax.set_aspect("equal")
-    ax.set_xlabel("x (µm), displacement x10")
-    ax.set_ylabel("y (µm), displacement x10")
-    ax.set_title(f"{title}\nt = {snap['time'] * 1e9:.2f} ns, displacements magnified {MAGNIFY:.0f}x",
-                 fontsize=10)
-    ax.legend(loc="lower center", fontsize=8, markerscale=3, ncol=2)
+    ax.grid(False)
+    ax.set_xlabel(f"x (µm), displacement ×{MAGNIFY:.0f}")
+    ax.set_ylabel(f"y (µm), displacement ×{MAGNIFY:.0f}")
+    ax.set_title(f"{title}\nt = {snap['time'] * 1e9:.2f} ns, displacements magnified {MAGNIFY:.0f}×")
+    # The legend under the axes: inside it would hide particles.
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), markerscale=3, ncol=4,
+              handletextpad=0.3, columnspacing=1.2)
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    fig.savefig(path)
     plt.close(fig)
 
 
 def figure_lines(runs, col, ylabel, title, path, scale):
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    styles = ["-", "--", ":", "-."]
-    for (label, h), ls in zip(runs, styles):
+    ts, tu = style.time_scale(T_CMP)
+    for k, (label, h) in enumerate(runs):
         m = h["time"] <= T_CMP + 1e-15
-        ax.plot(h["time"][m] * 1e9, h[col][m] * scale, ls, lw=1.3, label=label)
-    ax.axvline(1.08, color="0.7", lw=0.8)
-    ax.text(1.1, 0.02, "Si round trip 5 µm", transform=ax.get_xaxis_transform(), fontsize=7,
-            color="0.4")
-    ax.set_xlabel("time (ns)")
+        ax.plot(h["time"][m] * ts, h[col][m] * scale, label=label, **style.line_style(k))
+    # The silicon round trip, explained in the legend (no text over the curves).
+    ax.axvline(1.08e-9 * ts, color="0.5", lw=0.9, ls=(0, (6, 2, 1, 2)), zorder=0,
+               label=f"Si round trip through 5 µm ({1.08e-9 * ts:.2f} {tu})")
+    ax.set_xlabel(f"time ({tu})")
     ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.set_title(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    # The legend outside on the right (as in the pulse study's figures), added after the layout
+    # so that the axes keep their size: it covers no curve; the tight bounding box takes it in.
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    fig.savefig(path)
     plt.close(fig)
 
 
@@ -157,25 +165,26 @@ def figure_interface(out, H, path):
     times = (1.0e-9, 2.0e-9, T_FIG)
     fig, axes = plt.subplots(1, len(times), figsize=(12, 3.8), sharey=True)
     for ax, t in zip(axes, times):
-        for (label, name), ls in zip([("fixed 5 µm", "fixed"), ("extended 15 µm", "extended"),
-                                      ("silent 5 µm", "silent")], ["-", "--", ":"]):
+        for j, (label, name) in enumerate([("fixed 5 µm", "fixed"), ("extended 15 µm", "extended"),
+                                           ("silent 5 µm", "silent")]):
             h = H[name]
             k = int(np.argmin(np.abs(h["time"] - t)))
-            ax.plot(x, [h[c][k] * 1e-9 for c in cols], ls, marker="o", ms=3, lw=1.2, label=label)
-        ax.set_title(f"t = {t * 1e9:.2f} ns", fontsize=10)
+            ax.plot(x, [h[c][k] * 1e-9 for c in cols], marker="o", ms=3, lw=1.2, label=label,
+                    **style.line_style(j))
+        ax.set_title(f"t = {t * 1e9:.2f} ns")
         ax.set_xlabel("x along the interface (µm)")
-        ax.grid(alpha=0.3)
-    axes[0].set_ylabel("σyy at the interface, substrate side (GPa)")
-    axes[0].legend(fontsize=8)
-    fig.suptitle("σyy along the W–Si interface (21 points of a probe along the gmsh curve "
-                 "\"interface\")", fontsize=10)
+    axes[0].set_ylabel(r"$\sigma_{yy}$ at the interface, substrate side (GPa)")
+    axes[0].legend(loc="best")
+    fig.suptitle(r"$\sigma_{yy}$ along the W–Si interface (21 points of a probe along the gmsh curve "
+                 "\"interface\")")
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    fig.savefig(path)
     plt.close(fig)
 
 
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "out")
+    style.apply()
     H = {}
     for name in ["fixed", "extended", "silent", "cell_0.05", "cell_0.167", "ppc_4", "ppc_9"]:
         p = os.path.join(out, name, "history.csv")
@@ -209,9 +218,11 @@ def main():
     # sigma_yy at E and F for the three substrates.
     three = [("fixed 5 µm", H["fixed"]), ("extended 15 µm", H["extended"]),
              ("silent 5 µm", H["silent"])]
-    figure_lines(three, "E.syy", "σyy at E (GPa)", "σyy at E (4.95 µm, 0.05 µm below the interface)",
+    figure_lines(three, "E.syy", r"$\sigma_{yy}$ at E (GPa)",
+                 r"$\sigma_{yy}$ at E (x = 4.95 µm, 0.05 µm below the interface)",
                  os.path.join(out, "figure19.png"), 1e-9)
-    figure_lines(three, "F.syy", "σyy at F (GPa)", "σyy at F (0.95 µm, 0.05 µm below the interface)",
+    figure_lines(three, "F.syy", r"$\sigma_{yy}$ at F (GPa)",
+                 r"$\sigma_{yy}$ at F (x = 0.95 µm, 0.05 µm below the interface)",
                  os.path.join(out, "figure20.png"), 1e-9)
     # J2 convergence: cell size and particles per cell (silent bottom).
     cells = [(lab, H[k]) for lab, k in [("0.05 µm", "cell_0.05"), ("0.1 µm", "silent"),
@@ -222,7 +233,7 @@ def main():
                                ("figure22.png", cells, "F", "cell size"),
                                ("figure23.png", ppcs, "E", "particles per cell"),
                                ("figure24.png", ppcs, "F", "particles per cell")]:
-        figure_lines(runs, f"{P}.J2", f"J2 at {P} (GPa²)", f"J2 at {P}, silent bottom: {what}",
+        figure_lines(runs, f"{P}.J2", f"$J_2$ at {P} (GPa²)", f"$J_2$ at {P}, silent bottom: {what}",
                      os.path.join(out, fig), 1e-18)
     # Convergence numbers: relative L2 of J2 against the finest / densest run.
     conv = {}

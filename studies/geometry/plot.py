@@ -15,13 +15,15 @@ import json
 import math
 import os
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 import sys
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import style  # noqa: E402
 from history import compare, read_history as columns  # noqa: E402
+
+import matplotlib.pyplot as plt  # noqa: E402
+
+BLUE, RED, GREEN = style.COLOURS[0], style.COLOURS[1], style.COLOURS[2]
 
 
 def read_csv(path):
@@ -37,6 +39,7 @@ def main():
     args = ap.parse_args()
     out = args.out
     metrics = {}
+    style.apply()
 
     # ---- inclined edge ----
     rows = read_csv(os.path.join(out, "inclined_widths.csv"))
@@ -75,39 +78,40 @@ def main():
     fig, axs = plt.subplots(1, 2, figsize=(10.5, 4.4))
     ax = axs[0]
     w = [f(r, "fwhm_cells") for r in silent]
-    ax.loglog(w, [f(r, "rpp") for r in silent], "o-", color="tab:blue", label=r"$|R_{PP}|$ (div u)")
-    ax.loglog(w, [f(r, "rps") for r in silent], "s-", color="tab:red", label=r"$|R_{PS}|$ (curl u)")
+    ax.loglog(w, [f(r, "rpp") for r in silent], "o-", color=BLUE, label=r"$|R_{PP}|$ (div u)")
+    ax.loglog(w, [f(r, "rps") for r in silent], "s-", color=RED, label=r"$|R_{PS}|$ (curl u)")
     wv = [f(r, "fwhm_cells") for r in silent_v]
-    ax.loglog(wv, [f(r, "rpp") for r in silent_v], "o--", color="tab:blue", alpha=0.5, mfc="none",
+    ax.loglog(wv, [f(r, "rpp") for r in silent_v], "o--", color=BLUE, alpha=0.5, mfc="none",
               label=r"$|R_{PP}|$ on velocities")
-    ax.loglog(wv, [f(r, "rps") for r in silent_v], "s--", color="tab:red", alpha=0.5, mfc="none",
+    ax.loglog(wv, [f(r, "rps") for r in silent_v], "s--", color=RED, alpha=0.5, mfc="none",
               label=r"$|R_{PS}|$ on velocities")
-    ax.axhline(f(silent[0], "rpp_exact"), color="tab:blue", ls=":", label=r"$|R_{PP}|$ closed form")
-    ax.axhline(f(silent[0], "rps_exact"), color="tab:red", ls=":", label=r"$|R_{PS}|$ closed form")
+    ax.axhline(f(silent[0], "rpp_exact"), color=BLUE, ls=":", label=r"$|R_{PP}|$ closed form")
+    ax.axhline(f(silent[0], "rps_exact"), color=RED, ls=":", label=r"$|R_{PS}|$ closed form")
     for r in [r for r in variants if f(r, "a") == 1]:
-        ax.plot([f(r, "fwhm_cells")], [f(r, "rpp")], "x", color="tab:blue", ms=8)
-        ax.plot([f(r, "fwhm_cells")], [f(r, "rps")], "+", color="tab:red", ms=9)
+        ax.plot([f(r, "fwhm_cells")], [f(r, "rpp")], "x", color=BLUE, ms=8)
+        ax.plot([f(r, "fwhm_cells")], [f(r, "rps")], "+", color=RED, ms=9)
     ax.set_xlabel("pulse width (FWHM, cells)")
     ax.set_ylabel("reflected amplitude / incident")
     ax.set_title("Silent edge at 30° (aluminium, 4 ppc), receivers 8-12 cells deep\n"
-                 "x, +: anchor at the particle (nodal and paper forms)", fontsize=9)
+                 "x, +: anchor at the particle (nodal and paper forms)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     ax = axs[1]
     dr = silent30(depths)
     if dr:
         dm = [0.5 * (f(r, "depth0_cells") + f(r, "depth1_cells")) for r in dr]
-        ax.plot(dm, [f(r, "rpp") for r in dr], "o-", color="tab:blue", label=r"$|R_{PP}|$")
-        ax.plot(dm, [f(r, "rps") for r in dr], "s-", color="tab:red", label=r"$|R_{PS}|$")
-        ax.axhline(f(dr[0], "rpp_exact"), color="tab:blue", ls=":")
-        ax.axhline(f(dr[0], "rps_exact"), color="tab:red", ls=":")
+        ax.plot(dm, [f(r, "rpp") for r in dr], "o-", color=BLUE, label=r"$|R_{PP}|$")
+        ax.plot(dm, [f(r, "rps") for r in dr], "s-", color=RED, label=r"$|R_{PS}|$")
+        ax.axhline(f(dr[0], "rpp_exact"), color=BLUE, ls=":")
+        ax.axhline(f(dr[0], "rps_exact"), color=RED, ls=":")
         ax.set_ylim(0, None)
         ax.set_xlabel("receiver depth below the edge (cells, band centre)")
-        ax.set_title("FWHM 16 cells: the excess is a near field of the edge", fontsize=9)
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.set_ylabel("reflected amplitude / incident")
+        ax.set_title("FWHM 16 cells: the excess is a near field of the edge\n"
+                     "dotted: closed form")
+        ax.legend()
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "inclined_reflection.png"), dpi=130)
+    fig.savefig(os.path.join(out, "inclined_reflection.png"))
     plt.close(fig)
 
     # ---- ring ----
@@ -159,19 +163,21 @@ def main():
         metrics["ring"]["circle_r30mm"] = circle
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    style = {"free": ("tab:red", "--", "free outer circle"), "silent": ("tab:blue", "-", "silent outer circle"),
-             "extended": ("black", ":", "extended ring (R = 150 mm)")}
-    for k in ("free", "silent", "extended"):
+    # (colour, dashes, label); the extended ring is the reference, a wide light-grey band under
+    # the others (as in the pulse study's Figs. 5-7).
+    look = {"free": (RED, "--", "free outer circle"), "silent": (BLUE, "-", "silent outer circle"),
+            "extended": ("0.72", "-", "extended ring (R = 150 mm, reference)")}
+    for k in ("extended", "free", "silent"):
         c = columns(hist[k])
-        ax.plot([t * 1e6 for t in c["time"]], [v / 1e6 for v in c["P.sxx"]], color=style[k][0], ls=style[k][1],
-                label=style[k][2])
+        ax.plot([t * 1e6 for t in c["time"]], [v / 1e6 for v in c["P.sxx"]], color=look[k][0], ls=look[k][1],
+                label=look[k][2], **(dict(lw=3.6, zorder=1) if k == "extended" else {}))
     ax.set_xlabel("time (µs)")
     ax.set_ylabel(r"$\sigma_{rr}$ at P (MPa)")
-    ax.set_title("Ring a = 10 mm, R = 50 mm, 100 MPa pressure pulse in the hole", fontsize=10)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.set_title("Ring a = 10 mm, R = 50 mm, 100 MPa pressure pulse in the hole")
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "ring_history.png"), dpi=130)
+    # The legend outside on the right, added after the layout: it covers no curve.
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    fig.savefig(os.path.join(out, "ring_history.png"))
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
@@ -180,37 +186,38 @@ def main():
         t = [x * 1e6 for x in c["time"]]
         W = ring[k]["external_work_J"]
         left = [(a + b) / W for a, b in zip(c["energy.kinetic"], c["energy.elastic"])]
-        ax.plot(t, left, color=style[k][0], ls=style[k][1], label=f"{k}: energy in the ring")
+        ax.plot(t, left, color=look[k][0], ls=look[k][1], label=f"{k}: energy in the ring")
         if k == "silent":
-            ax.plot(t, [a / W for a in c["energy.absorbed"]], color="tab:green", label="silent: absorbed")
+            ax.plot(t, [a / W for a in c["energy.absorbed"]], color=GREEN, ls="-.",
+                    label="silent: absorbed")
     ax.set_xlabel("time (µs)")
     ax.set_ylabel("fraction of the work of the pressure")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.set_title("Ring: energy left in the ring, and absorbed by the silent circle")
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "ring_energy.png"), dpi=130)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    fig.savefig(os.path.join(out, "ring_energy.png"))
     plt.close(fig)
 
     if circle:
         fig, axes = plt.subplots(1, 2, figsize=(11, 4))
         for k in ("free", "silent"):
-            axes[0].plot(circle["angles_deg"], circle[k]["srr_L2_vs_extended"], "o" + style[k][1],
-                         color=style[k][0], ms=4, label=style[k][2])
+            axes[0].plot(circle["angles_deg"], circle[k]["srr_L2_vs_extended"], "o" + look[k][1],
+                         color=look[k][0], ms=4, label=look[k][2])
         axes[0].set_yscale("log")
         axes[0].set_xlabel("angle on the circle r = 30 mm (degrees from +x)")
         axes[0].set_ylabel(r"relative L2 of $\sigma_{rr}$ vs extended, 0-30 µs")
         axes[0].set_xticks(range(0, 361, 45))
         axes[0].grid(True, alpha=0.3, which="both")
-        axes[0].legend(fontsize=8)
+        axes[0].legend()
         axes[1].plot(circle["angles_deg"], circle["extended_peak_compression_MPa"], "ko-", ms=4)
         axes[1].set_xlabel("angle on the circle r = 30 mm (degrees from +x)")
         axes[1].set_ylabel(r"peak compression $-\sigma_{rr}$ of the direct wave (MPa)")
         axes[1].set_xticks(range(0, 361, 45))
-        axes[1].grid(True, alpha=0.3)
-        fig.suptitle("Ring: 24 points of a probe along the gmsh curve \"probe_circle\" (r = 30 mm)",
-                     fontsize=10)
+        axes[0].set_title("silent and free circle against the extended ring")
+        axes[1].set_title("the direct wave in the extended ring")
+        fig.suptitle("Ring: 24 points of a probe along the gmsh curve \"probe_circle\" (r = 30 mm)")
         fig.tight_layout()
-        fig.savefig(os.path.join(out, "ring_circle.png"), dpi=130)
+        fig.savefig(os.path.join(out, "ring_circle.png"))
         plt.close(fig)
 
     with open(os.path.join(out, "metrics.json"), "w") as fo:

@@ -78,6 +78,135 @@ def timing(out, name):
     return best
 
 
+
+# Readable names of the runs in the figures (the run names are those of studies/hybrid/run).
+LABEL = {
+    "film_extended": "all-MPM, extended substrate 15 µm (reference)",
+    "film_silent": "all-MPM, silent bottom, substrate 5 µm",
+    "film_hybrid_fixed": "hybrid, uniform Q1 far field, fixed bottom",
+    "film_hybrid_dashpot": "hybrid, uniform Q1 far field, LK dashpot bottom",
+    "film_hybrid_coarse_fixed": "hybrid, graded coarse Q1 far field, fixed bottom",
+    "film_hybrid_unstructured_fixed": "hybrid, unstructured Q1 far field, fixed bottom",
+    "film_hybrid_unstructured_1um_fixed": "hybrid, unstructured Q1 far field, fixed bottom, 1 µm of particles",
+    "film_extended_30um": "all-MPM, extended substrate 30 µm (reference)",
+    "film_hybrid_unstructured_30um_fixed": "hybrid, unstructured Q1 far field to 30 µm, fixed bottom",
+    "pulse_extended": "all-MPM, extended plate (reference)",
+    "pulse_silent": "all-MPM, silent right side",
+    "pulse_hybrid_extended": "hybrid, Q1 far field to the extended plate's free end",
+    "pulse_hybrid_dashpot": "hybrid, Q1 far field with LK dashpots",
+}
+
+
+def looks(style):
+    """Line look of each run: the all-MPM extended reference a wide light-grey band under the
+    others (as in the pulse study's Figs. 5-7), the others colours of style.COLOURS with their own
+    dashes (apart in grey print), one run the same look in every figure."""
+    c = style.COLOURS
+    ref = dict(color="0.72", ls="-", lw=3.6, zorder=1)
+    return {
+        "film_extended": ref, "film_extended_30um": ref, "pulse_extended": ref,
+        "film_silent": dict(color=c[1], ls="--"), "pulse_silent": dict(color=c[1], ls="--"),
+        "film_hybrid_unstructured_fixed": dict(color=c[0], ls="-"),
+        "film_hybrid_unstructured_30um_fixed": dict(color=c[0], ls="-"),
+        "film_hybrid_fixed": dict(color=c[2], ls="-."),
+        "pulse_hybrid_extended": dict(color=c[2], ls="-."),
+        "film_hybrid_dashpot": dict(color=c[6], ls=":"),
+        "pulse_hybrid_dashpot": dict(color=c[6], ls=":"),
+        "film_hybrid_coarse_fixed": dict(color=c[3], ls=(0, (5, 1.5, 1, 1.5, 1, 1.5))),
+    }
+
+
+YARDSTICK = dict(color="0.35", ls="-", lw=0.7)  # the 0.05 µm all-MPM run: thin dark grey
+
+
+def figures(out, m, H, fine, fine30):
+    """hybrid_film.png, hybrid_cost_accuracy.png, hybrid_film_30um.png, hybrid_pulse.png in OUTDIR
+    (fine, fine30: the 0.05 µm yardstick histories, or None)."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+    import style
+    import matplotlib.pyplot as plt
+    style.apply()
+    look = looks(style)
+
+    def panels(runs, yard, yard_label, cols, ylabels, t_end, title, path, window=None):
+        """One panel per column, one curve per run, the legend under the panels (off the data)."""
+        ts, tu = style.time_scale(t_end)
+        fig, ax = plt.subplots(1, len(cols), figsize=(11, 4.2))
+        for a, (c, scale, ptitle), ylabel in zip(ax, cols, ylabels):
+            for n in runs:
+                a.plot(H[n]["time"] * ts, H[n][c] * scale, label=LABEL[n], **look[n])
+            if yard is not None:
+                a.plot(yard["time"] * ts, yard[c] * scale, label=yard_label, **YARDSTICK)
+            if window is not None:
+                a.axvline(window[0] * ts, color="0.3", lw=0.9, ls=(0, (6, 2, 1, 2)), zorder=0,
+                          label=window[1] % (window[0] * ts, tu))
+            a.set_xlabel("time (%s)" % tu)
+            a.set_ylabel(ylabel)
+            a.set_title(ptitle)
+        handles, labels = ax[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=2)
+        fig.suptitle(title)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, path))
+        plt.close(fig)
+
+    below = "0.05 µm below the W–Si interface"
+    film_cols = [("E.syy", 1e-9, "probe E, x = 4.95 µm, " + below),
+                 ("F.syy", 1e-9, "probe F, x = 0.95 µm, " + below)]
+    panels(["film_extended", "film_silent", "film_hybrid_fixed", "film_hybrid_dashpot",
+            "film_hybrid_coarse_fixed", "film_hybrid_unstructured_fixed"],
+           fine, "all-MPM, extended substrate 15 µm, 0.05 µm cells (accuracy yardstick)",
+           film_cols, [r"$\sigma_{yy}$ at E (GPa)", r"$\sigma_{yy}$ at F (GPa)"], m["window"]["film"][1],
+           "Tungsten film on silicon, 1.3 GPa step: all-MPM and hybrid runs (0.1 µm cells)",
+           "hybrid_film.png")
+    # Cost against accuracy: step-loop CPU time (build/bench_hybrid where it ran, else the
+    # timing runs' step wall time) and the error against the 0.05 um run.
+    if "accuracy_vs_fine" in m:
+        bc = m.get("benchmark", {}).get("cases", {})
+        c = style.COLOURS
+        show = [("film_extended", "extended", dict(marker="s", color="0.45")),
+                ("film_silent", "film_silent", dict(marker="v", color=c[1])),
+                ("film_hybrid_coarse_fixed", "film_hybrid_coarse_fixed", dict(marker="^", color=c[3])),
+                ("film_hybrid_unstructured_fixed", "film_hybrid_unstructured_fixed",
+                 dict(marker="o", color=c[0])),
+                ("film_hybrid_unstructured_1um_fixed", "film_hybrid_unstructured_1um_fixed",
+                 dict(marker="D", color=c[4]))]
+        fig, ax = plt.subplots(1, 4, figsize=(14, 3.6), sharex=True)
+        for a, (col, what) in zip(ax, [("E.syy", r"$\sigma_{yy}$ at E"), ("F.syy", r"$\sigma_{yy}$ at F"),
+                                       ("E.J2", r"$J_2$ at E"), ("F.J2", r"$J_2$ at F")]):
+            top = 0
+            for n, bn, st in show:
+                if not m["runs"][n]["timing"]:
+                    continue
+                t = bc[bn]["step_cpu_seconds_min"] if bn in bc else m["runs"][n]["timing"]["step_wall_seconds"]
+                e = m["accuracy_vs_fine"]["error_vs_fine"][n][col]
+                top = max(top, e)
+                a.plot([t], [e], ls="none", ms=7, label=LABEL[n], **st)
+            a.set_xlabel("step loop, one thread (s)")
+            a.set_title(what)
+            a.set_xlim(left=0); a.set_ylim(0, 1.15 * top)
+        ax[0].set_ylabel("relative L2 error against\nthe 0.05 µm run, 0–3.2 ns")
+        handles, labels = ax[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=3)
+        fig.suptitle("Film: cost (step-loop CPU time) against accuracy (error against the all-MPM "
+                     "run at 0.05 µm cells)")
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "hybrid_cost_accuracy.png"))
+        plt.close(fig)
+    if "film_hybrid_unstructured_30um_fixed" in H:
+        panels(["film_extended_30um", "film_hybrid_unstructured_30um_fixed"],
+               fine30, "all-MPM, extended substrate 30 µm, 0.05 µm cells (accuracy yardstick)",
+               film_cols, [r"$\sigma_{yy}$ at E (GPa)", r"$\sigma_{yy}$ at F (GPa)"], m["window"]["film_30um"][1],
+               "Tungsten film on a 30 µm silicon substrate, to 6.4 ns: all-MPM and hybrid",
+               "hybrid_film_30um.png")
+    panels(["pulse_extended", "pulse_silent", "pulse_hybrid_extended", "pulse_hybrid_dashpot"],
+           None, None, [("A.sxx", 1e-6, "longitudinal stress at A"),
+                        ("A.syy", 1e-6, "lateral stress at A")],
+           [r"$\sigma_{xx}$ at A (MPa)", r"$\sigma_{yy}$ at A (MPa)"], H["pulse_extended"]["time"][-1],
+           "Plate under a compressive pulse: all-MPM and hybrid runs", "hybrid_pulse.png",
+           window=(m["window"]["pulse"][1], "end of the comparison window (%.0f %s)"))
+
+
 def main(out):
     film = ["film_extended", "film_silent", "film_hybrid_fixed", "film_hybrid_dashpot",
             "film_hybrid_graded_fixed", "film_hybrid_coarse_fixed", "film_hybrid_unstructured_fixed",
@@ -179,65 +308,8 @@ def main(out):
     with open(os.path.join(out, "metrics.json"), "w") as f:
         json.dump(m, f, indent=2)
     try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-        for n, st in [("film_extended", "k-"), ("film_silent", "b--"), ("film_hybrid_fixed", "r-."),
-                      ("film_hybrid_dashpot", "g:"), ("film_hybrid_coarse_fixed", "m--"),
-                      ("film_hybrid_unstructured_fixed", "c-")]:
-            for a, p in zip(ax, "EF"):
-                a.plot(H[n]["time"] * 1e9, H[n][p + ".syy"] / 1e9, st, label=n)
-        if "accuracy_vs_fine" in m:
-            for a, p in zip(ax, "EF"):
-                a.plot(fine["time"] * 1e9, fine[p + ".syy"] / 1e9, color="0.6", lw=0.8,
-                       label="film_extended at 0.05 um (yardstick)")
-        for a, p in zip(ax, "EF"):
-            a.set_xlabel("t (ns)"); a.set_ylabel("sigma_yy at %s (GPa)" % p); a.legend(fontsize=7)
-        fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_film.png"), dpi=120)
-        # Cost against accuracy: step-loop CPU time (build/bench_hybrid where it ran, else the
-        # timing runs' step wall time) and the error against the 0.05 um run.
-        if "accuracy_vs_fine" in m:
-            bc = m.get("benchmark", {}).get("cases", {})
-            show = [("film_extended", "extended", "ks"), ("film_silent", "film_silent", "bv"),
-                    ("film_hybrid_coarse_fixed", "film_hybrid_coarse_fixed", "m^"),
-                    ("film_hybrid_unstructured_fixed", "film_hybrid_unstructured_fixed", "co"),
-                    ("film_hybrid_unstructured_1um_fixed", "film_hybrid_unstructured_1um_fixed", "rD")]
-            fig, ax = plt.subplots(1, 4, figsize=(14, 3.6), sharex=True)
-            for a, c in zip(ax, ["E.syy", "F.syy", "E.J2", "F.J2"]):
-                top = 0
-                for n, bn, st in show:
-                    if not m["runs"][n]["timing"]:
-                        continue
-                    t = bc[bn]["step_cpu_seconds_min"] if bn in bc else m["runs"][n]["timing"]["step_wall_seconds"]
-                    e = m["accuracy_vs_fine"]["error_vs_fine"][n][c]
-                    top = max(top, e)
-                    a.plot([t], [e], st, label=n)
-                a.set_xlabel("step loop, one thread (s)")
-                a.set_title("%s: error vs the 0.05 um run" % c, fontsize=9)
-                a.set_xlim(left=0); a.set_ylim(0, 1.15 * top)
-            ax[0].legend(fontsize=6, loc="lower right")
-            fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_cost_accuracy.png"), dpi=120)
-        if "film_hybrid_unstructured_30um_fixed" in H:
-            fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-            curves = [("film_extended_30um", H["film_extended_30um"], "k", 1.0),
-                      ("film_hybrid_unstructured_30um_fixed", H["film_hybrid_unstructured_30um_fixed"], "c", 1.0)]
-            if "accuracy_vs_fine" in m and "yardstick_30um" in m["accuracy_vs_fine"]:
-                curves.append(("film_extended_30um at 0.05 um (yardstick)", fine30, "0.6", 0.8))
-            for lab, h, col, lw in curves:
-                for a, p in zip(ax, "EF"):
-                    a.plot(h["time"] * 1e9, h[p + ".syy"] / 1e9, "-", color=col, lw=lw, label=lab)
-            for a, p in zip(ax, "EF"):
-                a.set_xlabel("t (ns)"); a.set_ylabel("sigma_yy at %s (GPa)" % p); a.legend(fontsize=7)
-            fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_film_30um.png"), dpi=120)
-        fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-        for n, st in [("pulse_extended", "k-"), ("pulse_silent", "b--"), ("pulse_hybrid_extended", "r-."),
-                      ("pulse_hybrid_dashpot", "g:")]:
-            for a, c in zip(ax, ["A.sxx", "A.syy"]):
-                a.plot(H[n]["time"] * 1e6, H[n][c] / 1e6, st, label=n)
-        for a, c in zip(ax, ["A.sxx", "A.syy"]):
-            a.set_xlabel("t (us)"); a.set_ylabel(c + " (MPa)"); a.legend(fontsize=7)
-        fig.tight_layout(); fig.savefig(os.path.join(out, "hybrid_pulse.png"), dpi=120)
+        figures(out, m, H, fine if "accuracy_vs_fine" in m else None,
+                fine30 if "yardstick_30um" in m.get("accuracy_vs_fine", {}) else None)
     except ImportError:
         pass
     print(json.dumps(sp, indent=2))

@@ -13,19 +13,23 @@ import json
 import math
 import os
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 import sys
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import style  # noqa: E402
 from history import compare, read_history as read  # noqa: E402
+
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.colors import to_rgba  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 BCS = ("free", "silent", "extended")
-STYLE = {"free": ("tab:red", "--", "free boundary"),
-         "silent": ("tab:blue", "-", "silent boundary"),
-         "extended": ("black", ":", "extended region")}
+# (look, label): the extended run is the reference, a wide light-grey band under the others (as in
+# the pulse study's Figs. 5-7); the truncated plates in colours of style.COLOURS.
+STYLE = {"free": (dict(color=style.COLOURS[1], ls="--"), "free boundary"),
+         "silent": (dict(color=style.COLOURS[0], ls="-"), "silent boundary"),
+         "extended": (dict(color="0.72", ls="-", lw=3.6, zorder=1), "extended region (reference)")}
+LABEL = {"free": "free boundary", "silent": "silent boundary", "extended": "extended region"}
 MARGIN_CELLS = 10
 
 
@@ -74,7 +78,7 @@ def figure8(cases, probes, path):
         case = cases[bc]
         fl = body(case, "flyer")["box"]
         tg = body(case, "target")["box"]
-        ax.add_patch(Rectangle((fl[0], fl[1]), fl[2] - fl[0], fl[3] - fl[1], fc="#c9d9ee",
+        ax.add_patch(Rectangle((fl[0], fl[1]), fl[2] - fl[0], fl[3] - fl[1], fc=to_rgba(style.COLOURS[5], 0.35),
                                ec="k", label="aluminium"))
         ax.add_patch(Rectangle((tg[0], tg[1]), tg[2] - tg[0], tg[3] - tg[1], fc="#dddddd", ec="k",
                                label="steel"))
@@ -88,49 +92,56 @@ def figure8(cases, probes, path):
             ax.text(xt + 0.002, tg[1] + 0.004, "x of the truncated\nright side", fontsize=7,
                     color="gray")
         if bc == "silent":
-            ax.plot([tg[2], tg[2]], [tg[1], tg[3]], color="tab:blue", lw=4, label="silent layer")
+            ax.plot([tg[2], tg[2]], [tg[1], tg[3]], color=style.COLOURS[0], lw=4, label="silent layer")
         for name, (x, y) in probes.items():
             ax.plot(x, y, "ko", ms=4)
             ax.text(x + 0.002, y + 0.002, name, fontsize=10)
         ax.set_xlim(-0.045, tg[2] + 0.01)
         ax.set_ylim(-0.01, 0.11)
         ax.set_aspect("equal")
-        ax.set_title(f"({tag}) {STYLE[bc][2]}", fontsize=10)
+        ax.grid(False)
+        ax.set_title(f"({tag}) {LABEL[bc]}")
         ax.set_xlabel("x (m)")
         if tag == "a":
             ax.set_ylabel("y (m)")
             ax.legend(fontsize=7, loc="lower left")
-        ax.text(fl[0], fl[3] + 0.003, f"{fl[2]-fl[0]:.2f} x {fl[3]-fl[1]:.2f}", fontsize=7)
-        ax.text(tg[0] + 0.003, tg[3] + 0.003, f"{tg[2]-tg[0]:.2f} x {tg[3]-tg[1]:.2f}", fontsize=7)
+        ax.text(fl[0], fl[3] + 0.003, f"{fl[2]-fl[0]:.2f} × {fl[3]-fl[1]:.2f}", fontsize=7)
+        ax.text(tg[0] + 0.003, tg[3] + 0.003, f"{tg[2]-tg[0]:.2f} × {tg[3]-tg[1]:.2f}", fontsize=7)
     fig.suptitle("Oblique impact: aluminium plate strikes the steel plate off-centre "
-                 "(assumed geometry; paper Fig. 8)", fontsize=10)
+                 "(assumed geometry; paper Fig. 8)")
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    fig.savefig(path)
     plt.close(fig)
 
 
 def stress_figure(hist, probe, win, win1, path, title):
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=True)
+    ts, tu = style.time_scale(max(h["time"][-1] for h in hist.values()))
+    vs, vu = style.field_scale(f"{probe}.sxx")
+    # The extended reference first, so that the other curves are drawn over its band.
+    order = ["extended", "free", "silent"]
     for ax, prefix, sub in zip(axes, ("", "multi_"),
                                ("single velocity field (the paper's MPM)",
                                 "multi-velocity-field contact")):
-        for bc in BCS:
-            col, ls, label = STYLE[bc]
+        for bc in order:
+            look, label = STYLE[bc]
             h = hist[prefix + bc]
-            ax.plot([t * 1e6 for t in h["time"]], [s / 1e6 for s in h[f"{probe}.sxx"]], color=col,
-                    ls=ls, lw=1.3, label=label)
-        ax.axvline(win * 1e6, color="gray", lw=0.8)
-        ax.axvline(win1 * 1e6, color="gray", lw=0.8, ls="--")
-        ax.text(win * 1e6, ax.get_ylim()[0], " end of the\n reflection-free\n window",
-                fontsize=7, va="bottom", color="gray")
-        ax.set_xlabel("time (µs)")
-        ax.set_title(sub, fontsize=10)
-        ax.grid(alpha=0.3)
-    axes[0].set_ylabel(rf"$\sigma_{{xx}}$ at {probe} (MPa)")
-    axes[0].legend(fontsize=8)
-    fig.suptitle(title, fontsize=11)
+            ax.plot([t * ts for t in h["time"]], [s * vs for s in h[f"{probe}.sxx"]], label=label,
+                    **look)
+        # The windows' ends: vertical lines explained in the legend (no text over the curves).
+        ax.axvline(win * ts, color="0.3", lw=0.9, ls=(0, (6, 2, 1, 2)), zorder=0,
+                   label=f"end of the reflection-free window ({win * ts:.1f} {tu})")
+        ax.axvline(win1 * ts, color="0.3", lw=0.9, ls=(0, (1.5, 1.5)), zorder=0,
+                   label=f"end of the first-reflection window ({win1 * ts:.1f} {tu})")
+        ax.set_xlabel(f"time ({tu})")
+        ax.set_title(sub)
+    axes[0].set_ylabel(rf"$\sigma_{{xx}}$ at {probe} ({vu})")
+    fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
+    # The legend under the panels, where it covers no curve (the tight bounding box takes it in).
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=3)
+    fig.savefig(path)
     plt.close(fig)
 
 
@@ -140,6 +151,7 @@ def main():
     ap.add_argument("--cases", required=True)
     ap.add_argument("--bin", required=True)
     args = ap.parse_args()
+    style.apply()
     cases = {bc: json.load(open(os.path.join(args.cases, f"{bc}.json"))) for bc in BCS}
     for bc in BCS:  # bodies from gmsh surfaces: their extent as built, from the run's summary
         built = {b["name"]: b["extent"]

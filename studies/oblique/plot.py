@@ -9,13 +9,19 @@ OUTDIR/metrics_mpm.json (`oblique --method mpm`), adds the closed-form curves
 import cmath
 import json
 import math
+import os
 import sys
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import style  # noqa: E402
+
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+
+# One colour per reflected wave (style.COLOURS): closed form solid lines, FEM filled markers, MPM
+# open markers.
+C = {"PP": style.COLOURS[0], "PS": style.COLOURS[1], "SS": style.COLOURS[2], "SP": style.COLOURS[3]}
 
 
 def lk(nu, angle, a=1.0, b=1.0):
@@ -56,54 +62,55 @@ def main():
     except FileNotFoundError:
         pass
     nu = m["nu"]
+    style.apply()
     ang = np.linspace(0, 80, 161)
     ex = np.array([lk(nu, math.radians(a)) for a in ang])
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.3))
     p = [r for r in m["results"] if r["wave"] == "P"]
     s = [r for r in m["results"] if r["wave"] == "SV"]
     ax = axs[0]
-    ax.plot(ang, ex[:, 0], "C0-", label="|R_PP| exact")
-    ax.plot(ang, ex[:, 1], "C1-", label="|R_PS| exact")
-    ax.plot([r["angle_deg"] for r in p], [r["R_PP"] for r in p], "C0o", label="|R_PP| FEM")
-    ax.plot([r["angle_deg"] for r in p], [r["R_PS"] for r in p], "C1s", label="|R_PS| FEM")
+    ax.plot(ang, ex[:, 0], "-", color=C["PP"], label="$|R_{PP}|$ exact")
+    ax.plot(ang, ex[:, 1], "--", color=C["PS"], label="$|R_{PS}|$ exact")
+    ax.plot([r["angle_deg"] for r in p], [r["R_PP"] for r in p], "o", color=C["PP"], label="$|R_{PP}|$ FEM")
+    ax.plot([r["angle_deg"] for r in p], [r["R_PS"] for r in p], "s", color=C["PS"], label="$|R_{PS}|$ FEM")
     ax.set_title("incident P")
     ax = axs[1]
-    ax.plot(ang, ex[:, 2], "C2-", label="|R_SS| exact")
-    ax.plot(ang, ex[:, 3], "C3-", label="|R_SP| exact")
-    ax.plot([r["angle_deg"] for r in s], [r["R_SS"] for r in s], "C2o", label="|R_SS| FEM")
+    ax.plot(ang, ex[:, 2], "-", color=C["SS"], label="$|R_{SS}|$ exact")
+    ax.plot(ang, ex[:, 3], "--", color=C["SP"], label="$|R_{SP}|$ exact")
+    ax.plot([r["angle_deg"] for r in s], [r["R_SS"] for r in s], "o", color=C["SS"], label="$|R_{SS}|$ FEM")
     trav = [r for r in s if not r["reflected_p_evanescent"]]
     ev = [r for r in s if r["reflected_p_evanescent"]]
-    ax.plot([r["angle_deg"] for r in trav], [r["R_SP"] for r in trav], "C3s", label="|R_SP| FEM")
+    ax.plot([r["angle_deg"] for r in trav], [r["R_SP"] for r in trav], "s", color=C["SP"],
+            label="$|R_{SP}|$ FEM")
     if ev:
-        ax.plot([r["angle_deg"] for r in ev], [r["R_SP"] for r in ev], "C3x",
-                label="|R_SP| FEM (evanescent P: not an amplitude)")
+        ax.plot([r["angle_deg"] for r in ev], [r["R_SP"] for r in ev], "x", color=C["SP"],
+                label="$|R_{SP}|$ FEM (evanescent P: not an amplitude)")
     if mpm:
         pm = [r for r in mpm["results"] if r["wave"] == "P"]
         sm = [r for r in mpm["results"] if r["wave"] == "SV" and not r["reflected_p_evanescent"]]
         sm_all = [r for r in mpm["results"] if r["wave"] == "SV"]
-        axs[0].plot([r["angle_deg"] for r in pm], [r["R_PP"] for r in pm], "C0^", mfc="none",
-                    label="|R_PP| MPM")
-        axs[0].plot([r["angle_deg"] for r in pm], [r["R_PS"] for r in pm], "C1v", mfc="none",
-                    label="|R_PS| MPM")
-        axs[1].plot([r["angle_deg"] for r in sm_all], [r["R_SS"] for r in sm_all], "C2^",
-                    mfc="none", label="|R_SS| MPM")
-        axs[1].plot([r["angle_deg"] for r in sm], [r["R_SP"] for r in sm], "C3v", mfc="none",
-                    label="|R_SP| MPM")
+        axs[0].plot([r["angle_deg"] for r in pm], [r["R_PP"] for r in pm], "^", color=C["PP"],
+                    mfc="none", label="$|R_{PP}|$ MPM")
+        axs[0].plot([r["angle_deg"] for r in pm], [r["R_PS"] for r in pm], "v", color=C["PS"],
+                    mfc="none", label="$|R_{PS}|$ MPM")
+        axs[1].plot([r["angle_deg"] for r in sm_all], [r["R_SS"] for r in sm_all], "^",
+                    color=C["SS"], mfc="none", label="$|R_{SS}|$ MPM")
+        axs[1].plot([r["angle_deg"] for r in sm], [r["R_SP"] for r in sm], "v", color=C["SP"],
+                    mfc="none", label="$|R_{SP}|$ MPM")
     kappa = math.sqrt((1 - 2 * nu) / (2 * (1 - nu)))
     ax.axvline(math.degrees(math.asin(kappa)), color="0.6", ls=":", lw=1)
     ax.set_title("incident SV (dotted: critical angle)")
     for ax in axs:
-        ax.set_xlabel("angle of incidence from the boundary normal (deg)")
+        ax.set_xlabel("angle of incidence from the boundary normal (°)")
         ax.set_ylabel("reflected / incident displacement amplitude")
         ax.set_xlim(0, 80)
         ax.set_ylim(0, 0.8)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
     fig.suptitle(f"LK dashpots (a = b = 1): FEM far-field (Q1){' and MPM silent layer (1 ppc)' if mpm else ''}, "
-                 f"nu = {nu}, Gaussian pulse {m['pulse_fwhm_cells']} cells FWHM; extended-domain differencing",
-                 fontsize=10)
+                 f"ν = {nu}, Gaussian pulse {m['pulse_fwhm_cells']} cells FWHM\nmeasured by extended-domain differencing")
     fig.tight_layout()
-    fig.savefig(f"{out}/reflection_vs_angle.png", dpi=130)
+    for ax in axs:  # under each panel, where it covers no curve (the tight bounding box takes it in)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
+    fig.savefig(f"{out}/reflection_vs_angle.png")
     print(f"oblique: wrote {out}/reflection_vs_angle.png")
 
 

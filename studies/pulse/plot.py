@@ -8,19 +8,26 @@ import argparse
 import json
 import os
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 import sys
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import style  # noqa: E402
 from history import compare, read_history as read  # noqa: E402
 
-STYLE = {"free": ("tab:red", "--", "free boundary"),
-         "silent": ("tab:blue", "-", "silent boundary"),
-         "extended": ("black", ":", "extended region"),
-         "fem_dashpot": ("tab:green", "-.", "FEM, LK dashpots"),
-         "fem_extended": ("tab:purple", (0, (1, 1)), "FEM, extended region")}
+import matplotlib.pyplot as plt  # noqa: E402
+
+# Curve looks: the MPM extended run is the reference, a wide light-grey band under the others; the
+# FEM extended run is black dotted on top of it, the two truncated treatments of each method solid
+# / dashed / dash-dot in colours of style.COLOURS (apart in grey print by their dashes too).
+STYLE = {"free": dict(color=style.COLOURS[1], ls="--", lw=1.4, label="MPM, free boundary"),
+         "silent": dict(color=style.COLOURS[0], ls="-", lw=1.4, label="MPM, silent boundary"),
+         "extended": dict(color="0.72", ls="-", lw=3.6, zorder=1,
+                          label="MPM, extended region (reference)"),
+         "fem_dashpot": dict(color=style.COLOURS[2], ls="-.", lw=1.4, label="FEM, LK dashpots"),
+         "fem_extended": dict(color=style.COLOURS[6], ls=":", lw=1.5, label="FEM, extended region")}
+# All three figures alike: the same size and the same axes box, the legend outside on the right.
+FIGSIZE = (8.6, 4.2)       # inches
+AXES_BOX = [0.085, 0.12, 0.6, 0.8]  # left, bottom, width, height (figure fractions)
 FIGURES = [("figure5.png", "compressive", "sxx", r"$\sigma_{xx}$ at A (MPa)",
             "Longitudinal stress at A, compressive pulse (paper Fig. 5)"),
            ("figure6.png", "compressive", "syy", r"$\sigma_{yy}$ at A (MPa)",
@@ -79,24 +86,29 @@ def main():
             m["fem_dof_updates_per_second"] = {bc: summaries[bc]["dof_updates_per_second"] for bc in fem}
         metrics[load] = m
 
+    style.apply()
+    # The reference first, so that the other curves are drawn over its band.
+    order = ["extended"] + [bc for bc in study["treatments"] + fem if bc != "extended"]
     for fname, load, comp, ylabel, title in FIGURES:
-        fig, ax = plt.subplots(figsize=(6.4, 4.2))
-        for bc in study["treatments"] + fem:
-            h = read(hist[(load, bc)])
-            color, ls, label = STYLE[bc]
-            ax.plot([t * 1e6 for t in h["time"]], [v / 1e6 for v in h[f"{probe}.{comp}"]],
-                    color=color, ls=ls, lw=1.4, label=label)
+        fig = plt.figure(figsize=FIGSIZE)
+        ax = fig.add_axes(AXES_BOX)
+        hs = {bc: read(hist[(load, bc)]) for bc in order}
+        ts, tu = style.time_scale(max(h["time"][-1] for h in hs.values()))
+        vs, _ = style.field_scale(f"{probe}.{comp}")
+        for bc in order:
+            h = hs[bc]
+            ax.plot([t * ts for t in h["time"]], [v * vs for v in h[f"{probe}.{comp}"]], **STYLE[bc])
+        # The end of the window: a vertical line, explained in the legend (no text over the data).
         t1 = study["loads"][load]["window"][1]
-        ax.axvline(t1 * 1e6, color="grey", lw=0.8, alpha=0.6)
-        ax.text(t1 * 1e6, ax.get_ylim()[1], " end of reflection-free window\n of the extended run",
-                fontsize=7, va="top", color="grey")
-        ax.set_xlabel("time (us)")
+        ax.axvline(t1 * ts, color="0.3", lw=0.9, ls=(0, (6, 2, 1, 2)), zorder=0,
+                   label=f"end of the extended run's\nreflection-free window ({t1 * ts:.1f} {tu})")
+        ax.set_xlabel(f"time ({tu})")
         ax.set_ylabel(ylabel)
-        ax.set_title(title, fontsize=10)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="lower right")
-        fig.tight_layout()
-        fig.savefig(os.path.join(args.out, fname), dpi=130)
+        ax.set_title(title)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+        # Fixed size (no tight bounding box): Figs. 5-7 have the same size and the same axes box.
+        with plt.rc_context({"savefig.bbox": "standard"}):
+            fig.savefig(os.path.join(args.out, fname))
         plt.close(fig)
 
     with open(os.path.join(args.out, "metrics.json"), "w") as f:

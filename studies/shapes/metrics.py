@@ -93,36 +93,52 @@ def main():
                fmt(g("SV30", "R_SS")), fmt(rate)]
         print(" | ".join(row))
     try:
-        import matplotlib
-        matplotlib.use("Agg")
+        sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+        import style
         import matplotlib.pyplot as plt
+        style.apply()
+        # Bars: colours of style.COLOURS and a hatch each (apart in grey print); each panel's
+        # legend under it, where it covers no bar.
+        hatch = ["", "//", "..", "xx"]
+        bar = lambda k: dict(color=style.COLOURS[k], hatch=hatch[k], edgecolor="white", lw=0)  # noqa: E731
         fig, ax = plt.subplots(1, 3, figsize=(13, 4))
         xs = range(len(SHAPES))
         for k, key in enumerate(["cells_0.01_0.005", "cells_0.005_0.002", "ppc_1_4", "ppc_4_9"]):
+            lab = {"cells_0.01_0.005": "cells 0.01 → 0.005 m", "cells_0.005_0.002": "cells 0.005 → 0.002 m",
+                   "ppc_1_4": "1 → 4 particles per cell", "ppc_4_9": "4 → 9 particles per cell"}[key]
             ax[0].bar([i + 0.2 * k for i in xs], [m["shapes"][s]["convergence"][key] for s in SHAPES],
-                      width=0.2, label=key.replace("_", " "))
+                      width=0.2, label=lab, **bar(k))
         ax[0].set_xticks([i + 0.3 for i in xs], [LABEL[s] for s in SHAPES])
-        ax[0].set_title("convergence: successive rel. L2 differences of σxx at D")
-        ax[0].legend(fontsize=7)
+        ax[0].set_title("convergence (plates, σxx at D)")
+        ax[0].set_ylabel("relative L2 difference of successive runs")
         for k, key in enumerate(["column_P_1ppc", "column_P_4ppc", "column_P_edge"]):
+            lab = {"column_P_1ppc": "P wave, 1 ppc", "column_P_4ppc": "P wave, 4 ppc",
+                   "column_P_edge": "P wave, end on the grid's edge"}[key]
             ax[1].bar([i + 0.25 * k for i in xs], [m["shapes"][s][key] or 0 for s in SHAPES],
-                      width=0.25, label=key.replace("column_", "").replace("_", " "))
+                      width=0.25, label=lab, **bar(k))
         ax[1].set_yscale("log")
         ax[1].set_xticks([i + 0.25 for i in xs], [LABEL[s] for s in SHAPES])
-        ax[1].set_title("column: reflected / incident energy")
-        ax[1].legend(fontsize=7)
+        ax[1].set_title("column: silent layer at normal incidence")
+        ax[1].set_ylabel("reflected / incident energy")
         for k, key in enumerate(["P30", "P45", "SV30", "SV45"]):
             q = "R_PP" if key.startswith("P") else "R_SS"
             vals = [((m["shapes"][s]["oblique"] or {}).get(key) or {}).get(q) or 0 for s in SHAPES]
-            ax[2].bar([i + 0.2 * k for i in xs], vals, width=0.2, label=f"{key} |{q}|")
+            wave, angle = ("P", key[1:]) if key.startswith("P") else ("SV", key[2:])
+            ax[2].bar([i + 0.2 * k for i in xs], vals, width=0.2,
+                      label=f"{wave} at {angle}°: $|R_{{{q[2:]}}}|$", **bar(k))
         ex = ((m["shapes"]["bilinear"]["oblique"] or {}).get("P30") or {}).get("R_PP_exact")
         if ex:
-            ax[2].axhline(ex, color="k", lw=0.8, ls="--", label="closed form P30")
+            ax[2].axhline(ex, color="k", lw=0.8, ls="--", label="closed form, P at 30°")
         ax[2].set_xticks([i + 0.3 for i in xs], [LABEL[s] for s in SHAPES])
-        ax[2].set_title("oblique: reflection coefficients (MPM)")
-        ax[2].legend(fontsize=7)
+        ax[2].set_title("oblique incidence on the silent layer (MPM)")
+        ax[2].set_ylabel("reflected / incident amplitude")
+        for a in ax:
+            a.grid(axis="x", visible=False)
+        fig.suptitle("Grid shape functions compared: convergence and the silent layer's reflection")
         fig.tight_layout()
-        fig.savefig(os.path.join(out, "shapes.png"), dpi=110)
+        for a in ax:
+            a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
+        fig.savefig(os.path.join(out, "shapes.png"))
     except ImportError:
         print("shapes: matplotlib not found; no figure", file=sys.stderr)
 
