@@ -1224,6 +1224,12 @@ class Builder {
                     ? Anchor::Boundary
                     : Anchor::Particle;
     o.done();
+    if (type == "silent")
+      c.notes.push_back("silent \"" + name + "\" on the " + what + " (" +
+                        std::to_string(sb.layer.ids.size()) + " particles): LK dashpots a " +
+                        fmt(sb.a) + " rho c_d, b " + fmt(sb.b) + " rho c_s, " +
+                        (sb.form == SilentForm::Nodal ? "nodal" : "particle") + " form, at the " +
+                        (sb.anchor == Anchor::Boundary ? "boundary" : "particles"));
     // The impedances a rho c_d and b rho c_s of each particle's material are set by
     // Solver::finalize().
     s_->silents.push_back(std::move(sb));

@@ -78,8 +78,12 @@ TEST(CaseLoad, ValidCaseBuilds) {
   EXPECT_EQ(c.output.history_every, 2);
   EXPECT_EQ(c.output.snapshots, 0);
   EXPECT_FALSE(c.output.progress);
-  ASSERT_EQ(c.notes.size(), 1u);
+  ASSERT_EQ(c.notes.size(), 2u);
   EXPECT_NE(c.notes[0].find("sin^2"), std::string::npos) << c.notes[0];
+  // check's line for the silent layer: where, how many particles, the dashpots and the form.
+  EXPECT_NE(c.notes[1].find("on the bottom side of body \"plate\", width 0.001 (40 particles): LK "
+                            "dashpots a 1 rho c_d, b 1 rho c_s, particle form, at the particles"),
+            std::string::npos) << c.notes[1];
 }
 
 TEST(CaseLoad, DefaultsAndOverrides) {
@@ -277,7 +281,7 @@ TEST(CaseLoad, ReferenceExampleBuilds) {
   ASSERT_EQ(s.silents.size(), 1u);
   EXPECT_EQ(s.silents[0].layer.ids.size(), 200u);
   ASSERT_EQ(c.probes.size(), 1u);
-  EXPECT_EQ(c.notes.size(), 1u);
+  EXPECT_EQ(c.notes.size(), 2u);  // the traction's and the silent layer's lines
 }
 
 }  // namespace
