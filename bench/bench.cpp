@@ -73,8 +73,7 @@ struct PassBytes {
 const PassBytes kMuslStep[] = {
     {"reset_grid", "W m px py fx fy qx qy", 0, 7 * 8},
     {"p2g", "R x y m vx vy vol sxx syy sxy; RW m px py fx fy", 9 * 8, 5 * 16},
-    {"nodal_velocity", "R m fix px py; W vx vy", 0, 3 * 8 + 1 + 2 * 8},
-    {"grid_update", "R m fix vx vy fx fy; W vnx vny", 0, 5 * 8 + 1 + 2 * 8},
+    {"grid_update", "R m fix px py fx fy; W vx vy vnx vny", 0, 5 * 8 + 1 + 4 * 8},
     {"g2p + re-map", "R x y m, RW vx vy; R vx vy vnx vny, RW qx qy", 3 * 8 + 2 * 16, 4 * 8 + 2 * 16},
     {"re-mapped velocity", "R m fix; RW qx qy", 0, 8 + 1 + 2 * 16},
     {"stress + move", "RW x y vol sxx syy szz sxy; R qx qy vnx vny", 7 * 16, 4 * 8},

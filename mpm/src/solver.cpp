@@ -782,25 +782,30 @@ void Solver::apply_loads() {
 // (m + dt/2 C) v+ = (m - dt/2 C) v + dt f  (trapezoidal, unconditionally stable for C).
 // The second loop touches only the boundary nodes, so the silent layer costs O(boundary).
 void Solver::grid_update() {
-  kernels::nodal_velocity(grid, NodeBox{0, grid.nnx - 1, 0, grid.nny - 1}, grid.m.data(),
-                          grid.fix.data(), grid.px.data(), grid.py.data(), grid.vx.data(),
-                          grid.vy.data(), mass_floor_, nthreads_);
   const long n = static_cast<long>(grid.nodes());
   const double floor = mass_floor_, DT = dt;
   const double* m = grid.m.data();
   const uint8_t* fix = grid.fix.data();
-  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
+  const double* px = grid.px.data(); const double* py = grid.py.data();
+  double* vx = grid.vx.data(); double* vy = grid.vy.data();
   const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
   double* ux = grid.vnx.data(); double* uy = grid.vny.data();
-  // Health check at no extra pass: a NaN or Inf anywhere in the particles' mass, momentum or
-  // stress reaches the nodes' updated velocities this step (x - x is 0 only for finite x).
+  // One pass: the start velocity p / m (as kernels::nodal_velocity computes it) and the updated
+  // one, without reading the nodes' mass and flags twice. Health check at no extra pass: a NaN
+  // or Inf anywhere in the particles' mass, momentum or stress reaches the nodes' updated
+  // velocities this step (x - x is 0 only for finite x).
   int bad = 0;
 #pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
   for (long i = 0; i < n; ++i) {
     const double mi = m[i];
+    const bool heavy = mi > floor;
+    const double vxi = heavy && !(fix[i] & 1) ? px[i] / mi : 0.0;
+    const double vyi = heavy && !(fix[i] & 2) ? py[i] / mi : 0.0;
+    vx[i] = vxi;
+    vy[i] = vyi;
     if (mi <= floor) { ux[i] = 0; uy[i] = 0; continue; }
-    ux[i] = (fix[i] & 1) ? 0.0 : vx[i] + DT * fx[i] / mi;
-    uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * fy[i] / mi;
+    ux[i] = (fix[i] & 1) ? 0.0 : vxi + DT * fx[i] / mi;
+    uy[i] = (fix[i] & 2) ? 0.0 : vyi + DT * fy[i] / mi;
     bad |= !(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0);
   }
   if (bad) fail_nonfinite();
