@@ -60,30 +60,24 @@ class HybridRegion final : public Region {
 
   void save(StateWriter& w) const override {
     hy_.save_state(w);
-    save_snapshot_list(w, snap_);
+    snaps_.save(w);
   }
   bool restore(const StateReader& r) override {
-    earlier_ = SnapshotList::read(r);
+    snaps_.restore(r);
     return hy_.load_state(r);
   }
 
   void open_snapshots(const std::string& out_dir) override {
-    snap_.set_fields(c_.output.fields);
-    snap_.set_compression(c_.output.compression);
-    earlier_.open(snap_, out_dir);
-    if (c_.output.grid) grid_.open(s_, out_dir, c_.output.compression, earlier_.times);
+    snaps_.open(s_, c_.output, out_dir);
     fe_.set_snapshot_compression(c_.output.compression);
     fe_.resume_snapshots(out_dir, "fem");
   }
   void write_snapshot(const std::string& out_dir) override {
-    const auto layer = s_.layer_flags();
-    snap_.write(s_.p, s_.steps, s_.t, &layer);
-    if (c_.output.grid) grid_.write(s_);
+    snaps_.write(s_);
     fe_.write_snapshot(out_dir, "fem");
   }
   void finish() override {
-    snap_.close();
-    grid_.close();
+    snaps_.close();
     fe_.close_snapshots();
     hy_.update_energies();
   }
@@ -118,7 +112,7 @@ class HybridRegion final : public Region {
     j["curve_probes"] = curve_probes_json(c_.probes);
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
-                    {"snapshots", snapshots ? snap_.count() : 0},
+                    {"snapshots", snapshots ? snaps_.count() : 0},
                     {"xdmf", snapshots ? "particles.xdmf" : ""},
                     {"fem_snapshots", fe_.snapshot_count()},
                     {"fem_xdmf", snapshots ? "fem.xdmf" : ""},
@@ -132,9 +126,7 @@ class HybridRegion final : public Region {
   fem::Solver& fe_;
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
-  SnapshotWriter snap_;
-  SnapshotList earlier_;
-  GridSnapshots grid_;  // output.grid
+  MpmSnapshots snaps_;
 };
 
 }  // namespace

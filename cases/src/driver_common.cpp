@@ -130,6 +130,25 @@ void GridSnapshots::write(const Solver& s) {
                  {"J2", 1, "Pa^2", j2.data()}});
 }
 
+void MpmSnapshots::open(const Solver& s, const OutputSpec& out, const std::string& out_dir) {
+  snap_.set_fields(out.fields);
+  snap_.set_compression(out.compression);
+  earlier_.open(snap_, out_dir);
+  grid_on_ = out.grid;
+  if (grid_on_) grid_.open(s, out_dir, out.compression, earlier_.times);
+}
+
+void MpmSnapshots::write(const Solver& s) {
+  const auto layer = s.layer_flags();
+  snap_.write(s.p, s.steps, s.t, &layer);
+  if (grid_on_) grid_.write(s);
+}
+
+void MpmSnapshots::close() {
+  snap_.close();
+  grid_.close();
+}
+
 void save_snapshot_list(StateWriter& w, const SnapshotWriter& snap) {
   w.put("snapshots.steps", std::vector<std::int64_t>(snap.steps().begin(), snap.steps().end()));
   w.put("snapshots.times", snap.times());

@@ -57,6 +57,25 @@ class GridSnapshots {
   MeshSnapshotWriter w_;
 };
 
+// An MPM region's snapshots (the MPM and hybrid regions): the particles' (particles.h5 + .xdmf)
+// with the fields and compression of the case's output section, the grid's beside them when the
+// case asks (output.grid), and the list of them that a checkpoint carries.
+class MpmSnapshots {
+ public:
+  void save(StateWriter& w) const { save_snapshot_list(w, snap_); }
+  void restore(const StateReader& r) { earlier_ = SnapshotList::read(r); }
+  void open(const Solver& s, const OutputSpec& out, const std::string& out_dir);
+  void write(const Solver& s);
+  void close();
+  int count() const { return snap_.count(); }
+
+ private:
+  SnapshotWriter snap_;
+  SnapshotList earlier_;  // a restart's snapshots of the run before it
+  GridSnapshots grid_;    // output.grid
+  bool grid_on_ = false;
+};
+
 // Writes `bytes` to `dst` whole or not at all: a temporary file beside it, every write, the
 // flush, fsync and close checked, then a rename. Throws naming dst and the cause.
 void write_file_atomically(const std::filesystem::path& dst, const std::string& bytes);

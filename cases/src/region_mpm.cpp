@@ -51,27 +51,21 @@ class MpmRegion final : public Region {
 
   void save(StateWriter& w) const override {
     s_.save_state(w, "mpm.");
-    save_snapshot_list(w, snap_);
+    snaps_.save(w);
   }
   bool restore(const StateReader& r) override {
-    earlier_ = SnapshotList::read(r);
+    snaps_.restore(r);
     return s_.load_state(r, "mpm.");
   }
 
   void open_snapshots(const std::string& out_dir) override {
-    snap_.set_fields(c_.output.fields);
-    snap_.set_compression(c_.output.compression);
-    earlier_.open(snap_, out_dir);
-    if (c_.output.grid) grid_.open(s_, out_dir, c_.output.compression, earlier_.times);
+    snaps_.open(s_, c_.output, out_dir);
   }
   void write_snapshot(const std::string&) override {
-    const auto layer = s_.layer_flags();
-    snap_.write(s_.p, s_.steps, s_.t, &layer);
-    if (c_.output.grid) grid_.write(s_);
+    snaps_.write(s_);
   }
   void finish() override {
-    snap_.close();
-    grid_.close();
+    snaps_.close();
     s_.update_energies();
   }
 
@@ -92,7 +86,7 @@ class MpmRegion final : public Region {
     j["curve_probes"] = curve_probes_json(c_.probes);
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
-                    {"snapshots", snapshots ? snap_.count() : 0},
+                    {"snapshots", snapshots ? snaps_.count() : 0},
                     {"xdmf", snapshots ? "particles.xdmf" : ""},
                     {"grid_xdmf", snapshots && c_.output.grid ? "grid.xdmf" : ""}};
   }
@@ -102,9 +96,7 @@ class MpmRegion final : public Region {
   Solver& s_;
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
-  SnapshotWriter snap_;
-  SnapshotList earlier_;  // a restart's snapshots of the run before it
-  GridSnapshots grid_;    // output.grid
+  MpmSnapshots snaps_;
 };
 
 }  // namespace

@@ -14,44 +14,23 @@
 #include <filesystem>
 #include <string>
 
-#include "test_case_common.hpp"
-
-#ifndef SMPM_CLI
-#define SMPM_CLI ""
-#endif
-#ifndef SMPM_SOURCE_DIR
-#define SMPM_SOURCE_DIR "."
-#endif
+#include "cli_common.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace smpm::case_testing;
+using namespace smpm::cli_testing;
 
-struct Proc {
-  int status;
-  std::string out, err;
-};
-
-// Runs `exe args` with the environment assignments `env` ("A=1 B=2 "); the exit status, stdout
-// and stderr.
+// Runs `exe args` with the environment assignments `env` ("A=1 B=2 ").
 Proc run(const std::string& env, const std::string& exe, const std::string& args,
-        const std::string& tag) {
-  const fs::path out = scratch() / ("modules_" + tag + ".out");
-  const fs::path err = scratch() / ("modules_" + tag + ".err");
-  const std::string cmd = env + "\"" + exe + "\" " + args + " >\"" + out.string() + "\" 2>\"" +
-                          err.string() + "\"";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(out), read_file(err)};
+         const std::string& tag) {
+  return run_shell(env + "\"" + exe + "\" " + args, "modules_" + tag);
 }
 
 bool loaded(const Proc& r, const std::string& lib) {
   return r.err.find("file=" + lib) != std::string::npos;
 }
-
-std::string source(const std::string& rel) { return (fs::path(SMPM_SOURCE_DIR) / rel).string(); }
-
-bool have_cli() { return std::string(SMPM_CLI).size() > 0 && fs::exists(SMPM_CLI); }
 
 TEST(Modules, EachCommandLoadsOnlyWhatItsCaseNeeds) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
@@ -68,11 +47,11 @@ TEST(Modules, EachCommandLoadsOnlyWhatItsCaseNeeds) {
       {"box_run", box_run, false, false, false},
       // A snapshot loads HDF5 (and the MPI libraries it links), nothing else.
       {"box_snapshot", box_run + " --set output.snapshots=1", false, false, true},
-      {"geometry", "check \"" + source("studies/film/cases/fixed.json") + "\"", true, false, false},
+      {"geometry", "check \"" + source_file("studies/film/cases/fixed.json") + "\"", true, false, false},
       // deal.II links HDF5.
-      {"fem", "check \"" + source("studies/pulse/cases/shear_fem_dashpot.json") + "\"", true, true,
+      {"fem", "check \"" + source_file("studies/pulse/cases/shear_fem_dashpot.json") + "\"", true, true,
        true},
-      {"hybrid", "check \"" + source("studies/hybrid/cases/film_hybrid_dashpot.json") + "\"", true,
+      {"hybrid", "check \"" + source_file("studies/hybrid/cases/film_hybrid_dashpot.json") + "\"", true,
        true, true},
   };
   for (const Expect& e : cases) {
@@ -95,7 +74,7 @@ TEST(Modules, AProgramWithoutItsModulesSaysWhereItLooked) {
   fs::create_directories(bin);
   const fs::path exe = bin / "silentmpm";
   fs::copy_file(SMPM_CLI, exe, fs::copy_options::overwrite_existing);
-  const std::string fem = source("studies/pulse/cases/shear_fem_dashpot.json");
+  const std::string fem = source_file("studies/pulse/cases/shear_fem_dashpot.json");
 
   // An MPM case on boxes needs no module.
   const fs::path box = write_file("modules_box2.json", kValid);
@@ -110,7 +89,7 @@ TEST(Modules, AProgramWithoutItsModulesSaysWhereItLooked) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line:\n" << r.err;
 
   const Proc g = run("SILENTMPM_MODULE_DIR= ", exe.string(),
-                    "check \"" + source("studies/film/cases/fixed.json") + "\"", "alone_geo");
+                    "check \"" + source_file("studies/film/cases/fixed.json") + "\"", "alone_geo");
   EXPECT_EQ(g.status, 1);
   EXPECT_NE(g.err.find("geometry.file: the gmsh module: libsilentmpm_gmsh.so not found"),
             std::string::npos) << g.err;

@@ -12,29 +12,17 @@
 #include <fstream>
 #include <string>
 
-#include "test_case_common.hpp"
-
-#ifndef SMPM_SOURCE_DIR
-#define SMPM_SOURCE_DIR "."
-#endif
+#include "cli_common.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace smpm::case_testing;
-
-struct Proc {
-  int status;
-  std::string out, err;
-};
+using namespace smpm::cli_testing;
 
 Proc plot(const std::string& args, const std::string& tag) {
-  const fs::path out = scratch() / ("plot_" + tag + ".out"), err = scratch() / ("plot_" + tag + ".err");
-  const std::string cmd = "/usr/bin/python3 \"" + std::string(SMPM_SOURCE_DIR) +
-                          "/scripts/plot.py\" " + args + " >\"" + out.string() + "\" 2>\"" +
-                          err.string() + "\"";
-  const int s = std::system(cmd.c_str());
-  return {WIFEXITED(s) ? WEXITSTATUS(s) : -1, read_file(out), read_file(err)};
+  return run_shell("/usr/bin/python3 \"" + source_file("scripts/plot.py") + "\" " + args,
+                   "plot_" + tag);
 }
 
 bool have_matplotlib() {

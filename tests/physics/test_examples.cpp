@@ -20,30 +20,18 @@
 #include <vector>
 
 #include "silentmpm/history.hpp"
-#include "test_case_common.hpp"
-
-#ifndef SMPM_CLI
-#define SMPM_CLI ""
-#endif
-#ifndef SMPM_SOURCE_DIR
-#define SMPM_SOURCE_DIR "."
-#endif
+#include "cli_common.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace smpm::case_testing;
+using namespace smpm::cli_testing;
 
-std::string source(const std::string& rel) { return (fs::path(SMPM_SOURCE_DIR) / rel).string(); }
-
+// `silentmpm args`: its exit status; its output is kept as <tag>.out and <tag>.err.
 int cli(const std::string& args, const std::string& tag) {
-  const std::string cmd = "\"" + std::string(SMPM_CLI) + "\" " + args + " >\"" +
-                          (scratch() / (tag + ".out")).string() + "\" 2>&1";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run_shell("\"" + std::string(SMPM_CLI) + "\" " + args, tag).status;
 }
-
-bool have_cli() { return std::string(SMPM_CLI).size() > 0 && fs::exists(SMPM_CLI); }
 
 // The mean of `v` over the rows with time in [t0, t1].
 double mean_over(const smpm::History& h, const std::vector<double>& v, double t0, double t1) {
@@ -63,16 +51,16 @@ TEST(Examples, EveryGalleryCasePassesCheck) {
       "studies/pulse/cases/shear_fem_dashpot.json"};
   for (const auto& c : cases) {
     const std::string tag = "check_" + fs::path(c).stem().string();
-    EXPECT_EQ(cli("check \"" + source(c) + "\"", tag), 0) << c << ":\n"
-                                                           << read_file(scratch() / (tag + ".out"));
+    EXPECT_EQ(cli("check \"" + source_file(c) + "\"", tag), 0) << c << ":\n"
+                                                           << read_file(scratch() / (tag + ".err"));
   }
 }
 
 TEST(Examples, ColumnCarriesTheTractionAndLetsItOut) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path out = scratch() / "example_column";
-  ASSERT_EQ(cli("run \"" + source("examples/column.json") + "\" --out \"" + out.string() + "\" -q",
-                "column"), 0) << read_file(scratch() / "column.out");
+  ASSERT_EQ(cli("run \"" + source_file("examples/column.json") + "\" --out \"" + out.string() + "\" -q",
+                "column"), 0) << read_file(scratch() / "column.err");
   const smpm::History h = smpm::read_history((out / "history.csv").string());
   const double E = 200e9, nu = 0.3, rho = 7850, t = 1e8;
   const double cp = std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)) / rho);
@@ -94,9 +82,9 @@ TEST(Examples, ColumnCarriesTheTractionAndLetsItOut) {
 TEST(Examples, HalfSpaceEnergyBalanceCloses) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path out = scratch() / "example_half_space";
-  ASSERT_EQ(cli("run \"" + source("examples/half-space.json") + "\" --out \"" + out.string() +
+  ASSERT_EQ(cli("run \"" + source_file("examples/half-space.json") + "\" --out \"" + out.string() +
                 "\" -q --set output.snapshots=2 --set output.grid=true", "half_space"), 0)
-      << read_file(scratch() / "half_space.out");
+      << read_file(scratch() / "half_space.err");
   // The grid's snapshots beside the particles' (their content: tests/unit/test_output_readers.cpp).
   const std::string summary = read_file(out / "summary.json");
   EXPECT_NE(summary.find("\"grid_xdmf\": \"grid.xdmf\""), std::string::npos) << summary;
