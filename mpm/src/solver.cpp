@@ -594,14 +594,17 @@ void Solver::pml_loads() {
     convolution_tables(P.alpha, P.dx, P.dy, dt, P.cx, P.cy, P.e_a, P.ca_a, P.cb_a);
     P.dt_coef = dt;
   }
+  pml_shapes<S>();
   // USF strains the particles with the start-of-step velocity, before the forces.
   if (opt.scheme == Scheme::USF) pml_advance<S>(grid.vx, grid.vy);
-  S sf;
-  long nodes[S::kNodes];
+  constexpr int K = S::kNodes;
   has_nodal_dashpot_ = true;
   for (std::size_t q = 0; q < n; ++q) {
     const uint32_t k = P.layer.idx[q];
-    layer_shape(P.layer, q, Anchor::Particle, sf, nodes);
+    const long* nodes = P.nodes.data() + K * q;
+    const double* N = P.N.data() + K * q;
+    const double* dNx = P.dNx.data() + K * q;
+    const double* dNy = P.dNy.data() + K * q;
     const Material& m = materials[p.group[k]];
     const double L = m.lambda + 2 * m.mu, mu = m.mu;
     const double* H = P.H.data() + 4 * q;
@@ -625,12 +628,12 @@ void Solver::pml_loads() {
       f[4 + c] = p.mass[k] * pml_mass_term(sum, prod, P.alpha, P.u[2 * q + c],
                                            P.zeta.data() + 4 * q + 2 * c, P.e_a, P.ca_a, P.cb_a);
     const double cm = sum * p.mass[k];
-    for (int a = 0; a < S::kNodes; ++a) {
-      grid.fx[nodes[a]] += f[4] * sf.N[a] - (f[0] * sf.dNx[a] + f[2] * sf.dNy[a]);
-      grid.fy[nodes[a]] += f[5] * sf.N[a] - (f[1] * sf.dNx[a] + f[3] * sf.dNy[a]);
-      grid.cxx[nodes[a]] += cm * sf.N[a];
-      grid.cyy[nodes[a]] += cm * sf.N[a];
-      dashpot_nodes_.push_back(nodes[a]);
+    for (int a = 0; a < K; ++a) {
+      grid.fx[nodes[a]] += f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
+      grid.fy[nodes[a]] += f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
+      grid.cxx[nodes[a]] += cm * N[a];
+      grid.cyy[nodes[a]] += cm * N[a];
+      add_dashpot_node(nodes[a]);
     }
   }
 }
@@ -644,19 +647,19 @@ void Solver::pml_loads() {
 // (power 3 and more) leaves enough FLIP for the growth to return (docs/physics.md section 9.3).
 template <class S>
 void Solver::pml_pic() {
-  S sf;
-  long nodes[S::kNodes];
+  constexpr int K = S::kNodes;
   for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
     const uint32_t k = pml.layer.idx[q];
     const NodalField* f = &fields_[0].f;
     if (!body_of_group_.empty())
       for (const VelocityField& F : fields_)
         if (F.body == body_of_group_[p.group[k]]) f = &F.f;
-    layer_shape(pml.layer, q, Anchor::Particle, sf, nodes);
+    const long* nodes = pml.nodes.data() + K * q;
+    const double* N = pml.N.data() + K * q;
     double wx = 0, wy = 0;
-    for (int a = 0; a < S::kNodes; ++a) {
-      wx += sf.N[a] * f->vx[nodes[a]];
-      wy += sf.N[a] * f->vy[nodes[a]];
+    for (int a = 0; a < K; ++a) {
+      wx += N[a] * f->vx[nodes[a]];
+      wy += N[a] * f->vy[nodes[a]];
     }
     const double w = pml.pic[q];
     p.vx[k] = w * wx + (1 - w) * p.vx[k];
@@ -666,20 +669,42 @@ void Solver::pml_pic() {
 
 template <class S>
 void Solver::pml_advance(const std::vector<double>& vx, const std::vector<double>& vy) {
-  S sf;
-  long nodes[S::kNodes];
+  constexpr int K = S::kNodes;
   for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
-    layer_shape(pml.layer, q, Anchor::Particle, sf, nodes);
+    const long* nodes = pml.nodes.data() + K * q;
+    const double* N = pml.N.data() + K * q;
+    const double* dNx = pml.dNx.data() + K * q;
+    const double* dNy = pml.dNy.data() + K * q;
     double* H = pml.H.data() + 4 * q;
     double* u = pml.u.data() + 2 * q;
-    for (int a = 0; a < S::kNodes; ++a) {
+    for (int a = 0; a < K; ++a) {
       const double wx = vx[nodes[a]], wy = vy[nodes[a]];
-      H[0] += dt * sf.dNx[a] * wx;
-      H[1] += dt * sf.dNx[a] * wy;
-      H[2] += dt * sf.dNy[a] * wx;
-      H[3] += dt * sf.dNy[a] * wy;
-      u[0] += dt * sf.N[a] * wx;
-      u[1] += dt * sf.N[a] * wy;
+      H[0] += dt * dNx[a] * wx;
+      H[1] += dt * dNx[a] * wy;
+      H[2] += dt * dNy[a] * wx;
+      H[3] += dt * dNy[a] * wy;
+      u[0] += dt * N[a] * wx;
+      u[1] += dt * N[a] * wy;
+    }
+  }
+}
+
+// The shape functions of the layer's particles at their positions at the start of the step.
+template <class S>
+void Solver::pml_shapes() {
+  constexpr int K = S::kNodes;
+  const std::size_t n = pml.layer.idx.size();
+  pml.nodes.resize(K * n);
+  pml.N.resize(K * n);
+  pml.dNx.resize(K * n);
+  pml.dNy.resize(K * n);
+  S sf;
+  for (std::size_t q = 0; q < n; ++q) {
+    layer_shape(pml.layer, q, Anchor::Particle, sf, pml.nodes.data() + K * q);
+    for (int a = 0; a < K; ++a) {
+      pml.N[K * q + a] = sf.N[a];
+      pml.dNx[K * q + a] = sf.dNx[a];
+      pml.dNy[K * q + a] = sf.dNy[a];
     }
   }
 }
@@ -704,7 +729,11 @@ void Solver::apply_loads() {
   }
   // Nodal dashpot blocks: clear the nodes assembled last step, then assemble
   // C_i += (V_p / h) N_i [a rho c_d n n^T + b rho c_s (I - n n^T)].
-  for (long i : dashpot_nodes_) grid.cxx[i] = grid.cxy[i] = grid.cyy[i] = 0;
+  if (dashpot_mark_.size() != grid.nodes()) dashpot_mark_.assign(grid.nodes(), 0);
+  for (long i : dashpot_nodes_) {
+    grid.cxx[i] = grid.cxy[i] = grid.cyy[i] = 0;
+    dashpot_mark_[i] = 0;
+  }
   dashpot_nodes_.clear();
   has_nodal_dashpot_ = false;
   for (auto& sl : silents) {
@@ -739,7 +768,7 @@ void Solver::apply_loads() {
         grid.cxx[nodes[a]] += wn * bxx;
         grid.cxy[nodes[a]] += wn * bxy;
         grid.cyy[nodes[a]] += wn * byy;
-        dashpot_nodes_.push_back(nodes[a]);
+        add_dashpot_node(nodes[a]);
       }
     }
   }
@@ -754,13 +783,11 @@ void Solver::apply_loads() {
       for (int a = 0; a < S::kNodes; ++a) {
         grid.cxx[nodes[a]] += c * sf.N[a];
         grid.cyy[nodes[a]] += c * sf.N[a];
-        dashpot_nodes_.push_back(nodes[a]);
+        add_dashpot_node(nodes[a]);
       }
     }
   }
   if (pml.active()) pml_loads<S>();
-  std::sort(dashpot_nodes_.begin(), dashpot_nodes_.end());
-  dashpot_nodes_.erase(std::unique(dashpot_nodes_.begin(), dashpot_nodes_.end()), dashpot_nodes_.end());
   // Gravity: f_i += m_i g, the nodal form of sum_p m_p g N_i (the lumped mass is sum_p m_p N_i).
   // On the grid's field; in multi-field contact the bodies' fields differ from it by their own
   // deviation, in which g cancels.
@@ -884,17 +911,21 @@ void Solver::boundary_work(bool remapped) {
   // Perfectly matched layers: the damping force's power, and that of the explicit loads; then
   // the particles' displacements advance (USF: in pml_loads).
   if (pml.active()) {
+    constexpr int K = S::kNodes;
     for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
-      layer_shape(pml.layer, q, Anchor::Particle, sf, nodes);
+      const long* pn = pml.nodes.data() + K * q;
+      const double* N = pml.N.data() + K * q;
+      const double* dNx = pml.dNx.data() + K * q;
+      const double* dNy = pml.dNy.data() + K * q;
       const double* f = pml.f.data() + 6 * q;
       const double cm = (pml.dx[q] + pml.dy[q]) * p.mass[pml.layer.idx[q]];
-      for (int a = 0; a < S::kNodes; ++a) {
+      for (int a = 0; a < K; ++a) {
         double ax, ay, bx, by;
-        vbar(nodes[a], ax, ay);
-        wbar(nodes[a], bx, by);
-        const double fx = f[4] * sf.N[a] - (f[0] * sf.dNx[a] + f[2] * sf.dNy[a]);
-        const double fy = f[5] * sf.N[a] - (f[1] * sf.dNx[a] + f[3] * sf.dNy[a]);
-        energy.absorbed += dt * (cm * sf.N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
+        vbar(pn[a], ax, ay);
+        wbar(pn[a], bx, by);
+        const double fx = f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
+        const double fy = f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
+        energy.absorbed += dt * (cm * N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
       }
     }
     if (opt.scheme != Scheme::USF) pml_advance<S>(ux, uy);

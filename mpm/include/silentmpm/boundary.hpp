@@ -111,6 +111,10 @@ struct PmlLayer {
   double dt_coef = 0;             // dt of the recursion coefficients below
   std::vector<double> cx, cy;     // 3 per particle: e, ca, cb for alpha + d_x, alpha + d_y
   double e_a = 1, ca_a = 0, cb_a = 0;
+  // This step's shape functions of each particle (kNodes per particle: node, N, dN/dx, dN/dy),
+  // evaluated once when the loads are assembled; the positions do not change before g2p.
+  std::vector<long> nodes;
+  std::vector<double> N, dNx, dNy;
   bool active() const { return !layer.ids.empty(); }
 };
 

@@ -171,7 +171,16 @@ class Solver {
   bool strips_ok_ = false;
   int stencil_rows_ = 1;  // a particle in cell row r writes node rows [r - b, r + stencil_rows_ - b]
   bool has_nodal_dashpot_ = false;
-  std::vector<long> dashpot_nodes_;  // nodes holding a dashpot block this step
+  // The nodes holding a dashpot block this step, each once (in the order they were first
+  // assembled; the blocks' update is per node, so the order does not matter), and a flag per
+  // grid node saying it is listed.
+  std::vector<long> dashpot_nodes_;
+  std::vector<std::uint8_t> dashpot_mark_;
+  void add_dashpot_node(long i) {
+    if (dashpot_mark_[i]) return;
+    dashpot_mark_[i] = 1;
+    dashpot_nodes_.push_back(i);
+  }
   double mass_floor_ = 0;
   // ranges_[s * G + g] = [begin, end) of particles of strip s and group g.
   std::vector<std::array<uint32_t, 2>> ranges_;
@@ -200,6 +209,7 @@ class Solver {
   template <class S> void p2g(unsigned what);
   void start_velocities();
   template <class S> void apply_loads();
+  template <class S> void pml_shapes();
   template <class S> void pml_loads();
   template <class S> void pml_pic();
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);

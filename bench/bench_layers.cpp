@@ -1,0 +1,240 @@
+// bench_layers: what each absorbing boundary costs per step, in MPM and in the FE far field.
+//
+// A steel square of W x W cells (MPM: 1 particle per cell; FEM: Q1) with the same boundary on
+// its left, right and bottom sides and a free top: free edges, LK dashpots (`silent` /
+// `dashpot`), Kelvin-Voigt springs, a graded damping band of L cells in front of the dashpots,
+// a perfectly matched layer of L cells in front of them. Each variant runs a short sin^2 pulse
+// from the top for a few steps to warm up, then is timed over S steps; the variants alternate,
+// and each figure is the best of R rounds (process CPU clock, one thread by default).
+//
+// Per variant it prints the time per step, the ratio to the free square's, and the cost of one
+// cell of the layer against a free cell:
+//     cost/cell = 1 + (t_variant / t_free - 1) N / N_layer,
+// N the cells of the square and N_layer those within the layer's thickness of the three sides
+// (L cells for the band and the PML, one cell for the dashpots and springs, which act on the
+// edge only). 1 means the layer is free; the goal the project keeps is at most 1.5.
+//
+// The MPM PML needs USL: its variant is timed against a free square under USL too (the other
+// MPM variants use MUSL, the default scheme).
+//
+//   build/bench_layers [--cells W] [--layer L] [--steps S] [--rounds R] [--threads T]
+//                      [--only mpm|fem] [--kind lk|kv|damping|pml]
+#include <time.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "silentmpm/case.hpp"
+#include "silentmpm/geo_box.hpp"
+
+using namespace smpm;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Options {
+  int cells = 200, layer = 10, steps = 200, rounds = 5, threads = 1;
+  std::string only;  // "mpm" or "fem": that method only
+  std::string kind;  // one boundary (with the free square it is compared with)
+};
+
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+constexpr double kH = 1e-3;  // cell size (m)
+
+std::string num(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+const char* kMaterial =
+    R"("materials": {"steel": {"model": "elastic", "young": 200e9, "poisson": 0.25, "density": 7800}})";
+
+// The load: a sin^2 pulse on the middle fifth of the top.
+std::string mpm_case(const Options& o, const std::string& kind, const std::string& scheme) {
+  const double W = o.cells * kH, L = o.layer * kH;
+  std::string b = R"({"title": "layer bench", "time": {"end": 1, "cfl": 0.5},)";
+  b += R"("grid": {"origin": [)" + num(-2 * kH) + ", " + num(-2 * kH) + R"(], "size": [)" +
+       num(W + 4 * kH) + ", " + num(W + 4 * kH) + R"(], "cell": )" + num(kH) + "},";
+  b += R"("scheme": {"update": ")" + scheme + R"(", "threads": )" + std::to_string(o.threads) + "},";
+  b += std::string(kMaterial) + ",";
+  b += R"("bodies": [{"name": "b", "material": "steel", "box": [0, 0, )" + num(W) + ", " + num(W) +
+       R"(], "particles_per_cell": 1}],)";
+  b += R"("boundaries": [{"type": "traction", "body": "b", "side": "top", "interval": [)" +
+       num(0.4 * W) + ", " + num(0.6 * W) +
+       R"(], "normal": -1e8, "time": {"shape": "sin2", "start": 0, "duration": 2e-6, "ramp": 1e-6}})";
+  for (const char* side : {"left", "right", "bottom"}) {
+    const std::string at = std::string(R"("body": "b", "side": ")") + side + "\"";
+    if (kind == "free") continue;
+    if (kind == "lk") b += R"(, {"type": "silent", )" + at + "}";
+    if (kind == "kv") b += R"(, {"type": "kelvin_voigt", "delta": )" + num(40 * kH) + ", " + at + "}";
+    if (kind == "damping")
+      b += R"(, {"type": "damping_layer", "width": )" + num(L) + R"(, "r0": 0.9, )" + at +
+           R"(}, {"type": "silent", )" + at + "}";
+    if (kind == "pml")
+      b += R"(, {"type": "pml", "width": )" + num(L) + R"(, "r0": 0.01, )" + at +
+           R"(}, {"type": "silent", )" + at + "}";
+  }
+  b += R"(], "output": {"snapshots": 0, "progress": false}})";
+  return b;
+}
+
+std::string fem_case(const Options& o, const std::string& kind, const std::string& geo) {
+  const double L = o.layer * kH;
+  std::string b = R"({"title": "layer bench", "time": {"end": 1, "cfl": 0.5},)";
+  b += R"("scheme": {"threads": )" + std::to_string(o.threads) + "},";
+  b += std::string(kMaterial) + ",";
+  b += R"("fem": {"mesh": ")" + geo + R"(", "regions": {"body": "steel"}, "boundaries": [)";
+  // The FE load is on the whole top (the mesh has no curve for its middle fifth); a traction
+  // costs the same per step either way.
+  b += R"({"type": "traction", "curve": "top", "normal": -1e8, "time": {"shape": "sin2", "start": 0, "duration": 2e-6, "ramp": 1e-6}})";
+  for (const char* side : {"left", "right", "bottom"}) {
+    const std::string at = std::string(R"("curve": ")") + side + "\"";
+    if (kind == "free") continue;
+    if (kind == "lk") b += R"(, {"type": "dashpot", )" + at + "}";
+    if (kind == "kv") b += R"(, {"type": "kelvin_voigt", "delta": )" + num(40 * kH) + ", " + at + "}";
+    if (kind == "damping")
+      b += R"(, {"type": "damping_layer", "width": )" + num(L) + R"(, "r0": 0.9, )" + at +
+           R"(}, {"type": "dashpot", )" + at + "}";
+    if (kind == "pml")
+      b += R"(, {"type": "pml", "width": )" + num(L) + R"(, "r0": 0.01, )" + at +
+           R"(}, {"type": "dashpot", )" + at + "}";
+  }
+  b += R"(]}, "output": {"snapshots": 0, "progress": false}})";
+  return b;
+}
+
+struct Variant {
+  std::string method, kind, scheme;  // scheme: MPM only
+  Case c;
+  int layer_cells = 0;               // thickness of the layer in cells (0: none)
+  double best = 1e300;               // seconds per step
+};
+
+void step(Variant& v) {
+  if (v.c.solver) v.c.solver->step();
+  else v.c.fem->step();
+}
+
+// Cells of a W x W square within `t` cells of its left, right and bottom sides.
+double layer_cells(int W, int t) { return double(W) * W - double(W - 2 * t) * (W - t); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&](const char* what) -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "bench_layers: %s needs a value\n", what);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--cells") o.cells = std::atoi(next("--cells"));
+    else if (a == "--layer") o.layer = std::atoi(next("--layer"));
+    else if (a == "--steps") o.steps = std::atoi(next("--steps"));
+    else if (a == "--rounds") o.rounds = std::atoi(next("--rounds"));
+    else if (a == "--threads") o.threads = std::atoi(next("--threads"));
+    else if (a == "--only") o.only = next("--only");
+    else if (a == "--kind") o.kind = next("--kind");
+    else {
+      std::fprintf(stderr,
+                   "usage: bench_layers [--cells W] [--layer L] [--steps S] [--rounds R] "
+                   "[--threads T] [--only mpm|fem] [--kind lk|kv|damping|pml]\n");
+      return 2;
+    }
+  }
+  if (o.cells < 4 * o.layer || o.layer < 1 || o.steps < 1 || o.rounds < 1 || o.threads < 1 ||
+      (!o.only.empty() && o.only != "mpm" && o.only != "fem") ||
+      (!o.kind.empty() && o.kind != "lk" && o.kind != "kv" && o.kind != "damping" &&
+       o.kind != "pml")) {
+    std::fprintf(stderr, "bench_layers: need --layer >= 1, --cells >= 4 layers, --steps, --rounds, "
+                         "--threads >= 1, --only mpm or fem, --kind lk, kv, damping or pml\n");
+    return 2;
+  }
+  const fs::path dir = fs::temp_directory_path() / "smpm_bench_layers";
+  fs::create_directories(dir);
+  const std::string geo = (dir / "box.geo").string();
+  std::ofstream(geo) << fem::box_geo_text(0, 0, o.cells * kH, o.cells * kH, kH);
+
+  std::vector<Variant> vs;
+  try {
+    if (o.only != "fem") {
+      for (const char* k : {"free", "lk", "kv", "damping"}) {
+        Variant v{"MPM", k, "MUSL", {}, 0};
+        v.c = load_case_text(mpm_case(o, k, "MUSL"), (dir / "mpm.json").string());
+        vs.push_back(std::move(v));
+      }
+      for (const char* k : {"free", "pml"}) {
+        Variant v{"MPM", k, "USL", {}, 0};
+        v.c = load_case_text(mpm_case(o, k, "USL"), (dir / "mpm.json").string());
+        vs.push_back(std::move(v));
+      }
+    }
+    if (o.only != "mpm")
+      for (const char* k : {"free", "lk", "kv", "damping", "pml"}) {
+        Variant v{"FEM", k, "", {}, 0};
+        v.c = load_case_text(fem_case(o, k, geo), (dir / "fem.json").string());
+        vs.push_back(std::move(v));
+      }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_layers: %s\n", e.what());
+    return 1;
+  }
+  if (!o.kind.empty()) {  // that boundary, and the free squares it is compared with
+    std::vector<char> keep(vs.size(), 0);
+    for (std::size_t i = 0; i < vs.size(); ++i)
+      for (const Variant& w : vs)
+        keep[i] |= vs[i].kind == o.kind || (vs[i].kind == "free" && w.kind == o.kind &&
+                                            w.method == vs[i].method && w.scheme == vs[i].scheme);
+    std::vector<Variant> kept;
+    for (std::size_t i = 0; i < vs.size(); ++i)
+      if (keep[i]) kept.push_back(std::move(vs[i]));
+    vs = std::move(kept);
+  }
+  for (Variant& v : vs)
+    v.layer_cells = (v.kind == "damping" || v.kind == "pml") ? o.layer : v.kind == "free" ? 0 : 1;
+
+  std::printf("bench_layers: %d x %d cells (h = 1 mm, steel), layers on left, right and bottom, "
+              "band and PML %d cells; %d steps x best of %d rounds, %d thread(s)\n",
+              o.cells, o.cells, o.layer, o.steps, o.rounds, o.threads);
+  for (Variant& v : vs)
+    for (int s = 0; s < 20; ++s) step(v);
+  for (int r = 0; r < o.rounds; ++r)
+    for (Variant& v : vs) {
+      const double t0 = cpu_seconds();
+      for (int s = 0; s < o.steps; ++s) step(v);
+      v.best = std::min(v.best, (cpu_seconds() - t0) / o.steps);
+    }
+  std::printf("%-6s %-8s %-6s %12s %10s %14s\n", "method", "boundary", "scheme", "us/step",
+              "vs free", "cost/cell");
+  const double N = double(o.cells) * o.cells;
+  for (const Variant& v : vs) {
+    const Variant* f = nullptr;
+    for (const Variant& w : vs)
+      if (w.method == v.method && w.kind == "free" && w.scheme == v.scheme) f = &w;
+    const double ratio = v.best / f->best;
+    std::printf("%-6s %-8s %-6s %12.1f %10.3f", v.method.c_str(), v.kind.c_str(),
+                v.scheme.empty() ? "-" : v.scheme.c_str(), 1e6 * v.best, ratio);
+    if (v.layer_cells > 0)
+      std::printf(" %14.2f\n", 1 + (ratio - 1) * N / layer_cells(o.cells, v.layer_cells));
+    else
+      std::printf(" %14s\n", "-");
+  }
+  return 0;
+}
