@@ -84,7 +84,7 @@ TEST(Column, ArrivalAndPlateauS) { check_arrival_and_plateau(true); }
 // incident pulse has left A and its reflection is inside, the energy of the field A - B on the
 // particles of A is the reflected energy. Pulse: sin^2 bell whose full width at half maximum is
 // `fwhm_cells` (its support is twice that).
-double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
+double reflected_energy_ratio(ColumnSpec c, int fwhm_cells, double imbalance_bound = 0.01) {
   const Material m = tungsten();
   const double cw = c.shear ? m.cs : m.cd;
   const double dur = 2.0 * fwhm_cells * c.h / cw;
@@ -127,7 +127,7 @@ double reflected_energy_ratio(ColumnSpec c, int fwhm_cells) {
     A->update_energies();
     const double imb = std::abs(A->energy.imbalance()) / A->energy.external_work;
     if (c.pml_cells > 0) std::printf("  energy imbalance %.3f\n", imb);
-    EXPECT_LE(imb, c.pml_cells > 0 ? 0.08 : 0.01) << "energy imbalance";
+    EXPECT_LE(imb, c.pml_cells > 0 ? 0.08 : imbalance_bound) << "energy imbalance";
   }
   return er / A->energy.external_work;
 }
@@ -733,4 +733,35 @@ TEST(Column, LayerFlagsMarkTheLayers) {
         EXPECT_LT(s->p.x[k], 2 * c.h) << k;
       }
   }
+}
+
+// LK at normal incidence on 16-cell (FWHM) pulses, every scheme, 1, 4 and 9 ppc: the reflected
+// amplitude, the square root of the reflected energy fraction (97-99 % of that energy is in
+// front of the last fifth of the column, i.e. it travels back: a reflection, not a residue at
+// the end). Measured, P / S:
+//   USL   0.19 / 0.11 % (1 ppc), 0.10 / 0.17 % (4), 0.11 / 0.17 % (9)
+//   MUSL  1.12 / 0.75 % (1 ppc), 0.39 / 0.33 % (4), 0.35 / 0.31 % (9); USF within 1 % of MUSL.
+// USL meets 0.3 % everywhere. MUSL and USF strain the particles with the particles' own
+// velocities re-mapped to the nodes (or, in USF, mapped at the start): at a node with particles
+// on one side only that value sits half a particle spacing inside, so the last particles see
+// about half the strain rate, a first-order error at the end. Taking the updated grid velocity
+// at the dashpot nodes instead brings 4 and 9 ppc to 0.13-0.18 % but doubles the 1-ppc figure
+// (2.4 %), where MUSL's two-cell central difference has its odd-even mode (docs/physics.md
+// section 4). The 1-ppc MUSL energy account closes to 1.1 % here (1 % on 8-cell pulses).
+TEST(SilentLayer, NormalIncidence16CellPulsesEveryScheme) {
+  for (const Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF})
+    for (const int ppc : {1, 2, 3})
+      for (const bool shear : {false, true}) {
+        ColumnSpec c;
+        c.cells = 100;
+        c.end = End::Silent;
+        c.scheme = sc;
+        c.ppc_side = ppc;
+        c.shear = shear;
+        const double amp = std::sqrt(reflected_energy_ratio(c, 16, 0.015));
+        std::printf("  [%s %d ppc %s] reflected amplitude %.4f\n", scheme_name(sc), ppc * ppc,
+                    shear ? "S" : "P", amp);
+        const double bound = sc == Scheme::USL ? 3e-3 : ppc == 1 ? 1.2e-2 : 4e-3;
+        EXPECT_LE(amp, bound) << scheme_name(sc) << " " << ppc * ppc << " ppc " << (shear ? "S" : "P");
+      }
 }
