@@ -1065,7 +1065,7 @@ class Builder {
     } else if (type == "damping_layer") {
       o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power"}, where);
     } else if (type == "pml") {
-      o.allow({"type", "name", "body", "side", "width", "r0", "power", "alpha"}, where);
+      o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power", "alpha"}, where);
     } else if (type == "silent") {
       o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor"},
               where);
@@ -1131,19 +1131,24 @@ class Builder {
       band.name = name;
       band.body = body_ref(o);
       const BodySpec& b = bodies_[band.body];
-      if (b.surface >= 0)
-        o.fail("body", "body \"" + b.name + "\" comes from a gmsh surface: a pml is a band inside a "
-                       "side of a box body (an edge parallel to an axis)");
-      const std::string side = o.choice("side", kSides);
-      const Edge e = box_edge(b, side);
-      band.axis = e.nx != 0 ? 0 : 1;
-      band.side = (e.nx + e.ny) > 0 ? 1 : -1;
-      band.c = band.axis == 0 ? e.ex0 : e.ey0;
+      std::string side;  // "left side" or the physical curve's label
+      double extent = 0;
+      if (o.has("curve") || b.surface >= 0) {
+        pml_curve(o, b, band, side, extent);
+      } else {
+        const std::string s = o.choice("side", kSides);
+        const Edge e = box_edge(b, s);
+        band.axis = e.nx != 0 ? 0 : 1;
+        band.side = (e.nx + e.ny) > 0 ? 1 : -1;
+        band.c = band.axis == 0 ? e.ex0 : e.ey0;
+        extent = e.extent;
+        side = s + " side";
+      }
       band.width = o.num("width");
       o.gt("width", band.width, 0);
-      if (!(band.width <= e.extent * (1 + 1e-12)))
+      if (!(band.width <= extent * (1 + 1e-12)))
         o.fail("width", "must be <= the size of body \"" + b.name + "\" normal to its " + side +
-                            " side (" + fmt(e.extent) + "), got " + fmt(band.width));
+                            " (" + fmt(extent) + "), got " + fmt(band.width));
       band.r0 = o.num("r0", 1e-3);
       if (!(band.r0 > 0 && band.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(band.r0));
       band.power = o.num("power", 2.0);
@@ -1165,9 +1170,9 @@ class Builder {
         }
         if (inside == 0)
           o.fail("width", "selects no particle: no particle centre of body \"" + b.name +
-                              "\" lies within " + fmt(band.width) + " m of its " + side + " side");
+                              "\" lies within " + fmt(band.width) + " m of its " + side);
       }
-      c.notes.push_back("pml \"" + name + "\" inside the " + side + " side of body \"" + b.name +
+      c.notes.push_back("pml \"" + name + "\" inside the " + side + " of body \"" + b.name +
                         "\": " + fmt(band.width) + " m, r0 " + fmt(band.r0) + ", power " +
                         fmt(band.power) + ", alpha " + fmt(band.alpha) + " 1/s, " +
                         std::to_string(inside) + " particles");
@@ -1324,6 +1329,57 @@ class Builder {
   }
 
   // Traction / silent layer on a curve: the particles of the body within `width` of it.
+  // A pml along a physical curve of a body from a gmsh surface: the curve must be one straight
+  // line parallel to an axis, on the edge of the body's bounding box and spanning it, so that
+  // the band is every particle of the body within its width of that line (the stretching acts
+  // along the line's normal only; docs/physics.md section 9.3).
+  void pml_curve(Obj& o, const BodySpec& b, PmlBand& band, std::string& label, double& extent) {
+    if (!o.has("curve"))
+      o.fail("side", "body \"" + b.name + "\" comes from a gmsh surface: give its boundary as "
+                     "\"curve\" (a physical curve) instead of \"side\"");
+    if (o.has("side")) o.fail("side", "give either side or curve, not both");
+    const auto& C = geo_->curves[geometry_group(o, "curve", false)];
+    label = Geometry::label("physical curve", C.tag, C.name);
+    extent = std::numeric_limits<double>::infinity();
+    if (checking_) return;  // the geometry's lines are not read yet
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    for (const auto& sg : C.segs)
+      for (const int n : sg) {
+        x0 = std::min(x0, geo_->x[n]);
+        x1 = std::max(x1, geo_->x[n]);
+        y0 = std::min(y0, geo_->y[n]);
+        y1 = std::max(y1, geo_->y[n]);
+      }
+    for (const auto& m : C.mid) {  // a curved segment bulges off its chord
+      x0 = std::min(x0, m[0]);
+      x1 = std::max(x1, m[0]);
+      y0 = std::min(y0, m[1]);
+      y1 = std::max(y1, m[1]);
+    }
+    const double tol = 1e-9 * std::max(b.x1 - b.x0, b.y1 - b.y0);
+    const bool vertical = x1 - x0 <= tol, horizontal = y1 - y0 <= tol;
+    if (!vertical && !horizontal)
+      o.fail("curve", geo_->file + ": " + label + " is not a straight line parallel to the x or "
+                      "the y axis (it spans x " + fmt(x0) + " to " + fmt(x1) + ", y " + fmt(y0) +
+                      " to " + fmt(y1) + "): a pml on particles stretches along an axis only");
+    band.axis = vertical ? 0 : 1;
+    band.c = vertical ? x0 : y0;
+    const double lo = vertical ? b.x0 : b.y0, hi = vertical ? b.x1 : b.y1;
+    if (std::abs(band.c - lo) <= tol) band.side = -1;
+    else if (std::abs(band.c - hi) <= tol) band.side = 1;
+    else
+      o.fail("curve", geo_->file + ": " + label + " (" + (vertical ? "x = " : "y = ") +
+                          fmt(band.c) + ") is not on the edge of body \"" + b.name +
+                          "\"'s bounding box: a pml is a band along an outer edge of the body");
+    const double a0 = vertical ? y0 : x0, a1 = vertical ? y1 : x1;
+    const double b0 = vertical ? b.y0 : b.x0, b1 = vertical ? b.y1 : b.x1;
+    if (a0 > b0 + tol || a1 < b1 - tol)
+      o.fail("curve", geo_->file + ": " + label + " covers " + (vertical ? "y" : "x") + " from " +
+                          fmt(a0) + " to " + fmt(a1) + ", not the whole edge of body \"" + b.name +
+                          "\" (" + fmt(b0) + " to " + fmt(b1) + "): a pml spans its body's edge");
+    extent = hi - lo;
+  }
+
   BoundaryLayer curve_layer(Obj& o, int bi, const std::string& name, std::string& what) {
     const BodySpec& b = bodies_[bi];
     if (!o.has("curve"))

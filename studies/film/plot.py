@@ -186,7 +186,8 @@ def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "out")
     style.apply()
     H = {}
-    for name in ["fixed", "extended", "silent", "cell_0.05", "cell_0.167", "ppc_4", "ppc_9"]:
+    for name in ["fixed", "extended", "silent", "cell_0.05", "cell_0.167", "ppc_4", "ppc_9",
+                 "extended_usl", "silent_usl", "pml"]:
         p = os.path.join(out, name, "history.csv")
         if os.path.exists(p):
             H[name] = history(p)
@@ -197,6 +198,22 @@ def main():
             "silent_vs_extended": rel_l2(H["silent"], H["extended"], col, T_CMP),
             "fixed_vs_extended": rel_l2(H["fixed"], H["extended"], col, T_CMP),
         }
+    # Absorbing layers under USL: the silent bottom alone and with a 1 um PML, against the
+    # extended substrate under the same scheme (sigma_yy and J2 at E and F, sigma_yy and
+    # sigma_xy along the interface).
+    if all(n in H for n in ("extended_usl", "silent_usl", "pml")):
+        ref = H["extended_usl"]
+        layers = {}
+        for n in ("silent_usl", "pml"):
+            row = {f"{P}.{f}": rel_l2(H[n], ref, f"{P}.{f}", T_CMP)
+                   for P in ("E", "F") for f in ("syy", "J2")}
+            if interface_columns(H[n], "syy"):
+                for f in ("syy", "sxy"):
+                    row[f"interface.{f}"] = interface_rel_l2(H[n], ref, f, T_CMP)
+            layers[n + "_vs_extended_usl"] = row
+        layers["extended_usl_vs_extended"] = {
+            f"{P}.syy": rel_l2(ref, H["extended"], f"{P}.syy", T_CMP) for P in ("E", "F")}
+        metrics["layers_usl"] = layers
     # The whole interface (21 points of the probe along the gmsh curve "interface").
     if interface_columns(H["silent"], "syy"):
         metrics["interface_relative_l2"] = {

@@ -254,13 +254,13 @@ std::vector<Bad> bad_cases() {
                       {"alpha", -1}};
        },
        "boundaries[2].alpha: must be >= 0"},
-      {"pml_curve_key",
+      {"pml_side_and_curve",
        [](ojson& j) {
          j["scheme"]["update"] = "USL";
          bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002},
                       {"curve", 3}};
        },
-       "boundaries[2].curve: unknown key for a pml boundary"},
+       "boundaries[2].side: give either side or curve, not both"},
       {"pml_two_alphas",
        [](ojson& j) {
          j["scheme"]["update"] = "USL";

@@ -40,6 +40,33 @@ Physical Surface("plate", 1) = {1}; Physical Surface("lid", 2) = {2};
 Physical Curve("right", 12) = {2}; Physical Curve("lid_bottom", 15) = {5};
 )";
 
+// A right triangle: its hypotenuse (curve 16) is inclined.
+const char* kTri = R"(
+DefineConstant[ h = 0.001 ];
+Point(1) = {0, 0, 0, h}; Point(2) = {0.02, 0, 0, h}; Point(3) = {0, 0.01, 0, h};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 1};
+Curve Loop(1) = {1, 2, 3}; Plane Surface(1) = {1};
+Physical Surface("plate", 1) = {1};
+Physical Curve("bottom", 13) = {1}; Physical Curve("slope", 16) = {2};
+)";
+
+// The plate of kRect with its bottom in two lines; curve 17 is the left half.
+const char* kSplit = R"(
+DefineConstant[ h = 0.001 ];
+Point(1) = {0, 0, 0, h}; Point(2) = {0.01, 0, 0, h}; Point(3) = {0.02, 0, 0, h};
+Point(4) = {0.02, 0.01, 0, h}; Point(5) = {0, 0.01, 0, h};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 5}; Line(5) = {5, 1};
+Curve Loop(1) = {1, 2, 3, 4, 5}; Plane Surface(1) = {1};
+Physical Surface("plate", 1) = {1};
+Physical Curve("bottom", 13) = {1, 2}; Physical Curve("bottom_left", 17) = {1};
+)";
+
+// A case under USL (the particle pml needs it).
+std::string usl(std::string json) {
+  const std::string at = R"("time": {)";
+  return json.replace(json.find(at), at.size(), R"("scheme": { "update": "USL" }, )" + at);
+}
+
 std::string case_json(const std::string& geo_file, const std::string& body,
                       const std::string& boundaries = "", const std::string& grid_size = "[0.03, 0.02]",
                       const std::string& geometry_extra = "", const std::string& probes = "") {
@@ -148,6 +175,32 @@ std::vector<Bad> bad_cases() {
                case_json("rect_p.geo", kBody, R"({ "type": "silent", "body": "plate", "curve": 12 })",
                          "[0.03, 0.02]", tiny, R"({ "name": "top", "curve": 14, "count": 5 })"),
                {"geometry.file", "rect_p.geo", "would have about 2e+10 cells"}});
+  // A pml along a physical curve: one straight line along an axis, on the body's bounding box,
+  // spanning it; the control case below is accepted.
+  v.push_back({"pml_inclined_curve", "tri_a.geo", kTri,
+               usl(case_json("tri_a.geo", kBody,
+                             R"({ "type": "pml", "body": "plate", "curve": "slope", "width": 0.002 })")),
+               {"boundaries[0].curve", "tri_a.geo", "physical curve 16 \"slope\"",
+                "is not a straight line parallel to the x or the y axis"}});
+  v.push_back({"pml_curve_inside", "two_b.geo", kTwo,
+               usl(case_json("two_b.geo", kBody,
+                             R"({ "type": "pml", "body": "plate", "curve": 15, "width": 0.002 })")),
+               {"boundaries[0].curve", "two_b.geo", "physical curve 15 \"lid_bottom\"",
+                "is not on the edge of body \"plate\"'s bounding box"}});
+  v.push_back({"pml_curve_part_of_edge", "split_a.geo", kSplit,
+               usl(case_json("split_a.geo", kBody,
+                             R"({ "type": "pml", "body": "plate", "curve": 17, "width": 0.002 })")),
+               {"boundaries[0].curve", "split_a.geo", "physical curve 17 \"bottom_left\"",
+                "not the whole edge of body \"plate\" (0 to 0.02)"}});
+  v.push_back({"pml_curve_too_wide", "split_b.geo", kSplit,
+               usl(case_json("split_b.geo", kBody,
+                             R"({ "type": "pml", "body": "plate", "curve": 13, "width": 0.02 })")),
+               {"boundaries[0].width", "must be <= the size of body \"plate\" normal to its physical "
+                "curve 13 \"bottom\" (0.01), got 0.02"}});
+  v.push_back({"pml_side_and_curve", "split_c.geo", kSplit,
+               usl(case_json("split_c.geo", kBody,
+                             R"({ "type": "pml", "body": "plate", "curve": 13, "side": "bottom", "width": 0.002 })")),
+               {"boundaries[0].side", "either side or curve, not both"}});
   // No geometry key at all.
   v.push_back({"no_geometry", "", "", R"({
   "grid": { "size": [0.03, 0.02], "cell": 0.001 }, "time": { "end": 1e-6, "cfl": 0.3 },
