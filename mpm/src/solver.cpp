@@ -188,7 +188,7 @@ void Solver::finalize() {
     pml.layer.idx.push_back(static_cast<uint32_t>(k));
     pml.dx.push_back(dx);
     pml.dy.push_back(dy);
-    // The share of the grid's velocity the particle takes (pml_pic): (depth / width)^2.5 in its
+    // The share of the grid's velocity the particle takes (pml_pic): (depth / width)^5 in its
     // deepest band.
     double depth = 0;
     for (const PmlBand& b : pml_bands)
@@ -642,9 +642,10 @@ void Solver::pml_loads() {
 // w v_grid(start) + (1 - w) v_p, so that g2p's increment (FLIP, PIC or a blend) leaves it with
 // w v_grid(end) + (1 - w) v_p(FLIP). The layer's equations know the grid's unknowns only; the FLIP
 // particle velocity is a memory they do not contain, and with it the layer grew after a few
-// thousand steps. w grows from 0 at the layer's inner edge as (depth / width)^2.5: a sudden
-// switch to PIC reflects (PIC smooths the velocity over the stencil each step), a gentler one
-// (power 3 and more) leaves enough FLIP for the growth to return (docs/physics.md section 9.3).
+// thousand steps. w grows from 0 at the layer's inner edge as (depth / width)^5: an earlier
+// switch to PIC reflects and converts waves (PIC smooths the velocity over the stencil each
+// step), a later one (power 6 and more, under USL) leaves enough FLIP for the growth to return
+// (docs/physics.md section 9.3).
 template <class S>
 void Solver::pml_pic() {
   constexpr int K = S::kNodes;

@@ -95,7 +95,7 @@ struct PmlBand {
 };
 
 // The power of the layer particles' PIC share in their depth (Solver::pml_pic).
-inline constexpr double kPmlPicPower = 2.5;
+inline constexpr double kPmlPicPower = 5;
 
 // The particles of every band of a solver, with their stretchings and memories (built by
 // Solver::finalize; a particle in two bands, at a corner, has both d_x and d_y).
