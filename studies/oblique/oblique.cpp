@@ -3,7 +3,7 @@
 // traces OUT/trace_<P|SV>_<angle>.csv.
 //
 //   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N] [--shape bilinear|gimp|bspline]
-//           [--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S]
+//           [--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N]
 //           (the right side of run A)
 #include <cstdlib>
 #include <fstream>
@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
                          "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
-                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S]\n");
+                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -64,6 +64,8 @@ int main(int argc, char** argv) {
       base.r0 = std::atof(argv[i + 1]);
     } else if (a == "--alpha") {
       base.alpha = std::atof(argv[i + 1]);
+    } else if (a == "--power") {
+      base.power = std::atof(argv[i + 1]);
     } else if (a == "--shape") {
       const std::string v = argv[i + 1];
       if (v == "bilinear") base.shape = ShapeKind::Bilinear;
@@ -93,11 +95,13 @@ int main(int argc, char** argv) {
     if (base.boundary == "damping") {
       j["damping_band_cells"] = base.band;
       j["damping_r0"] = base.r0;
+      j["damping_power"] = base.power;
     }
     if (base.boundary == "pml") {
       j["pml_cells"] = base.band;
       j["pml_r0"] = base.r0;
       j["pml_alpha"] = base.alpha;
+      j["pml_power"] = base.power;
     }
     j["nu"] = base.nu;
     j["pulse_fwhm_cells"] = base.fwhm;

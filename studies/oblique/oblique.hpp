@@ -55,11 +55,11 @@ struct Setup {
   int taper = 60;          // cos^2 taper beyond it (cells)
   smpm::ShapeKind shape = smpm::ShapeKind::Bilinear;  // MPM grid shape functions
   // The right side of run A: "lk" (dashpots), "kv" (dashpots and springs with `delta` cells),
-  // "damping" (a graded damping band of `band` cells with r0 and power 2, then the dashpots),
-  // "pml" (FEM: a perfectly matched layer of `band` cells with r0, power 2 and alpha, then the
+  // "damping" (a graded damping band of `band` cells with r0 and power (default 2), then the dashpots),
+  // "pml" (FEM: a perfectly matched layer of `band` cells with r0, power (default 2) and alpha, then the
   // dashpots).
   std::string boundary = "lk";
-  double delta = 40, band = 10, r0 = 1e-3, alpha = 0;
+  double delta = 40, band = 10, r0 = 1e-3, alpha = 0, power = 2;
   // Cells before the boundary where the initial data ends (a layer's thickness plus 2), or -1:
   // not cut (LK, Kelvin-Voigt).
   double clear() const { return boundary == "damping" || boundary == "pml" ? band + 2 : -1.0; }
@@ -234,6 +234,7 @@ inline Result measure(const Setup& su) {
         d.name = "band";
         d.width = su.band * h;
         d.r0 = su.r0;
+        d.power = su.power;
         s.boundaries.push_back(d);
       }
     }

@@ -37,6 +37,7 @@ inline Result measure_mpm(const Setup& su) {
       band.c = cells_x * h;
       band.width = su.band * h;
       band.r0 = su.r0;
+      band.power = su.power;
       band.alpha = su.alpha;
       s->pml_bands.push_back(band);
     }
@@ -50,6 +51,7 @@ inline Result measure_mpm(const Setup& su) {
         dl.layer = s->select_layer("band", 0, cells_x * h, 0, cells_x * h, w.ly * h, 1, 0,
                                    su.band * h);
         dl.r0 = su.r0;
+        dl.power = su.power;
         s->dampers.push_back(dl);
       }
     }
