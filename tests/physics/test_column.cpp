@@ -743,13 +743,10 @@ TEST(Column, LayerFlagsMarkTheLayers) {
 // the end). Measured, P / S:
 //   USL   0.19 / 0.11 % (1 ppc), 0.10 / 0.17 % (4), 0.11 / 0.17 % (9)
 //   MUSL  1.12 / 0.75 % (1 ppc), 0.39 / 0.33 % (4), 0.35 / 0.31 % (9); USF within 1 % of MUSL.
-// USL meets 0.3 % everywhere. MUSL and USF strain the particles with the particles' own
-// velocities re-mapped to the nodes (or, in USF, mapped at the start): at a node with particles
-// on one side only that value sits half a particle spacing inside, so the last particles see
-// about half the strain rate, a first-order error at the end. Taking the updated grid velocity
-// at the dashpot nodes instead brings 4 and 9 ppc to 0.13-0.18 % but doubles the 1-ppc figure
-// (2.4 %), where MUSL's two-cell central difference has its odd-even mode (docs/physics.md
-// section 4). The 1-ppc MUSL energy account closes to 1.1 % here (1 % on 8-cell pulses).
+// USL meets 0.3 % everywhere; MUSL and USF, which strain the particles with their own velocities
+// mapped to the nodes, do not at 1 ppc (docs/physics.md section 4: two changes at the edge
+// nodes that were tried and why they were not kept). The 1-ppc MUSL energy account closes to
+// 1.1 % here (1 % on 8-cell pulses).
 TEST(SilentLayer, NormalIncidence16CellPulsesEveryScheme) {
   for (const Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF})
     for (const int ppc : {1, 2, 3})
