@@ -774,17 +774,22 @@ void Solver::apply_loads() {
     }
   }
   // Damping layers: C_i += alpha_q m_q N_i(x_q) I, at the particle (a volume term).
-  for (const auto& dl : dampers) {
+  for (auto& dl : dampers) {
     const auto& L = dl.layer;
+    constexpr int K = S::kNodes;
+    dl.nodes.resize(K * L.idx.size());
+    dl.N.resize(K * L.idx.size());
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       if (dl.alpha[q] == 0) continue;
-      load_weights(L, q, Anchor::Particle, sf, nodes);
+      long* dn = dl.nodes.data() + K * q;
+      load_weights(L, q, Anchor::Particle, sf, dn);
       has_nodal_dashpot_ = true;
       const double c = dl.alpha[q] * p.mass[L.idx[q]];
-      for (int a = 0; a < S::kNodes; ++a) {
-        grid.cxx[nodes[a]] += c * sf.N[a];
-        grid.cyy[nodes[a]] += c * sf.N[a];
-        add_dashpot_node(nodes[a]);
+      for (int a = 0; a < K; ++a) {
+        dl.N[K * q + a] = sf.N[a];
+        grid.cxx[dn[a]] += c * sf.N[a];
+        grid.cyy[dn[a]] += c * sf.N[a];
+        add_dashpot_node(dn[a]);
       }
     }
   }
@@ -931,18 +936,21 @@ void Solver::boundary_work(bool remapped) {
     }
     if (opt.scheme != Scheme::USF) pml_advance<S>(ux, uy);
   }
-  // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i.
+  // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i, with the
+  // weights the blocks were assembled with.
   for (const auto& dl : dampers) {
     const auto& L = dl.layer;
+    constexpr int K = S::kNodes;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       if (dl.alpha[q] == 0) continue;
-      load_weights(L, q, Anchor::Particle, sf, nodes);
+      const long* dn = dl.nodes.data() + K * q;
+      const double* N = dl.N.data() + K * q;
       const double c = dl.alpha[q] * p.mass[L.idx[q]];
-      for (int a = 0; a < S::kNodes; ++a) {
+      for (int a = 0; a < K; ++a) {
         double ax, ay, bx, by;
-        vbar(nodes[a], ax, ay);
-        wbar(nodes[a], bx, by);
-        energy.absorbed += dt * c * sf.N[a] * (ax * bx + ay * by);
+        vbar(dn[a], ax, ay);
+        wbar(dn[a], bx, by);
+        energy.absorbed += dt * c * N[a] * (ax * bx + ay * by);
       }
     }
   }

@@ -82,6 +82,10 @@ struct DampingLayer {
   BoundaryLayer layer;
   double r0 = 1e-3, power = 2;
   std::vector<double> alpha;         // alpha per layer particle (1/s), set by Solver::finalize
+  // This step's weights of each particle (kNodes per particle: node, N), from the assembly of
+  // the blocks; the power of the damping force is booked with the same ones.
+  std::vector<long> nodes;
+  std::vector<double> N;
 };
 
 // A perfectly matched layer inside a straight side of a body (docs/physics.md section 9.3): the
