@@ -51,8 +51,8 @@ def oblique(out, shape):
 def bench(out):
     r = {}
     for line in open(os.path.join(out, "bench.txt")):
-        f = line.split()
-        if len(f) == 6 and f[0].isdigit():
+        f = line.split()  # particles, boundary, threads, steps, updates/s, shape[, bytes, GB/s, %]
+        if len(f) >= 6 and f[0].isdigit() and f[5] in SHAPES:
             r.setdefault(f[5], {})[f"{f[0]} {f[1]} {f[2]}t"] = float(f[4])
     return r
 
