@@ -157,7 +157,7 @@ void pml_forces(Solver::Impl& m, double dt) {
   const int nb = P.nb, nq = P.nq;
   for (std::size_t colour = 0; colour + 1 < P.colour_start.size(); ++colour) {
     const std::int64_t c0 = P.colour_start[colour], c1 = P.colour_start[colour + 1];
-#pragma omp parallel for schedule(static) num_threads(m.threads) if (c1 - c0 >= 2000)
+#pragma omp parallel for schedule(static) num_threads(m.threads) if (c1 - c0 >= 256)
     for (std::int64_t c = c0; c < c1; ++c) {
       const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
       const double* gs = P.grad.data() + static_cast<std::size_t>(P.shape[c]) * nq * nb * 2;

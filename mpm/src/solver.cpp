@@ -649,7 +649,10 @@ void Solver::pml_loads() {
 template <class S>
 void Solver::pml_pic() {
   constexpr int K = S::kNodes;
-  for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
+  const long n = static_cast<long>(pml.layer.idx.size());
+  // Each particle its own: in parallel, the same values as in order.
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 1024)
+  for (long q = 0; q < n; ++q) {
     const uint32_t k = pml.layer.idx[q];
     const NodalField* f = &fields_[0].f;
     if (!body_of_group_.empty())
@@ -671,7 +674,9 @@ void Solver::pml_pic() {
 template <class S>
 void Solver::pml_advance(const std::vector<double>& vx, const std::vector<double>& vy) {
   constexpr int K = S::kNodes;
-  for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
+  const long n = static_cast<long>(pml.layer.idx.size());
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 1024)
+  for (long q = 0; q < n; ++q) {
     const long* nodes = pml.nodes.data() + K * q;
     const double* N = pml.N.data() + K * q;
     const double* dNx = pml.dNx.data() + K * q;
@@ -699,8 +704,9 @@ void Solver::pml_shapes() {
   pml.N.resize(K * n);
   pml.dNx.resize(K * n);
   pml.dNy.resize(K * n);
-  S sf;
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 1024)
   for (std::size_t q = 0; q < n; ++q) {
+    S sf;
     layer_shape(pml.layer, q, Anchor::Particle, sf, pml.nodes.data() + K * q);
     for (int a = 0; a < K; ++a) {
       pml.N[K * q + a] = sf.N[a];
@@ -843,7 +849,11 @@ void Solver::grid_update() {
   }
   if (bad) fail_nonfinite();
   if (!has_nodal_dashpot_) return;
-  for (long i : dashpot_nodes_) {
+  const long nd = static_cast<long>(dashpot_nodes_.size());
+  const long* dnodes = dashpot_nodes_.data();
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
+  for (long k = 0; k < nd; ++k) {  // each node its own: in parallel, the same values
+    const long i = dnodes[k];
     if (m[i] <= floor) continue;
     dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
                      fix[i], ux[i], uy[i]);
