@@ -64,6 +64,25 @@ std::string num(double v) {
 const char* kMaterial =
     R"("materials": {"steel": {"model": "elastic", "young": 200e9, "poisson": 0.25, "density": 7800}})";
 
+// The boundary entries of `kind` on the left, right and bottom sides, each side named by
+// `select` + side (MPM: a body's side; FEM: a curve), the LK entry of the method being `lk`.
+std::string edges(const std::string& kind, const std::string& select, const std::string& lk,
+                  double L) {
+  std::string b;
+  if (kind == "free") return b;
+  for (const char* side : {"left", "right", "bottom"}) {
+    const std::string at = select + side + "\"";
+    const std::string dashpots = R"(, {"type": ")" + lk + "\", " + at + "}";
+    if (kind == "lk") b += dashpots;
+    if (kind == "kv") b += R"(, {"type": "kelvin_voigt", "delta": )" + num(40 * kH) + ", " + at + "}";
+    if (kind == "damping")
+      b += R"(, {"type": "damping_layer", "width": )" + num(L) + R"(, "r0": 0.9, )" + at + "}" + dashpots;
+    if (kind == "pml")
+      b += R"(, {"type": "pml", "width": )" + num(L) + R"(, "r0": 0.01, )" + at + "}" + dashpots;
+  }
+  return b;
+}
+
 // The load: a sin^2 pulse on the middle fifth of the top.
 std::string mpm_case(const Options& o, const std::string& kind, const std::string& scheme) {
   const double W = o.cells * kH, L = o.layer * kH;
@@ -77,18 +96,7 @@ std::string mpm_case(const Options& o, const std::string& kind, const std::strin
   b += R"("boundaries": [{"type": "traction", "body": "b", "side": "top", "interval": [)" +
        num(0.4 * W) + ", " + num(0.6 * W) +
        R"(], "normal": -1e8, "time": {"shape": "sin2", "start": 0, "duration": 2e-6, "ramp": 1e-6}})";
-  for (const char* side : {"left", "right", "bottom"}) {
-    const std::string at = std::string(R"("body": "b", "side": ")") + side + "\"";
-    if (kind == "free") continue;
-    if (kind == "lk") b += R"(, {"type": "silent", )" + at + "}";
-    if (kind == "kv") b += R"(, {"type": "kelvin_voigt", "delta": )" + num(40 * kH) + ", " + at + "}";
-    if (kind == "damping")
-      b += R"(, {"type": "damping_layer", "width": )" + num(L) + R"(, "r0": 0.9, )" + at +
-           R"(}, {"type": "silent", )" + at + "}";
-    if (kind == "pml")
-      b += R"(, {"type": "pml", "width": )" + num(L) + R"(, "r0": 0.01, )" + at +
-           R"(}, {"type": "silent", )" + at + "}";
-  }
+  b += edges(kind, R"("body": "b", "side": ")", "silent", L);
   b += R"(], "output": {"snapshots": 0, "progress": false}})";
   return b;
 }
@@ -102,18 +110,7 @@ std::string fem_case(const Options& o, const std::string& kind, const std::strin
   // The FE load is on the whole top (the mesh has no curve for its middle fifth); a traction
   // costs the same per step either way.
   b += R"({"type": "traction", "curve": "top", "normal": -1e8, "time": {"shape": "sin2", "start": 0, "duration": 2e-6, "ramp": 1e-6}})";
-  for (const char* side : {"left", "right", "bottom"}) {
-    const std::string at = std::string(R"("curve": ")") + side + "\"";
-    if (kind == "free") continue;
-    if (kind == "lk") b += R"(, {"type": "dashpot", )" + at + "}";
-    if (kind == "kv") b += R"(, {"type": "kelvin_voigt", "delta": )" + num(40 * kH) + ", " + at + "}";
-    if (kind == "damping")
-      b += R"(, {"type": "damping_layer", "width": )" + num(L) + R"(, "r0": 0.9, )" + at +
-           R"(}, {"type": "dashpot", )" + at + "}";
-    if (kind == "pml")
-      b += R"(, {"type": "pml", "width": )" + num(L) + R"(, "r0": 0.01, )" + at +
-           R"(}, {"type": "dashpot", )" + at + "}";
-  }
+  b += edges(kind, R"("curve": ")", "dashpot", L);
   b += R"(]}, "output": {"snapshots": 0, "progress": false}})";
   return b;
 }
