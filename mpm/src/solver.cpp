@@ -259,7 +259,10 @@ void Solver::sort_particles() {
   std::vector<uint32_t> perm(n);
   for (std::size_t k = 0; k < n; ++k) perm[count[key[k]]++] = static_cast<uint32_t>(k);
   p.permute(perm);
-  where_.assign(n, 0);
+  // Ids run over 0 .. n - 1, except on a rank of a decomposition, which holds some of them.
+  uint32_t id_end = 0;
+  for (std::size_t k = 0; k < n; ++k) id_end = std::max(id_end, p.id[k] + 1);
+  where_.assign(id_end, 0);
   for (std::size_t k = 0; k < n; ++k) where_[p.id[k]] = static_cast<uint32_t>(k);
   for (auto& tl : tractions)
     for (std::size_t k = 0; k < tl.layer.ids.size(); ++k) tl.layer.idx[k] = where_[tl.layer.ids[k]];
@@ -800,6 +803,8 @@ void Solver::apply_loads() {
     }
   }
   if (pml.active()) pml_loads<S>();
+  // Split over ranks: every load is in; the shared nodes sum their forces.
+  if (dist_) sum_halo(false, true);
   // Gravity: f_i += m_i g, the nodal form of sum_p m_p g N_i (the lumped mass is sum_p m_p N_i).
   // On the grid's field; in multi-field contact the bodies' fields differ from it by their own
   // deviation, in which g cancels.
@@ -898,10 +903,12 @@ void Solver::boundary_work(bool remapped) {
   // Gravity's work with the same velocity as the tractions' (void nodes have m = 0).
   if (opt.gravity_x != 0 || opt.gravity_y != 0) {
     const double gx = opt.gravity_x, gy = opt.gravity_y;
-    const long n = static_cast<long>(grid.nodes());
-    const double* m = grid.m.data();
-    const double* v0x = grid.vx.data(); const double* v0y = grid.vy.data();
-    const double* wx = ux.data(); const double* wy = uy.data();
+    // This rank's own nodes (every node without a decomposition).
+    const long n0 = own_hi_ < 0 ? 0 : own_lo_ * grid.nnx;
+    const long n = own_hi_ < 0 ? static_cast<long>(grid.nodes()) : (own_hi_ + 1) * grid.nnx - n0;
+    const double* m = grid.m.data() + n0;
+    const double* v0x = grid.vx.data() + n0; const double* v0y = grid.vy.data() + n0;
+    const double* wx = ux.data() + n0; const double* wy = uy.data() + n0;
     double w = 0;
 #pragma omp parallel for schedule(static) reduction(+ : w) num_threads(nthreads_)
     for (long i = 0; i < n; ++i)
@@ -1154,6 +1161,9 @@ void Solver::step_with() {
   const Scheme sc = opt.scheme;
   reset_grid();
   p2g<S>(sc == Scheme::USF ? kMomentum : kMomentum | kForce);
+  // Split over ranks: the shared nodes' masses and momenta are summed before anything reads them
+  // (the boundary layers' weights read the nodal mass); their forces once the loads are in.
+  if (dist_) sum_halo(true, false);
   call([&](StepHooks& h) { h.after_momentum(*this); });
   if (sc == Scheme::USF) {
     start_velocities();
@@ -1179,6 +1189,10 @@ void Solver::step_with() {
   switch (sc) {
     case Scheme::MUSL:
       g2p<S>(true, false);
+      if (dist_) {
+        double* q[2] = {grid.qx.data(), grid.qy.data()};
+        dist_->sum_halo(q, 2);
+      }
       call([&](StepHooks& h) { h.after_remap(*this); });
       remapped_velocities();
       if (remapped_power) boundary_work<S>(true);
@@ -1196,6 +1210,7 @@ void Solver::step_with() {
   ++steps;
   check_health();  // first: a blow-up, not the grid's size, is why particles fly off
   check_outside();
+  if (dist_ && dist_->migrate(*this)) sort_particles();
   call([&](StepHooks& h) { h.end_of_step(*this); });
 }
 
@@ -1210,8 +1225,19 @@ void Solver::step_with() {
 // nothing put in). Nodal values would not do: a node holding a sliver of mass at a body's edge
 // takes a large velocity the particles hardly see.
 void Solver::check_health() {
-  const long collapsed = collapsed_, stretched = stretched_;
-  const double ke = step_kinetic_, v2 = step_speed2_;
+  long collapsed = collapsed_, stretched = stretched_;
+  double ke = step_kinetic_, v2 = step_speed2_;
+  double put_in = energy.initial + std::abs(energy.external_work);
+  if (dist_) {  // the checks of the whole body: every rank takes the same decisions
+    double s[5] = {static_cast<double>(collapsed), static_cast<double>(stretched), ke,
+                   energy.initial, energy.external_work};
+    dist_->sum(s, 5);
+    dist_->max(&v2, 1);
+    collapsed = static_cast<long>(s[0]);
+    stretched = static_cast<long>(s[1]);
+    ke = s[2];
+    put_in = s[3] + std::abs(s[4]);
+  }
   collapsed_ = 0;
   stretched_ = 0;
   step_kinetic_ = 0;
@@ -1277,7 +1303,6 @@ void Solver::check_health() {
     throw std::runtime_error(o.str());
   }
   if (opt.energy_bound > 0) {
-    const double put_in = energy.initial + std::abs(energy.external_work);
     if (ke > opt.energy_bound * put_in + energy_floor_) {
       std::ostringstream o;
       o << "kinetic energy " << ke << " J exceeds " << opt.energy_bound

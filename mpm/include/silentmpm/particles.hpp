@@ -47,8 +47,12 @@ struct Particles {
     body[k] = static_cast<uint16_t>(body_id);
     group[k] = static_cast<uint16_t>(group_id);
   }
-  // Apply a permutation: new[k] = old[perm[k]].
+  // Apply a permutation: new[k] = old[perm[k]]. A shorter perm keeps only the particles it lists.
   void permute(const std::vector<uint32_t>& perm);
+  // Every field of particle k appended to out as doubles (ids and indices are exact in a
+  // double); unpack appends such a record as a new particle and returns the doubles it read.
+  void pack(std::size_t k, std::vector<double>& out) const;
+  std::size_t unpack(const double* in);
   // Bytes per particle of the arrays every run carries, and of the film block.
   static constexpr std::size_t bytes_per_particle() {
     return 13 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t);

@@ -25,12 +25,14 @@
 // template argument of the inner loop. Scatters to the grid run in parallel over horizontal
 // strips of particles: even strips first, then odd strips, so no two threads write one node.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "silentmpm/boundary.hpp"
 #include "silentmpm/contact.hpp"
+#include "silentmpm/decomposition.hpp"
 #include "silentmpm/energies.hpp"
 #include "silentmpm/grid.hpp"
 #include "silentmpm/kernels.hpp"
@@ -156,6 +158,31 @@ class Solver {
   // Check every particle is inside the grid; returns the index of the first outside, or -1.
   long first_particle_outside() const;
 
+  // --- processes (solver_exchange.cpp; decomposition.hpp) ----------------------------------
+  // Splits the step over ranks: d sums the halo and moves particles; node rows [own_lo, own_hi]
+  // of this solver's grid are this rank's own (the rest are copies of its neighbours' nodes, left
+  // out of sums over nodes); `dashpots`: whether any rank assembles nodal dashpot blocks (they are
+  // then summed over the halo too). Called after finalize and after the grid, particles and
+  // layers were cut to this rank's share; the solver does not own d.
+  void set_decomposition(Decomposition* d, long own_lo, long own_hi, bool dashpots);
+  Decomposition* decomposition() const { return dist_; }
+  // Keeps the particles with keep[k] != 0 and their boundary-layer entries (order kept).
+  void keep_particles(const std::vector<std::uint8_t>& keep);
+  // Appends to out[to[k]] a record of each particle with to[k] >= 0: its fields and its entries
+  // in every boundary layer; then removes those particles. export_particles and
+  // import_particles leave the particles unsorted: sort_particles() before they are used.
+  void export_particles(const std::vector<int>& to, std::vector<std::vector<double>>& out);
+  // Appends the particles of records written by export_particles (of a solver built from the
+  // same case).
+  void import_particles(const std::vector<double>& in);
+  void sort_particles();
+  // The energy account over every rank (this rank's own without a decomposition).
+  Energies total_energy() const;
+  // The cell row of a particle in this solver's grid.
+  int cell_row(std::size_t k) const {
+    return static_cast<int>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
+  }
+
   // --- checkpoints (solver_state.cpp) --------------------------------------------------------
   // The state a later step reads, as blocks named `prefix` + ...: clock, energies, every particle
   // array in the current order, the strips, spring displacements, contact dissipation.
@@ -190,8 +217,14 @@ class Solver {
   std::vector<VelocityField> fields_;     // empty: the grid's own field (set up by the step)
   std::vector<int> body_of_group_;        // with body fields: the body of each material group
   std::vector<StepHooks*> hooks_;
+  Decomposition* dist_ = nullptr;
+  long own_lo_ = 0, own_hi_ = -1;  // node rows of this rank (own_hi_ < 0: every row)
+  bool halo_dashpots_ = false;
+  void sum_halo(bool momentum, bool force);
+  // fn(layer, its per-entry arrays with their strides) for every boundary layer, in a fixed order.
+  template <class Fn> void for_each_layer(Fn&& fn);
 
-  void sort_particles();
+  void compact(const std::vector<std::uint8_t>& keep);
   void refresh_strip_rows();
   void refresh_fields();
   bool strips_conflict() const;

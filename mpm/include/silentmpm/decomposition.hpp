@@ -1,0 +1,33 @@
+#pragma once
+// A solver split over processes: each rank holds the particles of a slab of cell rows and a
+// window of the grid, its own node rows and copies of its neighbours' nearest rows (the halo).
+// The step asks its decomposition (set by Solver::set_decomposition; implemented over MPI in
+// parallel/) to
+//   * sum the nodal values every rank scattered into the nodes it shares with others, once all
+//     particles have been mapped and before any node is updated (every copy then holds the sum,
+//     and the grid update runs on all the window's nodes, the copies giving the same values);
+//   * move the particles that left the slab to the rank that owns them, at the end of the step;
+//   * sum and take maxima of the health checks' reductions over the ranks.
+// The serial solver has none and makes none of these calls.
+namespace smpm {
+
+class Solver;
+
+class Decomposition {
+ public:
+  virtual ~Decomposition() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  // Sums the halo of the n grid arrays (each grid.nodes() long) over the ranks sharing nodes.
+  virtual void sum_halo(double* const* fields, int n) = 0;
+  // Moves the particles outside this rank's cell rows (with their boundary-layer entries) to
+  // their owners; returns whether any particle left or arrived here.
+  virtual bool migrate(Solver& s) = 0;
+  // In place over the ranks.
+  virtual void sum(double* v, int n) = 0;
+  virtual void max(double* v, int n) = 0;
+  // Every rank learns whether any rank passed true.
+  virtual bool any(bool b) = 0;
+};
+
+}  // namespace smpm

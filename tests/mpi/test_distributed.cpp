@@ -1,0 +1,349 @@
+// The MPM step over MPI ranks (slabs; parallel/) against the same case on one process. Run by
+// CTest on 1, 2 and 4 ranks: every rank builds the serial solver too and compares with it.
+//   * 1 rank: bit-identical to the serial solver.
+//   * 2 and 4 ranks: per-particle fields by id within 1e-12 of each field's maximum, energies
+//     within 1e-12 of the largest term (a node on a rank border sums its parts in another
+//     order); two runs bit-identical; the nodal mass on the ranks' own nodes equals the
+//     particles' mass to 1e-14; particles crossing borders keep their ids and count, and their
+//     boundary-layer entries.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common.hpp"
+#include "silentmpm/distributed.hpp"
+#include "silentmpm/solver.hpp"
+
+namespace smpm::testing {
+namespace {
+
+int ranks() {
+  int n = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+struct PlateSpec {
+  int nx = 24, ny = 40;        // plate cells
+  int ppc = 2;
+  Scheme scheme = Scheme::MUSL;
+  ShapeKind shape = ShapeKind::Bilinear;
+  double vy0 = 0;              // initial upward velocity of the whole plate (m/s)
+  double spin = 0;             // initial rigid rotation about the plate's centre (rad/s)
+  bool springs = true;         // Kelvin-Voigt springs on the bottom layer
+  double lk = 1;               // the LK coefficients a = b of the silent layers
+  double spring_alpha = 1;     // alpha_n = alpha_t of the springs
+  // Instead: a damping band on the left edge, a PML band on the bottom, the right edge's LK in
+  // the particle form, and gravity.
+  bool other_layers = false;
+};
+
+// A tungsten plate on a grid with margins: a sin^2 pressure pulse on its top edge, LK silent
+// layers on its left and right edges (every slab border crosses them) and a silent layer with
+// Kelvin-Voigt springs on its bottom edge.
+std::unique_ptr<Solver> make_plate(const PlateSpec& c) {
+  const double h = 1e-3;
+  auto s = std::make_unique<Solver>();
+  s->materials.push_back(tungsten());
+  s->grid.init(-3 * h, -3 * h, h, c.nx + 6, c.ny + 6);
+  const double W = c.nx * h, H = c.ny * h;
+  s->seed_rectangle(0, 0, W, H, c.ppc, 0, 0, 0, c.vy0);
+  if (c.spin != 0)
+    for (std::size_t k = 0; k < s->p.size(); ++k) {
+      s->p.vx[k] = -c.spin * (s->p.y[k] - 0.5 * H);
+      s->p.vy[k] = c.vy0 + c.spin * (s->p.x[k] - 0.5 * W);
+    }
+  TractionLoad tl;
+  tl.layer = s->select_layer("top", 0, W, H, 0, H, 0, 1, h);
+  tl.normal = -100e6;
+  const double dur = 16 * h / s->materials[0].cd;
+  tl.fn = sin2_pulse(dur, 0.5 * dur);
+  s->tractions.push_back(tl);
+  if (c.other_layers) {
+    DampingLayer dl;
+    dl.layer = s->select_layer("band", 0, 0, H, 0, 0, -1, 0, 5 * h);
+    s->dampers.push_back(dl);
+    PmlBand band;
+    band.name = "pml";
+    band.body = 0;
+    band.axis = 1;
+    band.side = -1;
+    band.c = 0;
+    band.width = 5 * h;
+    s->pml_bands.push_back(band);
+    SilentBoundary sb;
+    sb.form = SilentForm::Particle;
+    sb.layer = s->select_layer("right", 0, W, 0, W, H, 1, 0, h);
+    s->silents.push_back(sb);
+    s->opt.gravity_y = -1e5;
+  }
+  for (int side = 0; side < 2 && !c.other_layers; ++side) {
+    SilentBoundary sb;
+    sb.a = sb.b = c.lk;
+    const double x = side ? W : 0;
+    sb.layer = s->select_layer(side ? "right" : "left", 0, x, side ? 0 : H, x, side ? H : 0,
+                               side ? 1 : -1, 0, h);
+    s->silents.push_back(sb);
+  }
+  SilentBoundary kv;
+  kv.a = kv.b = c.lk;
+  kv.alpha_n = kv.alpha_t = c.spring_alpha;
+  kv.layer = s->select_layer("bottom", 0, 0, 0, W, 0, 0, -1, h);
+  if (c.springs) kv.delta = 10 * h;
+  if (!c.other_layers) s->silents.push_back(kv);
+  s->opt.scheme = c.scheme;
+  s->opt.shape = c.shape;
+  s->opt.threads = 1;
+  s->dt = 0.3 * h / s->materials[0].cd;
+  s->finalize();
+  return s;
+}
+
+// Every rank's particles, by id, on every rank.
+struct Fields {
+  std::vector<std::array<double, 8>> v;  // x, y, vx, vy, sxx, syy, sxy, vol
+};
+Fields gather(const Solver& s) {
+  std::vector<double> mine;
+  for (std::size_t k = 0; k < s.p.size(); ++k)
+    for (double f : {static_cast<double>(s.p.id[k]), s.p.x[k], s.p.y[k], s.p.vx[k], s.p.vy[k],
+                     s.p.sxx[k], s.p.syy[k], s.p.sxy[k], s.p.vol[k]})
+      mine.push_back(f);
+  const int P = ranks();
+  int n = static_cast<int>(mine.size());
+  std::vector<int> counts(P), disp(P);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  int total = 0;
+  for (int r = 0; r < P; ++r) disp[r] = total, total += counts[r];
+  std::vector<double> all(total);
+  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), disp.data(), MPI_DOUBLE,
+                 MPI_COMM_WORLD);
+  Fields f;
+  f.v.assign(all.size() / 9, {});
+  std::vector<int> seen(f.v.size(), 0);
+  for (std::size_t r = 0; r + 8 < all.size(); r += 9) {
+    const auto id = static_cast<std::size_t>(all[r]);
+    EXPECT_LT(id, f.v.size()) << "a particle id outside 0 .. n - 1";
+    if (id >= f.v.size()) continue;
+    ++seen[id];
+    for (int q = 0; q < 8; ++q) f.v[id][q] = all[r + 1 + q];
+  }
+  for (std::size_t id = 0; id < seen.size(); ++id)
+    EXPECT_EQ(seen[id], 1) << "particle " << id << " held by " << seen[id] << " ranks";
+  return f;
+}
+Fields gather_serial(const Solver& s) {
+  Fields f;
+  f.v.assign(s.p.size(), {});
+  for (std::size_t k = 0; k < s.p.size(); ++k)
+    f.v[s.p.id[k]] = {s.p.x[k], s.p.y[k], s.p.vx[k], s.p.vy[k], s.p.sxx[k], s.p.syy[k],
+                      s.p.sxy[k], s.p.vol[k]};
+  return f;
+}
+
+// max |a - b| over particles, per field, over max |b|.
+std::array<double, 8> differences(const Fields& a, const Fields& b) {
+  std::array<double, 8> d{}, m{};
+  for (std::size_t k = 0; k < b.v.size(); ++k)
+    for (int q = 0; q < 8; ++q) {
+      d[q] = std::max(d[q], std::abs(a.v[k][q] - b.v[k][q]));
+      m[q] = std::max(m[q], std::abs(b.v[k][q]));
+    }
+  for (int q = 0; q < 8; ++q) d[q] = m[q] > 0 ? d[q] / m[q] : d[q];
+  return d;
+}
+
+double energy_difference(const Energies& a, const Energies& b) {
+  const double ta[] = {a.kinetic, a.elastic, a.dissipated, a.absorbed, a.external_work, a.initial};
+  const double tb[] = {b.kinetic, b.elastic, b.dissipated, b.absorbed, b.external_work, b.initial};
+  double d = 0, m = 0;
+  for (int q = 0; q < 6; ++q) {
+    d = std::max(d, std::abs(ta[q] - tb[q]));
+    m = std::max(m, std::abs(tb[q]));
+  }
+  return d / m;
+}
+
+std::size_t layer_entries(const Solver& s) {
+  std::size_t n = 0;
+  for (const auto& t : s.tractions) n += t.layer.ids.size();
+  for (const auto& t : s.silents) n += t.layer.ids.size();
+  return n;
+}
+
+struct Outcome {
+  Fields f;
+  Energies e;
+  long sent = 0;
+  std::size_t entries = 0;
+};
+
+Outcome run_distributed(const PlateSpec& c, int steps) {
+  auto s = make_plate(c);
+  Distributed d(*s, MPI_COMM_WORLD);
+  for (int n = 0; n < steps; ++n) s->step();
+  s->update_energies();
+  Outcome r;
+  r.f = gather(*s);
+  r.e = s->total_energy();
+  long sent = d.sent();
+  MPI_Allreduce(MPI_IN_PLACE, &sent, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  r.sent = sent;
+  unsigned long e = layer_entries(*s);
+  MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
+  r.entries = e;
+  return r;
+}
+
+Outcome run_serial(const PlateSpec& c, int steps) {
+  auto s = make_plate(c);
+  for (int n = 0; n < steps; ++n) s->step();
+  s->update_energies();
+  return {gather_serial(*s), s->energy, 0, layer_entries(*s)};
+}
+
+void expect_agreement(const Outcome& d, const Outcome& s, const std::string& what) {
+  const auto diff = differences(d.f, s.f);
+  const double de = energy_difference(d.e, s.e);
+  if (ranks() == 1) {  // the same operations in the same order
+    for (int q = 0; q < 8; ++q) EXPECT_EQ(diff[q], 0.0) << what << ": field " << q;
+    EXPECT_EQ(de, 0.0) << what << ": energies";
+    return;
+  }
+  for (int q = 0; q < 8; ++q) EXPECT_LE(diff[q], 1e-12) << what << ": field " << q;
+  EXPECT_LE(de, 1e-12) << what << ": energies";
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank == 0)
+    std::printf("%s on %d ranks: fields within %.1e of their maxima, energies within %.1e\n",
+                what.c_str(), ranks(), *std::max_element(diff.begin(), diff.end()), de);
+}
+
+// The pulse crosses the slab borders and reaches the silent layers; every scheme.
+TEST(Slabs, PulsePlateAgreesWithOneProcessEveryScheme) {
+  for (Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF}) {
+    PlateSpec c;
+    c.scheme = sc;
+    const Outcome d = run_distributed(c, 200), s = run_serial(c, 200);
+    expect_agreement(d, s, scheme_name(sc));
+    EXPECT_GT(s.e.absorbed, 0.01 * s.e.external_work) << "the pulse reached the silent layers";
+  }
+}
+
+TEST(Slabs, WiderStencilsAgreeWithOneProcess) {
+  for (ShapeKind sh : {ShapeKind::UGimp, ShapeKind::BSpline2}) {
+    PlateSpec c;
+    c.shape = sh;
+    const Outcome d = run_distributed(c, 150), s = run_serial(c, 150);
+    expect_agreement(d, s, sh == ShapeKind::UGimp ? "GIMP" : "B-spline");
+  }
+}
+
+// A damping band and a PML band (every border crosses the band; the PML lies in the lowest
+// slab), LK in the particle form, gravity.
+TEST(Slabs, BandPmlAndGravityAgreeWithOneProcess) {
+  for (Scheme sc : {Scheme::USL, Scheme::MUSL}) {
+    PlateSpec c;
+    c.other_layers = true;
+    c.scheme = sc;
+    const Outcome d = run_distributed(c, 200), s = run_serial(c, 200);
+    expect_agreement(d, s, std::string("band, PML, gravity, ") + scheme_name(sc));
+  }
+}
+
+// Two runs on the same ranks: the same bits (the halo sums in a fixed order).
+TEST(Slabs, TwoRunsBitIdentical) {
+  PlateSpec c;
+  const Outcome a = run_distributed(c, 120), b = run_distributed(c, 120);
+  const auto diff = differences(a.f, b.f);
+  for (int q = 0; q < 8; ++q) EXPECT_EQ(diff[q], 0.0) << "field " << q;
+  EXPECT_EQ(energy_difference(a.e, b.e), 0.0);
+}
+
+// After a step the grid holds the particles' mass: summed over each rank's own nodes, the nodal
+// mass is the particles' mass (partition of unity) to round-off.
+TEST(Slabs, NodalMassEqualsParticleMass) {
+  PlateSpec c;
+  auto s = make_plate(c);
+  Distributed d(*s, MPI_COMM_WORLD);
+  for (int n = 0; n < 5; ++n) s->step();
+  const int r = d.rank();
+  const int own0 = d.rows()[r] - d.window_row0();
+  const int own1 = (r == d.size() - 1 ? s->grid.nny + d.window_row0() : d.rows()[r + 1]) -
+                   d.window_row0();
+  // Sums in extended precision: a plain sum of 10^3-10^4 terms alone errs by 1e-14.
+  long double nodal = 0, particles = 0;
+  for (long i = static_cast<long>(own0) * s->grid.nnx; i < static_cast<long>(own1) * s->grid.nnx; ++i)
+    nodal += s->grid.m[i];
+  for (double m : s->p.mass) particles += m;
+  double v[2] = {static_cast<double>(nodal), static_cast<double>(particles)};
+  MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_NEAR(v[0], v[1], 1e-14 * v[1]);
+}
+
+// A spinning plate: particles cross the borders every step, with their layer entries (the
+// traction's, and the silent layers' with their springs' displacements); nothing is lost or
+// doubled. The silent layers are weak (a hundredth of LK, springs 1e-4 of the usual) so that
+// they do not stop the rotation.
+TEST(Slabs, MigrationKeepsIdsCountsAndLayers) {
+  PlateSpec c;
+  c.nx = 20;
+  c.ny = 20;
+  c.spin = 2e4;  // the plate's edges at 200 m/s: 0.012 cells per step (c_d 5.2 km/s, dt 58 ns)
+  c.lk = 0.01;
+  c.spring_alpha = 1e-4;
+  for (Scheme sc : {Scheme::MUSL, Scheme::USF}) {
+    c.scheme = sc;
+    const Outcome d = run_distributed(c, 300), s = run_serial(c, 300);
+    expect_agreement(d, s, std::string("migration, ") + scheme_name(sc));
+    EXPECT_EQ(d.entries, s.entries);
+    if (ranks() > 1) {
+      EXPECT_GT(d.sent, 50) << "particles crossed the borders";
+      int rank = 0;
+      MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+      if (rank == 0) std::printf("migration, %s: %ld particles moved between ranks\n", scheme_name(sc), d.sent);
+    }
+  }
+}
+
+TEST(Slabs, TooManyRanksForTheGridIsAnError) {
+  if (ranks() == 1) GTEST_SKIP() << "one rank takes any grid";
+  PlateSpec c;
+  c.ny = 2 * ranks() - 7;  // the grid has ny + 6 rows: one fewer than 2 per rank
+  c.ny = std::max(c.ny, 1);
+  auto s = make_plate(c);
+  if (s->grid.ny >= 2 * ranks()) GTEST_SKIP() << "the plate's margins alone are enough rows";
+  try {
+    Distributed d(*s, MPI_COMM_WORLD);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("MPI ranks need a grid of at least"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace smpm::testing
+
+int main(int argc, char** argv) {
+  smpm::parallel_init(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank != 0) {  // one report: rank 0's (every rank checks the same gathered values)
+    auto& l = ::testing::UnitTest::GetInstance()->listeners();
+    delete l.Release(l.default_result_printer());
+  }
+  int failed = RUN_ALL_TESTS();
+  MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  smpm::parallel_finalize();
+  return failed;
+}
