@@ -82,7 +82,13 @@ int compare(const std::string& a_csv, const std::string& b_csv, std::vector<std:
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+// Under several MPI ranks only rank 0 prints, except a run's failure, which may be one rank's
+// alone: that rank prints it and ends every rank (exit 2).
+bool root() { return smpm::process_rank() == 0; }
+
+int run_main(int argc, char** argv) {
   CLI::App app{
       "silentmpm - explicit 2D plane-strain MPM with the Lysmer-Kuhlemeyer silent boundary layer "
       "of Shen & Chen (2005).\nCase files are JSON in SI units; every key is documented in "
@@ -202,6 +208,7 @@ int main(int argc, char** argv) {
     ropt.restart = restart;
     if (!c.solver && c.fem) {  // FEM-only case
       if (*check) {
+        if (!root()) return 0;
         std::printf("%s: ok\n", case_path.c_str());
         std::printf("  %s\n", smpm::fem_check_line(c).c_str());
         for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
@@ -216,6 +223,7 @@ int main(int argc, char** argv) {
     }
     const smpm::Solver& s = *c.solver;
     if (*check) {
+      if (!root()) return 0;
       std::printf("%s: ok\n", case_path.c_str());
       std::printf("  particles %zu, grid %d x %d cells of %g m, dt %g s (CFL %.3f), %ld steps\n",
                   s.p.size(), s.grid.nx, s.grid.ny, s.grid.h, s.dt, s.dt / s.critical_dt(),
@@ -228,19 +236,39 @@ int main(int argc, char** argv) {
       return 0;
     }
     const auto r = smpm::run_case(c, out_dir, ropt);
-    if (!quiet)
+    if (!quiet && root())
       std::printf("%s: %ld steps, %zu particles, %.2f s, %.3g particle-updates/s -> %s\n",
-                  case_path.c_str(), r.steps, s.p.size(), r.wall_seconds,
+                  case_path.c_str(), r.steps, r.particles, r.wall_seconds,
                   r.particle_updates_per_second, out_dir.c_str());
     return 0;
   } catch (const smpm::RunInterrupted& e) {
-    std::fprintf(stderr, "silentmpm: %s\n", e.what());
+    if (root()) std::fprintf(stderr, "silentmpm: %s\n", e.what());
     return 3;
   } catch (const smpm::RunFailure& e) {
+    if (smpm::process_count() > 1) {
+      std::fprintf(stderr, "silentmpm: error (rank %d of %d): %s\n", smpm::process_rank(),
+                   smpm::process_count(), e.what());
+      std::fflush(stderr);
+      smpm::abort_processes(2);
+    }
     std::fprintf(stderr, "silentmpm: error: %s\n", e.what());
     return 2;
+  } catch (const std::exception& e) {
+    if (root()) std::fprintf(stderr, "silentmpm: error: %s\n", e.what());
+    return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    smpm::start_processes(&argc, &argv);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "silentmpm: error: %s\n", e.what());
     return 1;
   }
+  const int code = run_main(argc, argv);
+  smpm::stop_processes();
+  return code;
 }

@@ -167,6 +167,13 @@ void mark_incomplete(const fs::path& dir, const std::string& why) {
 
 RunResult run_region(const Case& c, detail::Region& region, const std::string& out_dir,
                      const RunOptions& opt) {
+  // Several MPI ranks: every rank steps and samples (the samples are sums over ranks), rank 0
+  // alone writes the folder and prints; every rank stops at the same step.
+  const int ranks = process_count();
+  const bool root = process_rank() == 0;
+  if (ranks > 1 && !opt.restart.empty())
+    throw std::runtime_error("--restart is not yet available on several MPI ranks (" +
+                             std::to_string(ranks) + " here): restart on one process");
   std::string history, note;
   const long first = opt.restart.empty() ? 0 : restore_run(c, region, opt.restart, history, note);
   const bool resuming = !opt.restart.empty();
@@ -175,32 +182,34 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
     throw StateError(opt.restart + ": the checkpoint is at step " + std::to_string(first) +
                      ", the case ends at step " + std::to_string(nsteps) +
                      ": nothing left to run (raise time.end to continue)");
-  fs::path dir;
+  fs::path dir = out_dir;
   try {
-    dir = detail::prepare_output_dir(out_dir, resuming);
+    if (root) dir = detail::prepare_output_dir(out_dir, resuming);
   } catch (const std::exception& e) {
     throw RunFailure(e.what());
   }
   if (!note.empty()) std::fprintf(stderr, "%s\n", note.c_str());
+  auto mark = [&](const std::string& why) {
+    if (root) mark_incomplete(dir, why);
+  };
   SignalGuard signals;
   try {
     // The marker is there while the run is: a run killed outright (SIGKILL, power loss) or
     // unable to write its reason (a full disk) still leaves it; completion removes it.
-    mark_incomplete(dir, "running or killed: started " + std::string(resuming ? "from the checkpoint "
-                         "at step " + std::to_string(first) : "at step 0") + " of " +
-                         std::to_string(nsteps) + "; a complete run removes this file and writes "
-                         "summary.json");
-    region.prepare(out_dir, resuming);
+    mark("running or killed: started " + std::string(resuming ? "from the checkpoint "
+         "at step " + std::to_string(first) : "at step 0") + " of " +
+         std::to_string(nsteps) + "; a complete run removes this file and writes summary.json");
+    if (root) region.prepare(out_dir, resuming);
 
     const std::vector<std::string> cols = detail::history_columns(c.probes);
-    detail::write_probe_table(dir, c.probes);
+    if (root) detail::write_probe_table(dir, c.probes);
     HistoryWriter hist;
-    if (resuming) hist.resume((dir / "history.csv").string(), cols, history);
-    else hist.open((dir / "history.csv").string(), cols);
+    if (root && resuming) hist.resume((dir / "history.csv").string(), cols, history);
+    else if (root) hist.open((dir / "history.csv").string(), cols);
     std::vector<double> row(cols.size());
     auto record = [&]() {
       region.record(row);
-      hist.row(region.time(), row);
+      if (root) hist.row(region.time(), row);
     };
 
     long snap_every = 0;
@@ -221,7 +230,7 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
 
     const auto t_start = Clock::now();
     double step_seconds = 0;
-    detail::Progress prog(c.output.progress, nsteps, t_start, first);
+    detail::Progress prog(c.output.progress && root, nsteps, t_start, first);
     if (!resuming) {
       record();
       if (snap_every) region.write_snapshot(out_dir);
@@ -234,13 +243,26 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
       } catch (const HybridError&) {
         throw;
       } catch (const std::exception& e) {
+        // Several ranks: the others cannot join a checkpoint of the failed step.
+        if (ranks > 1) throw RunFailure(e.what());
         throw RunFailure(e.what() + keep_failed_state(c, region, dir, out_dir, hist, snap_every != 0,
                                                       e.what()));
       }
       step_seconds += seconds_since(t0);
       if (n % hist_every == 0 || n == nsteps) record();
       if (snap_every && (n % snap_every == 0 || n == nsteps)) region.write_snapshot(out_dir);
-      if (g_signal != 0 && n < nsteps) {
+      // Several ranks stop together (a launcher passes a signal on to every rank, not at once).
+      const bool stop = ranks > 1 ? detail::mpi()->any(g_signal != 0) : g_signal != 0;
+      if (stop && n < nsteps && ranks > 1) {
+        hist.close();
+        region.finish();
+        std::ostringstream why;
+        why << "interrupted by a signal after step " << n << " of " << nsteps << " (t = "
+            << region.time() << " s); no checkpoint (not yet written by several MPI ranks)";
+        mark(why.str());
+        throw RunInterrupted(why.str());
+      }
+      if (stop && n < nsteps) {
         const char* name = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
         write_checkpoint(c, region, dir, hist);
         hist.close();
@@ -255,7 +277,7 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
         throw RunInterrupted(why.str());
       }
       if (checkpoint_due(n, t_before, region.time())) write_checkpoint(c, region, dir, hist);
-      prog.update(n, step_seconds);
+      if (root) prog.update(n, step_seconds);
     }
     hist.close();
     region.finish();
@@ -270,6 +292,7 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
     region.summary(j, r, snap_every != 0);
     if (resuming)
       j["restart"] = {{"checkpoint", opt.restart}, {"from_step", first}};
+    if (!root) return r;
     detail::write_summary(dir, j);
     std::error_code ec;
     fs::remove(dir / "RUN_INCOMPLETE", ec);
@@ -277,10 +300,13 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
   } catch (const RunInterrupted&) {
     throw;
   } catch (const HybridError& e) {  // a guard of the coupling that only a step finds: bad input
-    mark_incomplete(dir, std::string("failed: ") + e.what());
+    mark(std::string("failed: ") + e.what());
     throw;
   } catch (const std::exception& e) {
-    mark_incomplete(dir, std::string("failed: ") + e.what());
+    // Several ranks: the failing one says why (it may be the only one that failed).
+    if (ranks > 1) mark_incomplete(dir, "failed on rank " + std::to_string(process_rank()) + " of " +
+                                   std::to_string(ranks) + ": " + e.what());
+    else mark(std::string("failed: ") + e.what());
     throw RunFailure(e.what());
   }
 }
@@ -288,6 +314,10 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
 }  // namespace
 
 RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt) {
+  if (process_count() > 1 && (c.hybrid || !c.solver))
+    throw std::runtime_error(std::string(c.hybrid ? "a hybrid (MPM and FEM) case" : "an FEM case") +
+                             " does not run on several MPI ranks yet (" +
+                             std::to_string(process_count()) + " here): run it on one process");
   const std::unique_ptr<detail::Region> region =
       c.hybrid     ? detail::far_field_module().hybrid_region(c)
       : c.solver   ? detail::mpm_region(c)

@@ -1,4 +1,4 @@
-// Loading the gmsh and far-field modules on first use (modules.hpp).
+// Loading the gmsh, far-field and MPI modules on first use (modules.hpp).
 #include "modules.hpp"
 
 #include <dlfcn.h>
@@ -85,6 +85,15 @@ const FarFieldModule& far_field_module() {
   if (!table)
     table = &load_table<FarFieldModule>("libsilentmpm_fe.so", "silentmpm_fe_module",
                                         kFarFieldModuleApi);
+  return *table;
+}
+
+const MpiModule& mpi_module() {
+  static std::mutex m;
+  static const MpiModule* table = nullptr;
+  std::lock_guard<std::mutex> lock(m);
+  if (!table)
+    table = &load_table<MpiModule>("libsilentmpm_mpi.so", "silentmpm_mpi_module", kMpiModuleApi);
   return *table;
 }
 

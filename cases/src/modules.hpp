@@ -6,6 +6,8 @@
 //   libsilentmpm_fe.so    fem/, coupling/, cases/fe/
 //                                    the deal.II far field, the coupling and their cases and
 //                                    run-loop regions (it needs the gmsh module)
+//   libsilentmpm_mpi.so   parallel/  MPI and PETSc: the MPM step over ranks (only under an MPI
+//                                    launcher; built when PETSc is found)
 //
 // Each module gives the core one table of functions through an extern "C" entry point. Its own
 // references to the core (materials, the case parsers, the output writers) are resolved against
@@ -22,6 +24,7 @@
 #include "case_keys.hpp"
 #include "run_loop.hpp"
 #include "silentmpm/case.hpp"
+#include "silentmpm/decomposition.hpp"
 #include "silentmpm/geometry.hpp"
 #include "silentmpm/gmsh_module.hpp"
 
@@ -40,10 +43,33 @@ struct FarFieldModule {
   std::string (*fem_check_line)(const Case& c);
 };
 
+// Bumped whenever the table or a signature in it changes.
+inline constexpr int kMpiModuleApi = 1;
+
+// The MPI module (parallel/: MPI and PETSc), loaded only when an MPI launcher started the
+// program (processes.cpp).
+struct MpiModule {
+  int api;
+  void (*start)(int* argc, char*** argv);  // MPI (threads funnelled) and PETSc
+  void (*stop)();
+  int (*rank)();
+  int (*size)();
+  // Cuts a finalized solver, built whole on every rank, to this rank's slab; the decomposition
+  // is attached to the solver and must outlive its steps.
+  std::unique_ptr<Decomposition> (*distribute)(Solver& s);
+  bool (*any)(bool b);                 // over every rank
+  void (*abort)(int code);             // MPI_Abort: every rank stops
+};
+
 const GmshModule& gmsh_module();  // loads libsilentmpm_gmsh.so on first use
+const MpiModule& mpi_module();    // loads libsilentmpm_mpi.so on first use
+// The MPI module when the program runs under an MPI launcher (start_processes), else null.
+const MpiModule* mpi();
 const FarFieldModule& far_field_module();  // loads libsilentmpm_fe.so on first use
 
 }  // namespace smpm::detail
 
+// The MPI module's entry point (parallel/src/module.cpp).
+extern "C" const smpm::detail::MpiModule* silentmpm_mpi_module();
 // The far-field module's entry point (cases/fe/module.cpp).
 extern "C" const smpm::detail::FarFieldModule* silentmpm_fe_module();

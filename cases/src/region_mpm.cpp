@@ -6,6 +6,7 @@
 
 #include "driver_common.hpp"
 #include "run_loop.hpp"
+#include "modules.hpp"
 #include "silentmpm/output.hpp"
 
 namespace smpm::detail {
@@ -18,10 +19,27 @@ namespace {
 
 class MpmRegion final : public Region {
  public:
-  explicit MpmRegion(Case& c) : c_(c), s_(*c.solver) {
+  explicit MpmRegion(Case& c)
+      : c_(c), s_(*c.solver),
+        whole_{s_.grid.x0, s_.grid.y0, s_.grid.h, s_.grid.nx, s_.grid.ny} {
     for (const auto& pr : c.probes) {
       pts_.push_back({pr.x, pr.y});
       bodies_.push_back(pr.body);
+    }
+    // Under an MPI launcher every rank built the whole case; each keeps its slab.
+    if (const MpiModule* m = mpi()) {
+      if (m->size() > 1) {
+        auto refuse = [&](const std::string& what) {
+          throw std::runtime_error(what + " is not yet available on several MPI ranks (" +
+                                   std::to_string(m->size()) + " here): run the case on one "
+                                   "process, or without it");
+        };
+        if (c.output.snapshots > 0) refuse("output.snapshots");
+        if (c.output.checkpoint_every > 0 || c.output.checkpoint_time > 0)
+          refuse("output.checkpoint_every / checkpoint_time");
+        if (s_.contact.multi()) refuse("multi-field contact");
+      }
+      dist_ = m->distribute(s_);
     }
   }
 
@@ -43,8 +61,9 @@ class MpmRegion final : public Region {
       if (pr.region) samples[q] = s_.region_mean(pr.rx0, pr.ry0, pr.rx1, pr.ry1, pr.body);
       for (const auto& f : pr.fields) row[k++] = probe_field(samples[q], f);
     }
-    put_energies(s_.energy, row, k);
-    if (!energies_finite(s_.energy))
+    const Energies e = s_.total_energy();
+    put_energies(e, row, k);
+    if (!energies_finite(e))
       throw std::runtime_error("the run diverged at step " + std::to_string(s_.steps) + " (t = " +
                                std::to_string(s_.t) + " s): energy is not finite; reduce time.dt");
   }
@@ -70,19 +89,29 @@ class MpmRegion final : public Region {
   }
 
   void rates(RunResult& r, long steps_run, double step_seconds) const override {
+    r.particles = static_cast<std::size_t>(total(static_cast<double>(s_.p.size())));
     r.particle_updates_per_second =
-        static_cast<double>(s_.p.size()) * steps_run / std::max(step_seconds, 1e-12);
+        static_cast<double>(r.particles) * steps_run / std::max(step_seconds, 1e-12);
   }
 
+  // Every rank calls it (the counts are sums over ranks); rank 0 writes it.
   void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const override {
-    j["particles"] = s_.p.size();
+    j["particles"] = r.particles;
     j["particle_updates_per_second"] = r.particle_updates_per_second;
     j["threads"] = s_.thread_count();
+    if (dist_) j["mpi_ranks"] = dist_->size();
     put_mpm_scheme(j, s_);
-    j["energy"] = energy_json(s_.energy);
+    j["grid"] = {{"origin", {whole_.x0, whole_.y0}}, {"cells", {whole_.nx, whole_.ny}},
+                 {"cell", whole_.h}};
+    j["energy"] = energy_json(s_.total_energy());
     j["silent_boundaries"] = silents_json(s_);
+    for (std::size_t q = 0; q < s_.silents.size(); ++q)
+      j["silent_boundaries"][q]["particles"] =
+          static_cast<std::size_t>(total(static_cast<double>(s_.silents[q].layer.idx.size())));
     j["loads"] = c_.notes;
     j["bodies"] = bodies_json(c_, s_);
+    for (auto& b : j["bodies"])
+      b["particles"] = static_cast<std::size_t>(total(b["particles"].get<double>()));
     j["curve_probes"] = curve_probes_json(c_.probes);
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
@@ -92,8 +121,20 @@ class MpmRegion final : public Region {
   }
 
  private:
+  // A count summed over the ranks (itself on one process).
+  double total(double v) const {
+    if (dist_) dist_->sum(&v, 1);
+    return v;
+  }
+
   Case& c_;
   Solver& s_;
+  // The grid of the whole case (a rank's solver holds its window of it).
+  struct {
+    double x0, y0, h;
+    int nx, ny;
+  } whole_;
+  std::unique_ptr<Decomposition> dist_;
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
   MpmSnapshots snaps_;

@@ -1429,6 +1429,18 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
       }
     }
   }
+  if (dist_) {  // the particles near a probe may lie on several ranks: add their sums
+    std::vector<double> sums(28 * np);
+    for (std::size_t q = 0; q < np; ++q) {
+      std::copy_n(acc[q].m, 4, &sums[28 * q]);
+      std::copy_n(&acc[q].f[0][0], 24, &sums[28 * q + 4]);
+    }
+    dist_->sum(sums.data(), static_cast<int>(sums.size()));
+    for (std::size_t q = 0; q < np; ++q) {
+      std::copy_n(&sums[28 * q], 4, acc[q].m);
+      std::copy_n(&sums[28 * q + 4], 24, &acc[q].f[0][0]);
+    }
+  }
   for (std::size_t q = 0; q < np; ++q) {
     const Acc& A = acc[q];
     double v[6] = {0, 0, 0, 0, 0, 0}, wsum = 0;
@@ -1464,6 +1476,12 @@ ProbeSample Solver::region_mean(double x0, double y0, double x1, double y1, int 
     szz += vk * p.szz[k];
     sxy += vk * p.sxy[k];
     j2 += vk * j2_of(p.sxx[k], p.syy[k], p.szz[k], p.sxy[k]);
+  }
+  if (dist_) {
+    double s[9] = {m, v, px, py, sxx, syy, szz, sxy, j2};
+    dist_->sum(s, 9);
+    m = s[0], v = s[1], px = s[2], py = s[3], sxx = s[4], syy = s[5], szz = s[6], sxy = s[7];
+    j2 = s[8];
   }
   ProbeSample out;
   if (!(m > 0 && v > 0)) return out;

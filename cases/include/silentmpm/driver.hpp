@@ -12,6 +12,7 @@ struct RunResult {
   long steps = 0;
   double wall_seconds = 0;
   double particle_updates_per_second = 0;
+  std::size_t particles = 0;            // MPM region, over every rank
   std::size_t dofs = 0;                 // FEM region
   double dof_updates_per_second = 0;    // FEM region
 };
@@ -41,6 +42,20 @@ struct RunOptions {
 // presence marks a complete run. Throws CaseError/StateError for an unusable restart file
 // (before the output folder is touched), RunFailure and RunInterrupted as above.
 RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt = {});
+
+// The processes of a run. A program started by an MPI launcher (mpirun; Open MPI, MPICH or a
+// PMIx launcher) runs an MPM case on every rank, each with a slab of the particles and the grid
+// (docs/parallel.md); otherwise it is one process. start_processes loads the MPI module and
+// starts MPI when a launcher is seen (a std::runtime_error when the module is missing), and
+// does nothing otherwise; stop_processes ends MPI. Under several ranks only rank 0 writes the
+// output folder and prints; snapshots, checkpoints, restarts, multi-field contact and FE regions
+// are refused (errors before the run). abort_processes ends every rank with `code` (a failure
+// on one rank, which the others cannot see).
+void start_processes(int* argc, char*** argv);
+void stop_processes();
+int process_rank();
+int process_count();
+[[noreturn]] void abort_processes(int code);
 
 // The checkpoint file's name in the output folder, and that of the state of a failed step.
 inline const char* checkpoint_file_name() { return "checkpoint.smpm"; }

@@ -1,0 +1,210 @@
+// `mpirun -np N silentmpm run`: the command line over MPI ranks against one process (label mpi;
+// this binary is not an MPI process, it starts mpirun). The pulse plate of the pulse study
+// (200 cell rows, 10 000 particles, LK on the right edge, a probe), 1 000 steps:
+//   * 1 rank: history.csv and probes.csv byte-identical to the plain run, summary.json equal
+//     but for timings and the rank count;
+//   * 2 and 4 ranks: every history column within 1e-10 relative L2 of the plain run (a column
+//     normalised by the largest of its kind: the probe's stresses, its velocities, the
+//     energies), the same particle count; two runs on 2 ranks byte-identical;
+//   * what the ranks cannot share yet is refused before the run (exit 1, one line naming it);
+//   * a failure on one rank stops every rank (exit 2) and leaves RUN_INCOMPLETE saying why;
+//   * an interrupt stops every rank after one step.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "silentmpm/history.hpp"
+
+#ifndef SMPM_MPIEXEC
+#define SMPM_MPIEXEC "mpirun"
+#endif
+
+namespace smpm::cli_testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kCase = source_file("studies/pulse/cases/compressive_silent.json");
+const std::string kShort = " --set time.end=4e-5 --set output.snapshots=0 -q";
+
+std::string mpirun(int np) {
+  return std::string("OMP_NUM_THREADS=1 ") + SMPM_MPIEXEC +
+         " --allow-run-as-root --oversubscribe -np " + std::to_string(np) + " ";
+}
+
+fs::path out_dir(const std::string& tag) {
+  const fs::path d = case_testing::scratch() / tag;
+  fs::remove_all(d);
+  return d;
+}
+
+Proc run(int np, const std::string& args, const std::string& tag) {
+  const std::string cmd = (np > 0 ? mpirun(np) : std::string("OMP_NUM_THREADS=1 ")) + SMPM_CLI +
+                          " run " + args;
+  return run_shell(cmd, tag);
+}
+
+// Per column: ||a - b|| / the largest ||b|| among the columns of its kind.
+std::map<std::string, double> differences(const fs::path& a, const fs::path& b) {
+  const History ha = read_history((a / "history.csv").string());
+  const History hb = read_history((b / "history.csv").string());
+  EXPECT_EQ(ha.columns, hb.columns);
+  EXPECT_EQ(ha.time.size(), hb.time.size());
+  auto kind = [](const std::string& c) {
+    if (c.rfind("energy.", 0) == 0) return std::string("energy");
+    const auto dot = c.find('.');
+    const std::string f = c.substr(dot + 1);
+    return c.substr(0, dot) + (f == "vx" || f == "vy" ? ".v" : ".s");
+  };
+  std::map<std::string, double> scale, diff, norm;
+  for (std::size_t q = 0; q < hb.columns.size(); ++q) {
+    double d = 0, n = 0;
+    for (std::size_t r = 0; r < std::min(ha.time.size(), hb.time.size()); ++r) {
+      const double x = ha.data[q][r], y = hb.data[q][r];
+      d += (x - y) * (x - y);
+      n += y * y;
+    }
+    diff[hb.columns[q]] = std::sqrt(d);
+    norm[hb.columns[q]] = std::sqrt(n);
+    double& s = scale[kind(hb.columns[q])];
+    s = std::max(s, std::sqrt(n));
+  }
+  std::map<std::string, double> rel;
+  for (const auto& [c, d] : diff) rel[c] = scale[kind(c)] > 0 ? d / scale[kind(c)] : d;
+  return rel;
+}
+
+nlohmann::json summary(const fs::path& dir) {
+  return nlohmann::json::parse(case_testing::read_file(dir / "summary.json"));
+}
+
+TEST(MpiCli, OneRankBitIdenticalOnEveryOutput) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path a = out_dir("plain1"), b = out_dir("np1");
+  const std::string args = kCase + " --set time.end=2e-5 --set output.snapshots=3 -q --out ";
+  ASSERT_EQ(run(0, args + a.string(), "plain1").status, 0);
+  const Proc p = run(1, args + b.string(), "np1");
+  ASSERT_EQ(p.status, 0) << p.err;
+  for (const char* f : {"history.csv", "probes.csv", "particles.xdmf"})
+    EXPECT_EQ(case_testing::read_file(a / f), case_testing::read_file(b / f)) << f;
+  // The snapshots' datasets (HDF5 stamps each object with its creation time, so the files'
+  // bytes differ between any two runs).
+  const Proc h = run_shell(
+      "/usr/bin/python3 -c \"import sys, h5py, numpy as np\n"
+      "a, b = h5py.File(sys.argv[1]), h5py.File(sys.argv[2]); names = []\n"
+      "a.visit(lambda n: names.append(n) if isinstance(a[n], h5py.Dataset) else None)\n"
+      "bad = [n for n in names if n not in b or not np.array_equal(a[n][()], b[n][()])]\n"
+      "print(len(names), 'datasets', len(bad), 'differ', bad[:5]); sys.exit(1 if bad or not names else 0)\" " +
+          (a / "particles.h5").string() + " " + (b / "particles.h5").string(),
+      "np1_h5");
+  EXPECT_EQ(h.status, 0) << h.out << h.err;
+  nlohmann::json sa = summary(a), sb = summary(b);
+  EXPECT_EQ(sb["mpi_ranks"], 1);
+  for (auto* j : {&sa, &sb})
+    for (const char* k : {"wall_seconds", "step_seconds", "particle_updates_per_second", "mpi_ranks"})
+      j->erase(k);
+  EXPECT_EQ(sa, sb);
+}
+
+TEST(MpiCli, TwoAndFourRanksMatchOneProcess) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path a = out_dir("plain");
+  ASSERT_EQ(run(0, kCase + kShort + " --out " + a.string(), "plain").status, 0);
+  for (int np : {2, 4}) {
+    const fs::path b = out_dir("np" + std::to_string(np));
+    const Proc p = run(np, kCase + kShort + " --out " + b.string(), "np" + std::to_string(np));
+    ASSERT_EQ(p.status, 0) << p.err;
+    double worst = 0;
+    for (const auto& [c, d] : differences(b, a)) {
+      EXPECT_LE(d, 1e-10) << np << " ranks, column " << c;
+      worst = std::max(worst, d);
+    }
+    std::printf("%d ranks: history within %.1e of one process\n", np, worst);
+    const nlohmann::json sa = summary(a), sb = summary(b);
+    EXPECT_EQ(sb["mpi_ranks"], np);
+    EXPECT_EQ(sb["particles"], sa["particles"]);
+    EXPECT_EQ(sb["grid"], sa["grid"]);
+    EXPECT_EQ(sb["silent_boundaries"], sa["silent_boundaries"]);
+    EXPECT_EQ(sb["bodies"], sa["bodies"]);
+    for (const char* e : {"kinetic", "elastic", "absorbed", "external_work"})
+      EXPECT_NEAR(sb["energy"][e].get<double>(), sa["energy"][e].get<double>(),
+                  1e-10 * sa["energy"]["external_work"].get<double>())
+          << e;
+    EXPECT_FALSE(fs::exists(b / "RUN_INCOMPLETE"));
+  }
+  const fs::path c = out_dir("np2_again");
+  ASSERT_EQ(run(2, kCase + kShort + " --out " + c.string(), "np2_again").status, 0);
+  EXPECT_EQ(case_testing::read_file(c / "history.csv"),
+            case_testing::read_file(case_testing::scratch() / "np2" / "history.csv"));
+}
+
+TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  struct Bad {
+    std::string args, message;
+  };
+  const fs::path o = out_dir("refused");
+  const std::vector<Bad> bad = {
+      {kCase + " --set time.end=4e-5 --set output.snapshots=2",
+       "output.snapshots is not yet available on several MPI ranks (2 here)"},
+      {kCase + kShort + " --set output.checkpoint_every=10",
+       "output.checkpoint_every / checkpoint_time is not yet available on several MPI ranks"},
+      {source_file("studies/pulse/cases/compressive_fem_dashpot.json") + " --set time.end=4e-6",
+       "an FEM case does not run on several MPI ranks yet (2 here)"},
+      {kCase + kShort + " --restart " + (o / "checkpoint.smpm").string(),
+       "--restart is not yet available on several MPI ranks (2 here)"}};
+  int k = 0;
+  for (const Bad& b : bad) {
+    const Proc p = run(2, b.args + " --out " + o.string(), "refused" + std::to_string(k++));
+    EXPECT_EQ(p.status, 1) << b.args << "\n" << p.err;
+    EXPECT_NE(p.err.find(b.message), std::string::npos) << b.args << "\n" << p.err;
+    // One line from rank 0, not one per rank.
+    std::size_t n = 0;
+    for (std::size_t at = p.err.find("silentmpm: error"); at != std::string::npos;
+         at = p.err.find("silentmpm: error", at + 1))
+      ++n;
+    EXPECT_EQ(n, 1u) << p.err;
+    EXPECT_FALSE(fs::exists(o / "summary.json"));
+  }
+}
+
+// The plate thrown upwards: its top rows leave the grid on the top rank only (20 steps); that
+// rank's error ends both.
+TEST(MpiCli, FailureOnOneRankStopsAllWithItsReason) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path o = out_dir("failed");
+  const Proc p = run(2, kCase + kShort + " --set bodies.0.velocity=[0,3000] --out " + o.string(),
+                     "failed");
+  EXPECT_EQ(p.status, 2) << p.err;
+  EXPECT_NE(p.err.find("silentmpm: error (rank 1 of 2): particle"), std::string::npos) << p.err;
+  EXPECT_NE(case_testing::read_file(o / "RUN_INCOMPLETE").find("failed on rank 1 of 2: particle"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(o / "summary.json"));
+}
+
+// SIGTERM to mpirun, which passes it on to the ranks once the run is under way (history.csv has
+// rows): every rank stops after the same step, RUN_INCOMPLETE says so, no summary.json. (The
+// ranks' message may not get through mpirun, which is being signalled itself.)
+TEST(MpiCli, InterruptStopsEveryRankAtOneStep) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path o = out_dir("interrupted");
+  const std::string hist = (o / "history.csv").string();
+  const std::string cmd =
+      mpirun(2) + SMPM_CLI + " run " + kCase + " --set time.end=1e-3 --set output.snapshots=0 -q" +
+      " --out " + o.string() + " & P=$!; for i in $(seq 600); do [ -f " + hist + " ] && [ $(wc -l < " +
+      hist + ") -ge 4 ] && break; sleep 0.1; done; kill -TERM $P; wait $P";
+  const Proc p = run_shell(cmd, "interrupted");
+  const std::string why = case_testing::read_file(o / "RUN_INCOMPLETE");
+  EXPECT_NE(why.find("interrupted by a signal after step"), std::string::npos) << why << p.err;
+  EXPECT_FALSE(fs::exists(o / "summary.json"));
+}
+
+}  // namespace
+}  // namespace smpm::cli_testing
