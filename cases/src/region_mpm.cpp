@@ -99,7 +99,21 @@ class MpmRegion final : public Region {
     j["particles"] = r.particles;
     j["particle_updates_per_second"] = r.particle_updates_per_second;
     j["threads"] = s_.thread_count();
-    if (dist_) j["mpi_ranks"] = dist_->size();
+    if (dist_) {
+      // Communication per step: the slowest rank's seconds, every rank's bytes.
+      const Decomposition::Traffic t = dist_->traffic();
+      double slow[2] = {t.halo_seconds, t.migration_seconds};
+      double bytes[3] = {t.halo_bytes, t.migration_bytes, static_cast<double>(t.particles_sent)};
+      dist_->max(slow, 2);
+      dist_->sum(bytes, 3);
+      const double n = std::max(1.0, static_cast<double>(r.steps));
+      j["mpi_ranks"] = dist_->size();
+      j["mpi"] = {{"halo_seconds_per_step", slow[0] / n},
+                  {"migration_seconds_per_step", slow[1] / n},
+                  {"halo_bytes_per_step", bytes[0] / n},
+                  {"migration_bytes_per_step", bytes[1] / n},
+                  {"particles_migrated", bytes[2]}};
+    }
     put_mpm_scheme(j, s_);
     j["grid"] = {{"origin", {whole_.x0, whole_.y0}}, {"cells", {whole_.nx, whole_.ny}},
                  {"cell", whole_.h}};

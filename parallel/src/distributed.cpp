@@ -67,6 +67,7 @@ struct Distributed::Impl {
   std::map<int, PetscSF> sf;       // star forest for n fields at once
   std::vector<double> leaf, root;
   long sent = 0, received = 0;
+  Traffic t;
 
   // Node rows of rank o: [R[o], R[o + 1]), the last rank also the grid's top row.
   int own_begin(int o) const { return R[o]; }
@@ -222,6 +223,7 @@ long Distributed::received() const { return d_->received; }
 void Distributed::sum_halo(double* const* fields, int n) {
   Impl& d = *d_;
   if (d.size == 1 || n == 0) return;
+  const double t0 = MPI_Wtime();
   PetscSF sf = d.forest(n);
   const std::size_t nl = d.ghost_rows.size() * d.nnx, nr = d.band_rows.size() * d.nnx;
   d.leaf.resize(nl * n);
@@ -243,6 +245,8 @@ void Distributed::sum_halo(double* const* fields, int n) {
   check(PetscSFBcastEnd(sf, MPI_DOUBLE, d.root.data(), d.leaf.data(), MPI_REPLACE), "PetscSFBcast");
   rows(d.band_rows, d.root.data(), nr, false);
   rows(d.ghost_rows, d.leaf.data(), nl, false);
+  d.t.halo_seconds += MPI_Wtime() - t0;
+  d.t.halo_bytes += static_cast<double>((nl + nr) * n * sizeof(double));  // leaves out, roots back
 }
 
 // After the step's last move: a particle whose cell row (in the window's numbering, as the
@@ -251,6 +255,7 @@ void Distributed::sum_halo(double* const* fields, int n) {
 bool Distributed::migrate(Solver& s) {
   Impl& d = *d_;
   if (d.size == 1) return false;
+  const double t0 = MPI_Wtime();
   const int lo = d.R[d.rank] - d.g0, hi = d.R[d.rank + 1] - d.g0;  // own cell rows [lo, hi)
   const int below = d.rank > 0 ? 0 : -1;
   const int above = d.rank < d.size - 1 ? static_cast<int>(d.nbrs.size()) - 1 : -1;
@@ -290,8 +295,13 @@ bool Distributed::migrate(Solver& s) {
   if (rtotal > 0) s.import_particles(rbuf);
   d.received += static_cast<long>(s.p.size() - before);
   for (int k : to) d.sent += k >= 0;
+  d.t.particles_sent = d.sent;
+  d.t.migration_bytes += static_cast<double>(sbuf.size() * sizeof(double) + nn * sizeof(int));
+  d.t.migration_seconds += MPI_Wtime() - t0;
   return leaving || rtotal > 0;
 }
+
+Decomposition::Traffic Distributed::traffic() const { return d_->t; }
 
 void Distributed::sum(double* v, int n) {
   if (d_->size > 1) MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, d_->comm);

@@ -28,6 +28,13 @@ class Decomposition {
   virtual void max(double* v, int n) = 0;
   // Every rank learns whether any rank passed true.
   virtual bool any(bool b) = 0;
+  // This rank's communication so far: seconds in halo sums and in migrations, bytes it sent in
+  // halo sums and in migrations, particles it sent.
+  struct Traffic {
+    double halo_seconds = 0, migration_seconds = 0, halo_bytes = 0, migration_bytes = 0;
+    long particles_sent = 0;
+  };
+  virtual Traffic traffic() const = 0;
 };
 
 }  // namespace smpm

@@ -39,6 +39,7 @@ class Distributed final : public Decomposition {
   void sum(double* v, int n) override;
   void max(double* v, int n) override;
   bool any(bool b) override;
+  Traffic traffic() const override;
 
   // Cell rows of every rank's slab: rank r owns [rows()[r], rows()[r + 1]) of the whole grid.
   const std::vector<int>& rows() const;
