@@ -125,6 +125,11 @@ int run_main(int argc, char** argv) {
   run->add_option("--shape", shape, "Grid shape functions: bilinear, gimp or bspline (default: "
                                     "the case's scheme.shape)");
   run->add_flag("--quiet,-q", quiet, "Print nothing but errors: no progress line, no completion line");
+  int ranks_across = 0;
+  run->add_option("--ranks-across", ranks_across, "Under mpirun: ranks across x of the blocks "
+                                                  "each rank holds (1: slabs of cell rows; "
+                                                  "default: the layout sharing the fewest nodes)")
+      ->check(CLI::Range(0, 1 << 20));
   std::string restart;
   run->add_option("--restart", restart, "Continue from a checkpoint (DIR/checkpoint.smpm) of this "
                                         "case, written by output.checkpoint_every/_time or an "
@@ -206,6 +211,7 @@ int run_main(int argc, char** argv) {
     smpm::Case c = smpm::load_case(case_path, overrides);
     smpm::RunOptions ropt;
     ropt.restart = restart;
+    ropt.ranks_across = ranks_across;
     if (!c.solver && c.fem) {  // FEM-only case
       if (*check) {
         if (!root()) return 0;

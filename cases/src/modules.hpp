@@ -54,9 +54,10 @@ struct MpiModule {
   void (*stop)();
   int (*rank)();
   int (*size)();
-  // Cuts a finalized solver, built whole on every rank, to this rank's slab; the decomposition
-  // is attached to the solver and must outlive its steps.
-  std::unique_ptr<Decomposition> (*distribute)(Solver& s);
+  // Cuts a finalized solver, built whole on every rank, to this rank's block (`across` ranks
+  // across x; 0: the layout with the fewest shared nodes); the decomposition is attached to the
+  // solver and must outlive its steps.
+  std::unique_ptr<Decomposition> (*distribute)(Solver& s, int across);
   bool (*any)(bool b);                 // over every rank
   void (*abort)(int code);             // MPI_Abort: every rank stops
 };

@@ -19,7 +19,7 @@ namespace {
 
 class MpmRegion final : public Region {
  public:
-  explicit MpmRegion(Case& c)
+  MpmRegion(Case& c, int across)
       : c_(c), s_(*c.solver),
         whole_{s_.grid.x0, s_.grid.y0, s_.grid.h, s_.grid.nx, s_.grid.ny} {
     for (const auto& pr : c.probes) {
@@ -39,7 +39,7 @@ class MpmRegion final : public Region {
           refuse("output.checkpoint_every / checkpoint_time");
         if (s_.contact.multi()) refuse("multi-field contact");
       }
-      dist_ = m->distribute(s_);
+      dist_ = m->distribute(s_, across);
     }
   }
 
@@ -108,6 +108,7 @@ class MpmRegion final : public Region {
       dist_->sum(bytes, 3);
       const double n = std::max(1.0, static_cast<double>(r.steps));
       j["mpi_ranks"] = dist_->size();
+      j["mpi_ranks_across"] = dist_->across();
       j["mpi"] = {{"halo_seconds_per_step", slow[0] / n},
                   {"migration_seconds_per_step", slow[1] / n},
                   {"halo_bytes_per_step", bytes[0] / n},
@@ -156,6 +157,8 @@ class MpmRegion final : public Region {
 
 }  // namespace
 
-std::unique_ptr<Region> mpm_region(Case& c) { return std::make_unique<MpmRegion>(c); }
+std::unique_ptr<Region> mpm_region(Case& c, int across) {
+  return std::make_unique<MpmRegion>(c, across);
+}
 
 }  // namespace smpm::detail

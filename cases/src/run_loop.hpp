@@ -52,7 +52,8 @@ class Region {
   virtual void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const = 0;
 };
 
-std::unique_ptr<Region> mpm_region(Case& c);     // region_mpm.cpp
+// `across`: ranks across x under an MPI launcher (RunOptions::ranks_across).
+std::unique_ptr<Region> mpm_region(Case& c, int across = 0);  // region_mpm.cpp
 // In the far-field module (cases/fe/; the core reaches them through modules.hpp).
 std::unique_ptr<Region> fem_region(Case& c);     // region_fem.cpp
 std::unique_ptr<Region> hybrid_region(Case& c);  // region_hybrid.cpp

@@ -903,16 +903,28 @@ void Solver::boundary_work(bool remapped) {
   // Gravity's work with the same velocity as the tractions' (void nodes have m = 0).
   if (opt.gravity_x != 0 || opt.gravity_y != 0) {
     const double gx = opt.gravity_x, gy = opt.gravity_y;
-    // This rank's own nodes (every node without a decomposition).
-    const long n0 = own_hi_ < 0 ? 0 : own_lo_ * grid.nnx;
-    const long n = own_hi_ < 0 ? static_cast<long>(grid.nodes()) : (own_hi_ + 1) * grid.nnx - n0;
+    // This rank's own nodes: every node without a decomposition, whole rows of slabs, one
+    // range of each row of a block.
+    const bool all = own_[1] < own_[0];
+    const bool rows = all || (own_[0] == 0 && own_[1] == grid.nnx - 1);
+    const long j0 = all ? 0 : own_[2], j1 = all ? grid.nny - 1 : own_[3];
+    const long n0 = rows ? j0 * grid.nnx : 0;
+    const long n = rows ? (j1 + 1) * grid.nnx - n0 : static_cast<long>(grid.nodes());
+    const long i0 = rows ? 0 : own_[0], i1 = rows ? grid.nnx - 1 : own_[1];
+    const long nnx = grid.nnx;
     const double* m = grid.m.data() + n0;
     const double* v0x = grid.vx.data() + n0; const double* v0y = grid.vy.data() + n0;
     const double* wx = ux.data() + n0; const double* wy = uy.data() + n0;
     double w = 0;
+    if (rows) {
 #pragma omp parallel for schedule(static) reduction(+ : w) num_threads(nthreads_)
-    for (long i = 0; i < n; ++i)
-      w += m[i] * (gx * 0.5 * (v0x[i] + wx[i]) + gy * 0.5 * (v0y[i] + wy[i]));
+      for (long i = 0; i < n; ++i)
+        w += m[i] * (gx * 0.5 * (v0x[i] + wx[i]) + gy * 0.5 * (v0y[i] + wy[i]));
+    } else {
+      for (long j = j0; j <= j1; ++j)
+        for (long i = j * nnx + i0; i <= j * nnx + i1; ++i)
+          w += m[i] * (gx * 0.5 * (v0x[i] + wx[i]) + gy * 0.5 * (v0y[i] + wy[i]));
+    }
     energy.external_work += dt * w;
   }
   for (auto& sl : silents) {

@@ -41,10 +41,10 @@ void Solver::for_each_layer(Fn&& fn) {
   }
 }
 
-void Solver::set_decomposition(Decomposition* d, long own_lo, long own_hi, bool dashpots) {
+void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool dashpots) {
   dist_ = d;
-  own_lo_ = own_lo;
-  own_hi_ = own_hi;
+  own_ = own;
+  halo_ = halo;
   halo_dashpots_ = dashpots;
   dashpot_nodes_.clear();
   dashpot_mark_.assign(grid.nodes(), 0);
@@ -71,18 +71,23 @@ void Solver::sum_halo(bool momentum, bool force) {
   dist_->sum_halo(f, n);
   if (!force || !halo_dashpots_) return;
   if (dashpot_mark_.size() != grid.nodes()) dashpot_mark_.assign(grid.nodes(), 0);
-  auto scan = [&](long r0, long r1) {  // node rows [r0, r1)
-    for (long i = std::max(0L, r0) * grid.nnx; i < std::min<long>(r1, grid.nny) * grid.nnx; ++i)
-      if (grid.cxx[i] != 0 || grid.cxy[i] != 0 || grid.cyy[i] != 0) {
-        add_dashpot_node(i);
-        has_nodal_dashpot_ = true;
-      }
+  auto scan = [&](long i) {
+    if (grid.cxx[i] != 0 || grid.cxy[i] != 0 || grid.cyy[i] != 0) {
+      add_dashpot_node(i);
+      has_nodal_dashpot_ = true;
+    }
   };
-  // The shared rows lie within the halo's width of the window's ends; the width is at most the
-  // rows between the window's ends and this rank's own rows, doubled.
-  const long below = own_lo_, above = grid.nny - 1 - own_hi_;
-  scan(0, own_lo_ + below);
-  scan(own_hi_ + 1 - above, grid.nny);
+  // The shared nodes: those of the window within the halo's width of this rank's box's edges
+  // (inside it or beyond).
+  const long nnx = grid.nnx, w = halo_;
+  for (long j = 0; j < grid.nny; ++j) {
+    if (j < own_[2] + w || j > own_[3] - w) {
+      for (long i = 0; i < nnx; ++i) scan(j * nnx + i);
+      continue;
+    }
+    for (long i = 0; i < std::min<long>(nnx, own_[0] + w); ++i) scan(j * nnx + i);
+    for (long i = std::max<long>(own_[0] + w, own_[1] - w + 1); i < nnx; ++i) scan(j * nnx + i);
+  }
 }
 
 void Solver::keep_particles(const std::vector<std::uint8_t>& keep) {

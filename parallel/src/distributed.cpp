@@ -1,4 +1,4 @@
-// Slabs of cell rows over MPI ranks (distributed.hpp; docs/parallel.md).
+// Blocks of cells over MPI ranks (distributed.hpp; docs/parallel.md).
 #include "silentmpm/distributed.hpp"
 
 #include <petscdmda.h>
@@ -23,6 +23,44 @@ void check(PetscErrorCode e, const char* what) {
 }
 
 bool g_started_mpi = false;
+
+// Cuts [0, n) into p parts of about equal cost, each at least `least` long.
+std::vector<int> cuts(const std::vector<double>& cost, int p, int least) {
+  const int n = static_cast<int>(cost.size());
+  double total = 0;
+  for (double c : cost) total += c;
+  std::vector<int> R(p + 1, 0);
+  R[p] = n;
+  double acc = 0;
+  int r = 0;
+  for (int o = 1; o < p; ++o) {
+    const double target = total * o / p;
+    while (r < n && acc + 0.5 * cost[r] < target) acc += cost[r++];
+    R[o] = r;
+  }
+  for (int o = 1; o < p; ++o) R[o] = std::max(R[o], R[o - 1] + least);
+  for (int o = p - 1; o >= 1; --o) R[o] = std::min(R[o], R[o + 1] - least);
+  return R;
+}
+
+// Which part of the cuts R holds cell c.
+int part_of(const std::vector<int>& R, int c) {
+  return static_cast<int>(std::upper_bound(R.begin(), R.end(), c) - R.begin()) - 1;
+}
+
+// The m x n = ranks layout with the fewest halo nodes: (m - 1) node columns of ny + 1 and
+// (n - 1) node rows of nx + 1, each shared once; the fewer ranks across on a tie.
+int blocks_across(int ranks, int nx, int ny) {
+  int best = 1;
+  double least = -1;
+  for (int m = 1; m <= ranks; ++m) {
+    if (ranks % m) continue;
+    const int n = ranks / m;
+    const double halo = static_cast<double>(m - 1) * (ny + 1) + static_cast<double>(n - 1) * (nx + 1);
+    if (least < 0 || halo < least) least = halo, best = m;
+  }
+  return best;
+}
 
 }  // namespace
 
@@ -53,72 +91,83 @@ void parallel_finalize() {
 
 struct Distributed::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
-  MPI_Comm graph = MPI_COMM_NULL;  // the neighbours below and above
+  MPI_Comm graph = MPI_COMM_NULL;  // the neighbours, sides and corners
   int rank = 0, size = 1;
-  int w = 2;                       // halo width (node rows)
-  std::vector<int> R;              // cell rows of rank r: [R[r], R[r + 1])
-  int nnx = 0, nny = 0;
-  int g0 = 0, gn = 0;              // window: node rows [g0, g0 + gn)
-  int o0 = 0, on = 0;              // own node rows [o0, o0 + on)
+  int m = 1, n = 1;                // ranks across x and along y; rank = pj * m + pi
+  int pi = 0, pj = 0;
+  int w = 2;                       // halo width (nodes)
+  std::vector<int> Cx, Ry;         // cells of rank (pi, pj): [Cx[pi], Cx[pi+1]) x [Ry[pj], Ry[pj+1])
+  int nnx = 0, nny = 0;            // nodes of the whole grid
+  int gx0 = 0, gy0 = 0, gnx = 0, gny = 0;  // window: nodes [gx0, gx0 + gnx) x [gy0, gy0 + gny)
   DM da = nullptr;
-  std::vector<int> ghost_rows;     // window rows owned by the neighbours (whole-grid numbering)
-  std::vector<int> band_rows;      // own rows the neighbours hold copies of
-  std::vector<int> nbrs;           // neighbour ranks (below first)
+  std::vector<long> leaves;        // window nodes owned by others (window indices)
+  std::vector<long> roots;         // own nodes the neighbours hold copies of (window indices)
+  std::vector<int> nbrs;           // neighbour ranks, ascending
   std::map<int, PetscSF> sf;       // star forest for n fields at once
+  std::vector<PetscSFNode> remote; // each leaf's owner and place in its root list
   std::vector<double> leaf, root;
   long sent = 0, received = 0;
   Traffic t;
 
-  // Node rows of rank o: [R[o], R[o + 1]), the last rank also the grid's top row.
-  int own_begin(int o) const { return R[o]; }
-  int own_end(int o) const { return o == size - 1 ? nny : R[o + 1]; }
-  std::vector<int> band_of(int o) const {
-    std::vector<int> b;
-    for (int j = own_begin(o); j < own_end(o); ++j)
-      if ((o > 0 && j < own_begin(o) + w) || (o < size - 1 && j >= own_end(o) - w)) b.push_back(j);
-    return b;
+  // Nodes of rank part p along an axis with cuts C and `nodes` nodes: [C[p], C[p + 1]), the
+  // last part also the grid's last node.
+  static int node_end(const std::vector<int>& C, int p, int nodes) {
+    return p == static_cast<int>(C.size()) - 2 ? nodes : C[p + 1];
   }
-  int owner_of_row(int j) const {
-    for (int o = 0; o < size; ++o)
-      if (j >= own_begin(o) && j < own_end(o)) return o;
-    return -1;
+  int owner_of_node(int i, int j) const {
+    return std::min(part_of(Ry, j), n - 1) * m + std::min(part_of(Cx, i), m - 1);
+  }
+  // Own nodes of rank o the neighbours hold: within w of a side it shares, row by row.
+  struct Band {
+    int x0, x1, y0, y1;  // own nodes [x0, x1) x [y0, y1)
+    int L, Rt, B, T;     // band widths on each side (0 where no neighbour)
+    std::vector<long> before;  // band nodes in rows before row y0 + r
+    bool full(int j) const { return j < y0 + B || j >= y1 - T; }
+    int mid() const { return std::min(x1 - x0, L + Rt); }
+    bool in(int i, int j) const { return full(j) || i < x0 + L || i >= x1 - Rt; }
+    long index(int i, int j) const {  // position among the band's nodes, row-major
+      const long base = before[j - y0];
+      if (full(j)) return base + (i - x0);
+      // The band columns before i: the left band's, then the right band's past the left one.
+      return base + std::min(i - x0, L) + std::max(0, i - std::max(x0 + L, x1 - Rt));
+    }
+  };
+  Band band(int o) const {
+    const int a = o % m, b = o / m;
+    Band B{Cx[a], node_end(Cx, a, nnx), Ry[b], node_end(Ry, b, nny),
+           a > 0 ? w : 0, a < m - 1 ? w : 0, b > 0 ? w : 0, b < n - 1 ? w : 0, {}};
+    B.before.assign(B.y1 - B.y0 + 1, 0);
+    for (int j = B.y0; j < B.y1; ++j)
+      B.before[j - B.y0 + 1] = B.before[j - B.y0] + (B.full(j) ? B.x1 - B.x0 : B.mid());
+    return B;
   }
 
-  // Leaf (f, ghost node l) -> root (owner, f * its band size + place of the node in its band).
-  PetscSF forest(int n) {
-    auto it = sf.find(n);
+  // Leaf (f, l) -> root (owner, f * its band size + the node's place in its band).
+  PetscSF forest(int nf) {
+    auto it = sf.find(nf);
     if (it != sf.end()) return it->second;
-    const PetscInt nl = static_cast<PetscInt>(ghost_rows.size()) * nnx;
-    const PetscInt nr = static_cast<PetscInt>(band_rows.size()) * nnx;
-    std::vector<std::vector<int>> bands(size);
-    for (int o = 0; o < size; ++o) bands[o] = band_of(o);
-    std::vector<PetscSFNode> remote(static_cast<std::size_t>(nl) * n);
-    for (int f = 0; f < n; ++f)
-      for (std::size_t r = 0; r < ghost_rows.size(); ++r) {
-        const int j = ghost_rows[r], o = owner_of_row(j);
-        const auto& b = bands[o];
-        const auto pos = std::find(b.begin(), b.end(), j) - b.begin();
-        if (pos == static_cast<long>(b.size()))
-          throw std::logic_error("halo: a ghost row is not in its owner's band");
-        const PetscInt band_n = static_cast<PetscInt>(b.size()) * nnx;
-        for (int i = 0; i < nnx; ++i) {
-          PetscSFNode& s = remote[f * nl + r * nnx + i];
-          s.rank = o;
-          s.index = f * band_n + pos * nnx + i;
-        }
+    const PetscInt nl = static_cast<PetscInt>(leaves.size());
+    const PetscInt nr = static_cast<PetscInt>(roots.size());
+    std::map<int, PetscInt> band_size;
+    for (int o : nbrs) band_size[o] = band(o).before.back();
+    std::vector<PetscSFNode> r(static_cast<std::size_t>(nl) * nf);
+    for (int f = 0; f < nf; ++f)
+      for (PetscInt l = 0; l < nl; ++l) {
+        r[f * nl + l].rank = remote[l].rank;
+        r[f * nl + l].index = f * band_size[static_cast<int>(remote[l].rank)] + remote[l].index;
       }
     PetscSF s;
     check(PetscSFCreate(comm, &s), "PetscSFCreate");
-    check(PetscSFSetGraph(s, nr * n, nl * n, nullptr, PETSC_COPY_VALUES, remote.data(),
+    check(PetscSFSetGraph(s, nr * nf, nl * nf, nullptr, PETSC_COPY_VALUES, r.data(),
                           PETSC_COPY_VALUES),
           "PetscSFSetGraph");
     check(PetscSFSetUp(s), "PetscSFSetUp");
-    sf[n] = s;
+    sf[nf] = s;
     return s;
   }
 };
 
-Distributed::Distributed(Solver& s, MPI_Comm comm) : d_(std::make_unique<Impl>()) {
+Distributed::Distributed(Solver& s, MPI_Comm comm, int across) : d_(std::make_unique<Impl>()) {
   Impl& d = *d_;
   d.comm = comm;
   MPI_Comm_rank(comm, &d.rank);
@@ -126,65 +175,87 @@ Distributed::Distributed(Solver& s, MPI_Comm comm) : d_(std::make_unique<Impl>()
   if (s.contact.multi())
     throw std::runtime_error("multi-field contact does not run on several MPI ranks yet");
   const Grid& g = s.grid;
-  const int P = d.size, ny = g.ny;
+  const int P = d.size;
   d.nnx = g.nnx;
   d.nny = g.nny;
-  // The window must hold every node a particle of the slab writes: its stencil, and a boundary
-  // anchor up to a cell away.
+  // The window must hold every node a particle of the block writes: its stencil, and a
+  // boundary anchor up to a cell away.
   d.w = s.opt.shape == ShapeKind::Bilinear ? 2 : 3;
-  if (ny < d.w * P)
-    throw std::runtime_error(std::to_string(P) + " MPI ranks need a grid of at least " +
-                             std::to_string(d.w * P) + " cell rows (" + std::to_string(d.w) +
-                             " per rank, the halo's width); this one has " + std::to_string(ny));
-  // Cost per cell row: particles, the film's J2-softening ones counting 5 (their update costs
-  // about five elastic ones).
-  std::vector<double> cost(ny, 0.0);
-  double total = 0;
+  d.m = across > 0 ? across : blocks_across(P, g.nx, g.ny);
+  if (P % d.m)
+    throw std::runtime_error(std::to_string(P) + " MPI ranks cannot form blocks " +
+                             std::to_string(d.m) + " ranks across");
+  d.n = P / d.m;
+  if (g.nx < d.w * d.m || g.ny < d.w * d.n)
+    throw std::runtime_error(std::to_string(P) + " MPI ranks (" + std::to_string(d.m) + " x " +
+                             std::to_string(d.n) + ") need a grid of at least " +
+                             std::to_string(d.w * d.m) + " x " + std::to_string(d.w * d.n) +
+                             " cells (" + std::to_string(d.w) + " per rank each way, the halo's "
+                             "width); this one has " + std::to_string(g.nx) + " x " +
+                             std::to_string(g.ny));
+  d.pi = d.rank % d.m;
+  d.pj = d.rank / d.m;
+  // Cost per cell column and row: particles, the film's J2-softening ones counting 5 (their
+  // update costs about five elastic ones).
+  std::vector<double> cx(g.nx, 0.0), cy(g.ny, 0.0);
+  auto cell = [&](std::size_t k, int& ci, int& cj) {
+    ci = std::clamp(static_cast<int>(std::floor((s.p.x[k] - g.x0) * g.inv_h)), 0, g.nx - 1);
+    cj = std::clamp(static_cast<int>(std::floor((s.p.y[k] - g.y0) * g.inv_h)), 0, g.ny - 1);
+  };
   for (std::size_t k = 0; k < s.p.size(); ++k) {
-    const int r = std::clamp(static_cast<int>(std::floor((s.p.y[k] - g.y0) * g.inv_h)), 0, ny - 1);
+    int ci, cj;
+    cell(k, ci, cj);
     const double c = s.materials[s.p.group[k]].model == Model::J2Film ? 5.0 : 1.0;
-    cost[r] += c;
-    total += c;
+    cx[ci] += c;
+    cy[cj] += c;
   }
-  d.R.assign(P + 1, 0);
-  d.R[P] = ny;
-  {
-    double acc = 0;
-    int r = 0;
-    for (int o = 1; o < P; ++o) {
-      const double target = total * o / P;
-      while (r < ny && acc + 0.5 * cost[r] < target) acc += cost[r++];
-      d.R[o] = r;
-    }
-    for (int o = 1; o < P; ++o) d.R[o] = std::max(d.R[o], d.R[o - 1] + d.w);
-    for (int o = P - 1; o >= 1; --o) d.R[o] = std::min(d.R[o], d.R[o + 1] - d.w);
-  }
-  // The DMDA of the nodes: one column of ranks, each owning the node rows of its slab's cells.
-  std::vector<PetscInt> ly(P);
-  for (int o = 0; o < P; ++o) ly[o] = d.own_end(o) - d.own_begin(o);
-  check(DMDACreate2d(comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, d.nnx, d.nny, 1,
-                     P, 1, d.w, nullptr, ly.data(), &d.da),
+  d.Cx = cuts(cx, d.m, d.w);
+  d.Ry = cuts(cy, d.n, d.w);
+  // The DMDA of the nodes, its ownership the blocks' cells (the last block of a row or column
+  // also the grid's last node).
+  std::vector<PetscInt> lx(d.m), ly(d.n);
+  for (int a = 0; a < d.m; ++a) lx[a] = Impl::node_end(d.Cx, a, d.nnx) - d.Cx[a];
+  for (int b = 0; b < d.n; ++b) ly[b] = Impl::node_end(d.Ry, b, d.nny) - d.Ry[b];
+  check(DMDACreate2d(comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, d.nnx, d.nny,
+                     d.m, d.n, 1, d.w, lx.data(), ly.data(), &d.da),
         "DMDACreate2d");
   check(DMSetUp(d.da), "DMSetUp");
   PetscInt xs, ys, xm, ym, gxs, gys, gxm, gym;
   check(DMDAGetCorners(d.da, &xs, &ys, nullptr, &xm, &ym, nullptr), "DMDAGetCorners");
   check(DMDAGetGhostCorners(d.da, &gxs, &gys, nullptr, &gxm, &gym, nullptr), "DMDAGetGhostCorners");
-  if (xs != 0 || xm != d.nnx || ys != d.own_begin(d.rank) || ym != ly[d.rank])
-    throw std::logic_error("DMDA ownership differs from the slabs");
-  d.o0 = static_cast<int>(ys);
-  d.on = static_cast<int>(ym);
-  d.g0 = static_cast<int>(gys);
-  d.gn = static_cast<int>(gym);
-  for (int j = d.g0; j < d.g0 + d.gn; ++j)
-    if (j < d.o0 || j >= d.o0 + d.on) d.ghost_rows.push_back(j);
-  d.band_rows = d.band_of(d.rank);
-  if (d.rank > 0) d.nbrs.push_back(d.rank - 1);
-  if (d.rank < P - 1) d.nbrs.push_back(d.rank + 1);
+  if (xs != d.Cx[d.pi] || xm != lx[d.pi] || ys != d.Ry[d.pj] || ym != ly[d.pj])
+    throw std::logic_error("DMDA ownership differs from the blocks");
+  d.gx0 = static_cast<int>(gxs);
+  d.gy0 = static_cast<int>(gys);
+  d.gnx = static_cast<int>(gxm);
+  d.gny = static_cast<int>(gym);
+  // Neighbours: the ranks whose nodes the window holds (sides and corners).
+  for (int b = std::max(0, d.pj - 1); b <= std::min(d.n - 1, d.pj + 1); ++b)
+    for (int a = std::max(0, d.pi - 1); a <= std::min(d.m - 1, d.pi + 1); ++a)
+      if (b * d.m + a != d.rank) d.nbrs.push_back(b * d.m + a);
   const int nn = static_cast<int>(d.nbrs.size());
   MPI_Dist_graph_create_adjacent(comm, nn, d.nbrs.data(), MPI_UNWEIGHTED, nn, d.nbrs.data(),
                                  MPI_UNWEIGHTED, MPI_INFO_NULL, 0, &d.graph);
+  // Leaves (row-major over the window) and this rank's roots (its band, row-major).
+  std::map<int, Impl::Band> bands;
+  for (int o : d.nbrs) bands.emplace(o, d.band(o));
+  for (int j = d.gy0; j < d.gy0 + d.gny; ++j)
+    for (int i = d.gx0; i < d.gx0 + d.gnx; ++i) {
+      const int o = d.owner_of_node(i, j);
+      if (o == d.rank) continue;
+      const Impl::Band& B = bands.at(o);
+      if (!B.in(i, j)) throw std::logic_error("halo: a window node outside its owner's band");
+      d.leaves.push_back(static_cast<long>(j - d.gy0) * d.gnx + (i - d.gx0));
+      d.remote.push_back({o, static_cast<PetscInt>(B.index(i, j))});
+    }
+  {
+    const Impl::Band B = d.band(d.rank);
+    for (int j = B.y0; j < B.y1; ++j)
+      for (int i = B.x0; i < B.x1; ++i)
+        if (B.in(i, j)) d.roots.push_back(static_cast<long>(j - d.gy0) * d.gnx + (i - d.gx0));
+  }
 
-  // This rank's particles (by the whole grid's rows), then its window of the grid.
+  // This rank's particles (by the whole grid's cells), then its window of the grid.
   const bool dashpots = [&] {
     for (const auto& sl : s.silents)
       if (sl.form == SilentForm::Nodal) return true;
@@ -192,16 +263,20 @@ Distributed::Distributed(Solver& s, MPI_Comm comm) : d_(std::make_unique<Impl>()
   }();
   std::vector<std::uint8_t> keep(s.p.size(), 0);
   for (std::size_t k = 0; k < s.p.size(); ++k) {
-    const int r = std::clamp(static_cast<int>(std::floor((s.p.y[k] - g.y0) * g.inv_h)), 0, ny - 1);
-    keep[k] = r >= d.R[d.rank] && r < d.R[d.rank + 1];
+    int ci, cj;
+    cell(k, ci, cj);
+    keep[k] = ci >= d.Cx[d.pi] && ci < d.Cx[d.pi + 1] && cj >= d.Ry[d.pj] && cj < d.Ry[d.pj + 1];
   }
-  Grid w;
-  w.init(g.x0, g.y0 + d.g0 * g.h, g.h, g.nx, d.gn - 1);
-  std::copy(g.fix.begin() + static_cast<long>(d.g0) * d.nnx,
-            g.fix.begin() + static_cast<long>(d.g0 + d.gn) * d.nnx, w.fix.begin());
-  s.grid = std::move(w);
+  Grid win;
+  win.init(g.x0 + d.gx0 * g.h, g.y0 + d.gy0 * g.h, g.h, d.gnx - 1, d.gny - 1);
+  for (int j = 0; j < d.gny; ++j)
+    std::copy_n(g.fix.begin() + static_cast<long>(d.gy0 + j) * d.nnx + d.gx0, d.gnx,
+                win.fix.begin() + static_cast<long>(j) * d.gnx);
+  s.grid = std::move(win);
   s.keep_particles(keep);
-  s.set_decomposition(this, d.o0 - d.g0, d.o0 + d.on - 1 - d.g0, dashpots);
+  const NodeBox own{static_cast<int>(xs - gxs), static_cast<int>(xs + xm - 1 - gxs),
+                    static_cast<int>(ys - gys), static_cast<int>(ys + ym - 1 - gys)};
+  s.set_decomposition(this, own, d.w, dashpots);
 }
 
 Distributed::~Distributed() {
@@ -212,67 +287,73 @@ Distributed::~Distributed() {
 
 int Distributed::rank() const { return d_->rank; }
 int Distributed::size() const { return d_->size; }
-const std::vector<int>& Distributed::rows() const { return d_->R; }
+int Distributed::across() const { return d_->m; }
+const std::vector<int>& Distributed::rows() const { return d_->Ry; }
+const std::vector<int>& Distributed::columns() const { return d_->Cx; }
 int Distributed::halo_width() const { return d_->w; }
-int Distributed::window_row0() const { return d_->g0; }
+int Distributed::window_row0() const { return d_->gy0; }
+int Distributed::window_column0() const { return d_->gx0; }
 long Distributed::sent() const { return d_->sent; }
 long Distributed::received() const { return d_->received; }
 
-// Ghost rows' partial sums go to their owners and are added there (the owner's value first);
+// Ghost nodes' partial sums go to their owners and are added there (the owner's value first);
 // the sums come back to every copy.
-void Distributed::sum_halo(double* const* fields, int n) {
+void Distributed::sum_halo(double* const* fields, int nf) {
   Impl& d = *d_;
-  if (d.size == 1 || n == 0) return;
+  if (d.size == 1 || nf == 0) return;
   const double t0 = MPI_Wtime();
-  PetscSF sf = d.forest(n);
-  const std::size_t nl = d.ghost_rows.size() * d.nnx, nr = d.band_rows.size() * d.nnx;
-  d.leaf.resize(nl * n);
-  d.root.resize(nr * n);
-  auto rows = [&](const std::vector<int>& list, double* buf, std::size_t len, bool to_buf) {
-    for (int f = 0; f < n; ++f)
-      for (std::size_t r = 0; r < list.size(); ++r) {
-        double* field = fields[f] + static_cast<std::size_t>(list[r] - d.g0) * d.nnx;
-        double* b = buf + f * len + r * d.nnx;
-        if (to_buf) std::memcpy(b, field, d.nnx * sizeof(double));
-        else std::memcpy(field, b, d.nnx * sizeof(double));
-      }
-  };
-  rows(d.ghost_rows, d.leaf.data(), nl, true);
-  rows(d.band_rows, d.root.data(), nr, true);
+  PetscSF sf = d.forest(nf);
+  const std::size_t nl = d.leaves.size(), nr = d.roots.size();
+  d.leaf.resize(nl * nf);
+  d.root.resize(nr * nf);
+  for (int f = 0; f < nf; ++f) {
+    const double* v = fields[f];
+    double* lb = d.leaf.data() + f * nl;
+    double* rb = d.root.data() + f * nr;
+    for (std::size_t q = 0; q < nl; ++q) lb[q] = v[d.leaves[q]];
+    for (std::size_t q = 0; q < nr; ++q) rb[q] = v[d.roots[q]];
+  }
   check(PetscSFReduceBegin(sf, MPI_DOUBLE, d.leaf.data(), d.root.data(), MPI_SUM), "PetscSFReduce");
   check(PetscSFReduceEnd(sf, MPI_DOUBLE, d.leaf.data(), d.root.data(), MPI_SUM), "PetscSFReduce");
   check(PetscSFBcastBegin(sf, MPI_DOUBLE, d.root.data(), d.leaf.data(), MPI_REPLACE), "PetscSFBcast");
   check(PetscSFBcastEnd(sf, MPI_DOUBLE, d.root.data(), d.leaf.data(), MPI_REPLACE), "PetscSFBcast");
-  rows(d.band_rows, d.root.data(), nr, false);
-  rows(d.ghost_rows, d.leaf.data(), nl, false);
+  for (int f = 0; f < nf; ++f) {
+    double* v = fields[f];
+    const double* lb = d.leaf.data() + f * nl;
+    const double* rb = d.root.data() + f * nr;
+    for (std::size_t q = 0; q < nr; ++q) v[d.roots[q]] = rb[q];
+    for (std::size_t q = 0; q < nl; ++q) v[d.leaves[q]] = lb[q];
+  }
   d.t.halo_seconds += MPI_Wtime() - t0;
-  d.t.halo_bytes += static_cast<double>((nl + nr) * n * sizeof(double));  // leaves out, roots back
+  d.t.halo_bytes += static_cast<double>((nl + nr) * nf * sizeof(double));  // leaves out, roots back
 }
 
-// After the step's last move: a particle whose cell row (in the window's numbering, as the
-// solver sorts it) left the slab goes to the neighbour on that side (a particle moves less than
-// a cell per step, and a slab has at least the halo's width of rows).
+// After the step's last move: a particle whose cell (in the window's numbering, as the solver
+// sorts it) left the block goes to the rank that owns it, a neighbour (a particle moves less
+// than a cell per step, and a block is at least the halo's width each way).
 bool Distributed::migrate(Solver& s) {
   Impl& d = *d_;
   if (d.size == 1) return false;
   const double t0 = MPI_Wtime();
-  const int lo = d.R[d.rank] - d.g0, hi = d.R[d.rank + 1] - d.g0;  // own cell rows [lo, hi)
-  const int below = d.rank > 0 ? 0 : -1;
-  const int above = d.rank < d.size - 1 ? static_cast<int>(d.nbrs.size()) - 1 : -1;
+  const int c0 = d.Cx[d.pi] - d.gx0, c1 = d.Cx[d.pi + 1] - d.gx0;  // own cells, window numbering
+  const int r0 = d.Ry[d.pj] - d.gy0, r1 = d.Ry[d.pj + 1] - d.gy0;
+  const int nn = static_cast<int>(d.nbrs.size());
   std::vector<int> to(s.p.size(), -1);
   bool leaving = false;
   for (std::size_t k = 0; k < s.p.size(); ++k) {
-    const int r = s.cell_row(k);
-    if (r >= lo && r < hi) continue;
-    const int slot = r < lo ? below : above;
-    if (slot < 0 || r < lo - d.w || r >= hi + d.w)
-      throw std::runtime_error("particle " + std::to_string(s.p.id[k]) +
-                               " left rank " + std::to_string(d.rank) + "'s rows by more than " +
-                               "the halo in one step (at y = " + std::to_string(s.p.y[k]) + ")");
-    to[k] = slot;
+    const int r = s.cell_row(k), c = s.cell_column(k);
+    if (r >= r0 && r < r1 && c >= c0 && c < c1) continue;
+    const int a = std::clamp(part_of(d.Cx, c + d.gx0), 0, d.m - 1);
+    const int b = std::clamp(part_of(d.Ry, r + d.gy0), 0, d.n - 1);
+    const auto it = std::find(d.nbrs.begin(), d.nbrs.end(), b * d.m + a);
+    if (it == d.nbrs.end())
+      throw std::runtime_error("particle " + std::to_string(s.p.id[k]) + " left rank " +
+                               std::to_string(d.rank) + "'s cells for a rank that is not its " +
+                               "neighbour in one step (at (" + std::to_string(s.p.x[k]) + ", " +
+                               std::to_string(s.p.y[k]) + "))");
+    to[k] = static_cast<int>(it - d.nbrs.begin());
     leaving = true;
   }
-  const int nn = static_cast<int>(d.nbrs.size());
   std::vector<std::vector<double>> out(nn);
   if (leaving) s.export_particles(to, out);
   std::vector<int> scount(nn), rcount(nn), sdisp(nn), rdisp(nn);

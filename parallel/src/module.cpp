@@ -21,8 +21,8 @@ int size() {
   MPI_Comm_size(MPI_COMM_WORLD, &n);
   return n;
 }
-std::unique_ptr<Decomposition> distribute(Solver& s) {
-  return std::make_unique<Distributed>(s, MPI_COMM_WORLD);
+std::unique_ptr<Decomposition> distribute(Solver& s, int across) {
+  return std::make_unique<Distributed>(s, MPI_COMM_WORLD, across);
 }
 bool any(bool b) {
   int v = b ? 1 : 0;

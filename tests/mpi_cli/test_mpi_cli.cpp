@@ -3,7 +3,7 @@
 // (200 cell rows, 10 000 particles, LK on the right edge, a probe), 1 000 steps:
 //   * 1 rank: history.csv and probes.csv byte-identical to the plain run, summary.json equal
 //     but for timings and the rank count;
-//   * 2 and 4 ranks: every history column within 1e-10 relative L2 of the plain run (a column
+//   * 2 and 4 ranks (slabs, and 2 x 2 blocks): every history column within 1e-10 relative L2 of the plain run (a column
 //     normalised by the largest of its kind: the probe's stresses, its velocities, the
 //     energies), the same particle count; two runs on 2 ranks byte-identical;
 //   * what the ranks cannot share yet is refused before the run (exit 1, one line naming it);
@@ -108,7 +108,7 @@ TEST(MpiCli, OneRankBitIdenticalOnEveryOutput) {
   nlohmann::json sa = summary(a), sb = summary(b);
   EXPECT_EQ(sb["mpi_ranks"], 1);
   for (auto* j : {&sa, &sb})
-    for (const char* k : {"wall_seconds", "step_seconds", "particle_updates_per_second", "mpi_ranks", "mpi"})
+    for (const char* k : {"wall_seconds", "step_seconds", "particle_updates_per_second", "mpi_ranks", "mpi_ranks_across", "mpi"})
       j->erase(k);
   EXPECT_EQ(sa, sb);
 }
@@ -117,18 +117,23 @@ TEST(MpiCli, TwoAndFourRanksMatchOneProcess) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path a = out_dir("plain");
   ASSERT_EQ(run(0, kCase + kShort + " --out " + a.string(), "plain").status, 0);
-  for (int np : {2, 4}) {
-    const fs::path b = out_dir("np" + std::to_string(np));
-    const Proc p = run(np, kCase + kShort + " --out " + b.string(), "np" + std::to_string(np));
+  // 2 and 4 ranks in the layout the program picks (slabs on this tall plate), 4 as 2 x 2 blocks.
+  for (const auto& [np, across] : std::vector<std::pair<int, int>>{{2, 0}, {4, 0}, {4, 2}}) {
+    const std::string tag = "np" + std::to_string(np) + (across ? "x" + std::to_string(across) : "");
+    const fs::path b = out_dir(tag);
+    const Proc p = run(np, kCase + kShort + " --ranks-across " + std::to_string(across) +
+                               " --out " + b.string(), tag);
     ASSERT_EQ(p.status, 0) << p.err;
     double worst = 0;
     for (const auto& [c, d] : differences(b, a)) {
-      EXPECT_LE(d, 1e-10) << np << " ranks, column " << c;
+      EXPECT_LE(d, 1e-10) << tag << ", column " << c;
       worst = std::max(worst, d);
     }
-    std::printf("%d ranks: history within %.1e of one process\n", np, worst);
     const nlohmann::json sa = summary(a), sb = summary(b);
+    std::printf("%d ranks, %d across: history within %.1e of one process\n", np,
+                sb["mpi_ranks_across"].get<int>(), worst);
     EXPECT_EQ(sb["mpi_ranks"], np);
+    EXPECT_EQ(sb["mpi_ranks_across"], across ? across : 1);
     EXPECT_EQ(sb["particles"], sa["particles"]);
     EXPECT_EQ(sb["grid"], sa["grid"]);
     EXPECT_EQ(sb["silent_boundaries"], sa["silent_boundaries"]);

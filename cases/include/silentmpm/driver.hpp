@@ -35,6 +35,9 @@ struct RunOptions {
   // A checkpoint to continue from ("": start at t = 0). It must come from the same case (the
   // same keys and values, except output.*, time.end and scheme.threads) and the same version.
   std::string restart;
+  // Under an MPI launcher: ranks across x of the blocks (1: slabs of rows); 0 picks the layout
+  // with the fewest nodes shared.
+  int ranks_across = 0;
 };
 
 // Runs the case and writes DIR/history.csv, DIR/summary.json, DIR/particles.{h5,xdmf}, and

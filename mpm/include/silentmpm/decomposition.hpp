@@ -18,6 +18,7 @@ class Decomposition {
   virtual ~Decomposition() = default;
   virtual int rank() const = 0;
   virtual int size() const = 0;
+  virtual int across() const = 0;  // ranks across x (the blocks' layout)
   // Sums the halo of the n grid arrays (each grid.nodes() long) over the ranks sharing nodes.
   virtual void sum_halo(double* const* fields, int n) = 0;
   // Moves the particles outside this rank's cell rows (with their boundary-layer entries) to

@@ -159,12 +159,13 @@ class Solver {
   long first_particle_outside() const;
 
   // --- processes (solver_exchange.cpp; decomposition.hpp) ----------------------------------
-  // Splits the step over ranks: d sums the halo and moves particles; node rows [own_lo, own_hi]
-  // of this solver's grid are this rank's own (the rest are copies of its neighbours' nodes, left
-  // out of sums over nodes); `dashpots`: whether any rank assembles nodal dashpot blocks (they are
-  // then summed over the halo too). Called after finalize and after the grid, particles and
-  // layers were cut to this rank's share; the solver does not own d.
-  void set_decomposition(Decomposition* d, long own_lo, long own_hi, bool dashpots);
+  // Splits the step over ranks: d sums the halo and moves particles; the nodes of `own`
+  // ({i0, i1, j0, j1}, inclusive, in this solver's grid) are this rank's (the rest are copies of
+  // its neighbours' nodes within `halo` nodes of it, left out of sums over nodes); `dashpots`:
+  // whether any rank assembles nodal dashpot blocks (they are then summed over the halo too).
+  // Called after finalize and after the grid, particles and layers were cut to this rank's
+  // share; the solver does not own d.
+  void set_decomposition(Decomposition* d, NodeBox own, int halo, bool dashpots);
   Decomposition* decomposition() const { return dist_; }
   // Keeps the particles with keep[k] != 0 and their boundary-layer entries (order kept).
   void keep_particles(const std::vector<std::uint8_t>& keep);
@@ -178,9 +179,12 @@ class Solver {
   void sort_particles();
   // The energy account over every rank (this rank's own without a decomposition).
   Energies total_energy() const;
-  // The cell row of a particle in this solver's grid.
+  // The cell row and column of a particle in this solver's grid.
   int cell_row(std::size_t k) const {
     return static_cast<int>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
+  }
+  int cell_column(std::size_t k) const {
+    return static_cast<int>(std::floor((p.x[k] - grid.x0) * grid.inv_h));
   }
 
   // --- checkpoints (solver_state.cpp) --------------------------------------------------------
@@ -218,7 +222,8 @@ class Solver {
   std::vector<int> body_of_group_;        // with body fields: the body of each material group
   std::vector<StepHooks*> hooks_;
   Decomposition* dist_ = nullptr;
-  long own_lo_ = 0, own_hi_ = -1;  // node rows of this rank (own_hi_ < 0: every row)
+  NodeBox own_{0, -1, 0, -1};  // this rank's nodes (i1 < i0: every node)
+  int halo_ = 0;               // the halo's width (nodes)
   bool halo_dashpots_ = false;
   void sum_halo(bool momentum, bool force);
   // fn(layer, its per-entry arrays with their strides) for every boundary layer, in a fixed order.

@@ -1,10 +1,10 @@
 #pragma once
-// The MPM solver over MPI ranks: horizontal slabs of cell rows, one per rank (docs/parallel.md).
-// The grid is a PETSc DMDA of the nodes, one process column and one process row per rank, whose
-// rows are cut where the particles' cost splits evenly; each rank's solver holds the DMDA's
-// ghosted window of the grid and the particles of its cell rows. The halo sums run over PETSc's
-// star forest (PetscSF) on the rows the ranks share only; particles move to a neighbour with MPI
-// neighbourhood collectives. PETSc's headers stay in parallel/src.
+// The MPM solver over MPI ranks: blocks of cells, m across and n along y, one per rank
+// (docs/parallel.md); m = 1 gives horizontal slabs. The grid is a PETSc DMDA of the nodes whose
+// ownership is the blocks' cells, cut where the particles' cost splits evenly; each rank's
+// solver holds the DMDA's ghosted window of the grid and the particles of its cells. The halo
+// sums run over PETSc's star forest (PetscSF) on the nodes the ranks share only; particles move
+// to a neighbour with MPI neighbourhood collectives. PETSc's headers stay in parallel/src.
 #include <mpi.h>
 
 #include <memory>
@@ -23,11 +23,12 @@ void parallel_finalize();
 class Distributed final : public Decomposition {
  public:
   // Cuts a finalized solver, on which every rank of comm built the whole case, to this rank's
-  // slab and attaches itself to it (it must outlive the solver's steps). Throws
-  // std::runtime_error, on every rank, when the grid has fewer cell rows than the ranks need
-  // (the halo's width each) or the case uses what the ranks cannot share yet (multi-field
-  // contact, step hooks).
-  Distributed(Solver& s, MPI_Comm comm);
+  // block and attaches itself to it (it must outlive the solver's steps). `across`: ranks
+  // across x (1: slabs of rows; 0: the layout with the fewest shared nodes). Throws
+  // std::runtime_error, on every rank, when the ranks do not divide by `across`, the grid has
+  // fewer cells than the blocks need (the halo's width each way) or the case uses what the
+  // ranks cannot share yet (multi-field contact).
+  Distributed(Solver& s, MPI_Comm comm, int across = 0);
   ~Distributed() override;
   Distributed(const Distributed&) = delete;
   Distributed& operator=(const Distributed&) = delete;
@@ -41,10 +42,14 @@ class Distributed final : public Decomposition {
   bool any(bool b) override;
   Traffic traffic() const override;
 
-  // Cell rows of every rank's slab: rank r owns [rows()[r], rows()[r + 1]) of the whole grid.
+  // The blocks: rank r = b * across() + a owns the whole grid's cells
+  // [columns()[a], columns()[a + 1]) x [rows()[b], rows()[b + 1]).
+  int across() const override;
+  const std::vector<int>& columns() const;
   const std::vector<int>& rows() const;
-  int halo_width() const;    // node rows of the neighbours a window holds on each side
-  int window_row0() const;   // the whole grid's node row of this rank's grid row 0
+  int halo_width() const;      // nodes of the neighbours a window holds on each side
+  int window_column0() const;  // the whole grid's node of this rank's grid node (0, 0)
+  int window_row0() const;
   // Particles sent to and received from the neighbours, over the run.
   long sent() const;
   long received() const;
