@@ -144,6 +144,11 @@ void MpmSnapshots::write(const Solver& s) {
   if (grid_on_) grid_.write(s);
 }
 
+void MpmSnapshots::write(const Particles& p, long step, double time,
+                         const std::vector<std::uint8_t>& layer) {
+  snap_.write(p, step, time, &layer);
+}
+
 void MpmSnapshots::close() {
   snap_.close();
   grid_.close();

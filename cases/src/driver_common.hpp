@@ -66,6 +66,8 @@ class MpmSnapshots {
   void restore(const StateReader& r) { earlier_ = SnapshotList::read(r); }
   void open(const Solver& s, const OutputSpec& out, const std::string& out_dir);
   void write(const Solver& s);
+  // Particles gathered from several ranks (no grid snapshot).
+  void write(const Particles& p, long step, double time, const std::vector<std::uint8_t>& layer);
   void close();
   int count() const { return snap_.count(); }
 

@@ -34,7 +34,7 @@ class MpmRegion final : public Region {
                                    std::to_string(m->size()) + " here): run the case on one "
                                    "process, or without it");
         };
-        if (c.output.snapshots > 0) refuse("output.snapshots");
+        if (c.output.snapshots > 0 && c.output.grid) refuse("output.grid");
         if (c.output.checkpoint_every > 0 || c.output.checkpoint_time > 0)
           refuse("output.checkpoint_every / checkpoint_time");
         if (s_.contact.multi()) refuse("multi-field contact");
@@ -77,14 +77,38 @@ class MpmRegion final : public Region {
     return s_.load_state(r, "mpm.");
   }
 
+  // Several ranks: rank 0 writes the snapshots of every rank's particles, gathered (in the
+  // order of their ids).
+  bool ranks() const { return dist_ && dist_->size() > 1; }
   void open_snapshots(const std::string& out_dir) override {
-    snaps_.open(s_, c_.output, out_dir);
+    if (!ranks() || dist_->rank() == 0) snaps_.open(s_, c_.output, out_dir);
   }
   void write_snapshot(const std::string&) override {
-    snaps_.write(s_);
+    if (!ranks()) return snaps_.write(s_);
+    std::vector<double> mine, all;
+    const auto layer = s_.layer_flags();
+    for (std::size_t k = 0; k < s_.p.size(); ++k) {
+      s_.p.pack(k, mine);
+      mine.push_back(layer[k]);
+    }
+    dist_->gather(mine, all);
+    if (dist_->rank() != 0) return;
+    Particles p;
+    if (s_.p.has_film()) p.enable_film();
+    std::vector<std::uint8_t> flags;
+    for (std::size_t r = 0; r < all.size();) {
+      r += p.unpack(all.data() + r);
+      flags.push_back(static_cast<std::uint8_t>(all[r++]));
+    }
+    std::vector<uint32_t> by_id(p.size());
+    for (std::size_t k = 0; k < p.size(); ++k) by_id[p.id[k]] = static_cast<uint32_t>(k);
+    p.permute(by_id);
+    std::vector<std::uint8_t> f(flags.size());
+    for (std::size_t k = 0; k < f.size(); ++k) f[k] = flags[by_id[k]];
+    snaps_.write(p, s_.steps, s_.t, f);
   }
   void finish() override {
-    snaps_.close();
+    if (!ranks() || dist_->rank() == 0) snaps_.close();
     s_.update_energies();
   }
 

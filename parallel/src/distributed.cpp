@@ -384,6 +384,29 @@ bool Distributed::migrate(Solver& s) {
 
 Decomposition::Traffic Distributed::traffic() const { return d_->t; }
 
+void Distributed::gather(const std::vector<double>& mine, std::vector<double>& on_root) {
+  Impl& d = *d_;
+  const long long n = static_cast<long long>(mine.size());
+  std::vector<long long> counts(d.size);
+  MPI_Gather(&n, 1, MPI_LONG_LONG, counts.data(), 1, MPI_LONG_LONG, 0, d.comm);
+  long long total = 0;
+  for (long long c : counts) total += c;
+  int too_large = d.rank == 0 && total > 2147483647LL;
+  MPI_Bcast(&too_large, 1, MPI_INT, 0, d.comm);
+  if (too_large)
+    throw std::runtime_error("gathering " + std::to_string(total) + " values on rank 0 needs more "
+                             "than one message can carry (2^31 - 1)");
+  std::vector<int> rc(d.size), disp(d.size);
+  for (int r = 0, at = 0; r < d.size; ++r) {
+    rc[r] = static_cast<int>(counts[r]);
+    disp[r] = at;
+    at += rc[r];
+  }
+  if (d.rank == 0) on_root.resize(static_cast<std::size_t>(total));
+  MPI_Gatherv(mine.data(), static_cast<int>(n), MPI_DOUBLE, on_root.data(), rc.data(), disp.data(),
+              MPI_DOUBLE, 0, d.comm);
+}
+
 void Distributed::sum(double* v, int n) {
   if (d_->size > 1) MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, d_->comm);
 }

@@ -9,6 +9,8 @@
 //   * move the particles that left the slab to the rank that owns them, at the end of the step;
 //   * sum and take maxima of the health checks' reductions over the ranks.
 // The serial solver has none and makes none of these calls.
+#include <vector>
+
 namespace smpm {
 
 class Solver;
@@ -29,6 +31,9 @@ class Decomposition {
   virtual void max(double* v, int n) = 0;
   // Every rank learns whether any rank passed true.
   virtual bool any(bool b) = 0;
+  // Rank 0 receives every rank's `mine`, in rank order (the others receive nothing). Throws
+  // std::runtime_error when the whole is too large for one message (2^31 - 1 doubles).
+  virtual void gather(const std::vector<double>& mine, std::vector<double>& on_root) = 0;
   // This rank's communication so far: seconds in halo sums and in migrations, bytes it sent in
   // halo sums and in migrations, particles it sent.
   struct Traffic {

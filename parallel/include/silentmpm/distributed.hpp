@@ -40,6 +40,7 @@ class Distributed final : public Decomposition {
   void sum(double* v, int n) override;
   void max(double* v, int n) override;
   bool any(bool b) override;
+  void gather(const std::vector<double>& mine, std::vector<double>& on_root) override;
   Traffic traffic() const override;
 
   // The blocks: rank r = b * across() + a owns the whole grid's cells
