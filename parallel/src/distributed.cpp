@@ -340,7 +340,12 @@ bool Distributed::migrate(Solver& s) {
   const int nn = static_cast<int>(d.nbrs.size());
   std::vector<int> to(s.p.size(), -1);
   bool leaving = false;
-  for (std::size_t k = 0; k < s.p.size(); ++k) {
+  // Slabs: the rows the step's moving pass saw tell whether any particle left (no pass over
+  // the particles then).
+  long seen0 = 0, seen1 = -1;
+  if (d.m == 1) s.occupied_rows(seen0, seen1);
+  const bool stayed = d.m == 1 && (seen0 > seen1 || (seen0 >= r0 && seen1 < r1));
+  for (std::size_t k = 0; k < s.p.size() && !stayed; ++k) {
     const int r = s.cell_row(k), c = s.cell_column(k);
     if (r >= r0 && r < r1 && c >= c0 && c < c1) continue;
     const int a = std::clamp(part_of(d.Cx, c + d.gx0), 0, d.m - 1);
