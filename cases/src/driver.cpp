@@ -105,7 +105,11 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
   const int threads = r.get<std::int32_t>("run.threads");
   const bool same_order = region.restore(r);
   if (region.steps() != step) r.fail("step counts disagree (corrupt checkpoint)");
-  if (!same_order || threads != region.threads())
+  if (process_count() > 1)
+    note = "note: continuing on " + std::to_string(process_count()) + " MPI ranks from a checkpoint "
+           "of the whole body, so sums run in another order and the history differs from an "
+           "uninterrupted run in round-off";
+  else if (!same_order || threads != region.threads())
     note = "note: continuing on " + std::to_string(region.threads()) + " thread(s); the checkpoint "
            "was written on " + std::to_string(threads) + ", so sums run in another order and the "
            "history differs from an uninterrupted run in round-off";
@@ -114,8 +118,10 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
 
 // A checkpoint (DIR/checkpoint.smpm); with `failed` (the failure's message) the state of a failed
 // step instead (DIR/failed.smpm), which a restart refuses.
+// Several MPI ranks: every rank takes part (the region gathers the whole body), rank 0 writes.
 void write_checkpoint(const Case& c, const detail::Region& region, const fs::path& dir,
                       HistoryWriter& hist, const std::string& failed = "") {
+  const bool root = process_rank() == 0;
   hist.flush();
   StateWriter w;
   if (!failed.empty()) w.put_string("run.failed", failed);
@@ -125,8 +131,9 @@ void write_checkpoint(const Case& c, const detail::Region& region, const fs::pat
   w.put("run.fingerprint", c.fingerprint);
   w.put("run.step", static_cast<std::int64_t>(region.steps()));
   w.put("run.threads", static_cast<std::int32_t>(region.threads()));
-  w.put_string("run.history", read_whole(dir / "history.csv"));
+  if (root) w.put_string("run.history", read_whole(dir / "history.csv"));
   region.save(w);
+  if (!root) return;
   detail::write_file_atomically(
       dir / (failed.empty() ? checkpoint_file_name() : failed_state_file_name()), w.bytes());
 }
@@ -171,9 +178,6 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
   // alone writes the folder and prints; every rank stops at the same step.
   const int ranks = process_count();
   const bool root = process_rank() == 0;
-  if (ranks > 1 && !opt.restart.empty())
-    throw std::runtime_error("--restart is not yet available on several MPI ranks (" +
-                             std::to_string(ranks) + " here): restart on one process");
   std::string history, note;
   const long first = opt.restart.empty() ? 0 : restore_run(c, region, opt.restart, history, note);
   const bool resuming = !opt.restart.empty();
@@ -188,7 +192,7 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
   } catch (const std::exception& e) {
     throw RunFailure(e.what());
   }
-  if (!note.empty()) std::fprintf(stderr, "%s\n", note.c_str());
+  if (!note.empty() && root) std::fprintf(stderr, "%s\n", note.c_str());
   auto mark = [&](const std::string& why) {
     if (root) mark_incomplete(dir, why);
   };
@@ -253,27 +257,22 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
       if (snap_every && (n % snap_every == 0 || n == nsteps)) region.write_snapshot(out_dir);
       // Several ranks stop together (a launcher passes a signal on to every rank, not at once).
       const bool stop = ranks > 1 ? detail::mpi()->any(g_signal != 0) : g_signal != 0;
-      if (stop && n < nsteps && ranks > 1) {
-        hist.close();
-        region.finish();
-        std::ostringstream why;
-        why << "interrupted by a signal after step " << n << " of " << nsteps << " (t = "
-            << region.time() << " s); no checkpoint (not yet written by several MPI ranks)";
-        mark(why.str());
-        throw RunInterrupted(why.str());
-      }
       if (stop && n < nsteps) {
-        const char* name = g_signal == SIGINT ? "SIGINT" : "SIGTERM";
+        const char* name = g_signal == SIGINT    ? "SIGINT"
+                           : g_signal == SIGTERM ? "SIGTERM"
+                                                 : "a signal to another rank";
         write_checkpoint(c, region, dir, hist);
         hist.close();
         region.finish();
         std::ostringstream why;
         why << "interrupted by " << name << " after step " << n << " of " << nsteps
             << " (t = " << region.time() << " s); checkpoint " << (dir / checkpoint_file_name()).string()
-            << "; continue with: silentmpm run '" << c.source << "' --out '" << out_dir
+            << "; continue with: "
+            << (ranks > 1 ? "mpirun -np " + std::to_string(ranks) + " (or any number of ranks) " : "")
+            << "silentmpm run '" << c.source << "' --out '" << out_dir
             << "' --restart '" << (dir / checkpoint_file_name()).string()
             << "' (and the same --set and --shape options as this run)";
-        mark_incomplete(dir, why.str());
+        mark(why.str());
         throw RunInterrupted(why.str());
       }
       if (checkpoint_due(n, t_before, region.time())) write_checkpoint(c, region, dir, hist);

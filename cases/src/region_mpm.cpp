@@ -21,26 +21,28 @@ class MpmRegion final : public Region {
  public:
   MpmRegion(Case& c, int across)
       : c_(c), s_(*c.solver),
-        whole_{s_.grid.x0, s_.grid.y0, s_.grid.h, s_.grid.nx, s_.grid.ny} {
+        whole_{s_.grid.x0, s_.grid.y0, s_.grid.h, s_.grid.nx, s_.grid.ny}, across_(across) {
     for (const auto& pr : c.probes) {
       pts_.push_back({pr.x, pr.y});
       bodies_.push_back(pr.body);
     }
-    // Under an MPI launcher every rank built the whole case; each keeps its slab.
-    if (const MpiModule* m = mpi()) {
-      if (m->size() > 1) {
-        auto refuse = [&](const std::string& what) {
-          throw std::runtime_error(what + " is not yet available on several MPI ranks (" +
-                                   std::to_string(m->size()) + " here): run the case on one "
-                                   "process, or without it");
-        };
-        if (c.output.snapshots > 0 && c.output.grid) refuse("output.grid");
-        if (c.output.checkpoint_every > 0 || c.output.checkpoint_time > 0)
-          refuse("output.checkpoint_every / checkpoint_time");
-        if (s_.contact.multi()) refuse("multi-field contact");
-      }
-      dist_ = m->distribute(s_, across);
+    // Under an MPI launcher every rank built the whole case; each keeps its block (split(),
+    // after a restart has loaded the whole body's state).
+    if (const MpiModule* m = mpi(); m && m->size() > 1) {
+      auto refuse = [&](const std::string& what) {
+        throw std::runtime_error(what + " is not yet available on several MPI ranks (" +
+                                 std::to_string(m->size()) + " here): run the case on one "
+                                 "process, or without it");
+      };
+      if (c.output.snapshots > 0 && c.output.grid) refuse("output.grid");
+      if (s_.contact.multi()) refuse("multi-field contact");
     }
+  }
+
+  // Cuts the solver to this rank's block, once (under an MPI launcher).
+  void split() const {
+    if (dist_ || !mpi()) return;
+    dist_ = mpi()->distribute(s_, across_);
   }
 
   double dt() const override { return s_.dt; }
@@ -50,9 +52,13 @@ class MpmRegion final : public Region {
   int threads() const override { return s_.thread_count(); }
   long steps() const override { return s_.steps; }
 
-  void step() override { s_.step(); }
+  void step() override {
+    split();
+    s_.step();
+  }
 
   void record(std::vector<double>& row) override {
+    split();
     auto samples = s_.sample(pts_, bodies_);
     s_.update_energies();
     std::size_t k = 0;
@@ -68,22 +74,39 @@ class MpmRegion final : public Region {
                                std::to_string(s_.t) + " s): energy is not finite; reduce time.dt");
   }
 
+  // Several ranks write one checkpoint of the whole body (rank 0 writes it), which a restart
+  // on any number of ranks, or on one process, reads whole before it splits.
   void save(StateWriter& w) const override {
-    s_.save_state(w, "mpm.");
+    split();
+    if (ranks()) s_.save_state_gathered(w, "mpm.");
+    else s_.save_state(w, "mpm.");
     snaps_.save(w);
   }
   bool restore(const StateReader& r) override {
     snaps_.restore(r);
-    return s_.load_state(r, "mpm.");
+    const bool same_order = s_.load_state(r, "mpm.");
+    if (!mpi()) return same_order;
+    const Energies e = s_.energy;
+    split();
+    // The account's booked terms stay with rank 0; every rank's kinetic and elastic energy are
+    // its particles'.
+    const bool root = dist_->rank() == 0;
+    s_.energy.initial = root ? e.initial : 0.0;
+    s_.energy.dissipated = root ? e.dissipated : 0.0;
+    s_.energy.absorbed = root ? e.absorbed : 0.0;
+    s_.energy.external_work = root ? e.external_work : 0.0;
+    return false;  // the particles were re-cut into blocks and re-sorted
   }
 
   // Several ranks: rank 0 writes the snapshots of every rank's particles, gathered (in the
   // order of their ids).
   bool ranks() const { return dist_ && dist_->size() > 1; }
   void open_snapshots(const std::string& out_dir) override {
+    split();
     if (!ranks() || dist_->rank() == 0) snaps_.open(s_, c_.output, out_dir);
   }
   void write_snapshot(const std::string&) override {
+    split();
     if (!ranks()) return snaps_.write(s_);
     std::vector<double> mine, all;
     const auto layer = s_.layer_flags();
@@ -108,11 +131,13 @@ class MpmRegion final : public Region {
     snaps_.write(p, s_.steps, s_.t, f);
   }
   void finish() override {
+    split();
     if (!ranks() || dist_->rank() == 0) snaps_.close();
     s_.update_energies();
   }
 
   void rates(RunResult& r, long steps_run, double step_seconds) const override {
+    split();
     r.particles = static_cast<std::size_t>(total(static_cast<double>(s_.p.size())));
     r.particle_updates_per_second =
         static_cast<double>(r.particles) * steps_run / std::max(step_seconds, 1e-12);
@@ -173,7 +198,8 @@ class MpmRegion final : public Region {
     double x0, y0, h;
     int nx, ny;
   } whole_;
-  std::unique_ptr<Decomposition> dist_;
+  int across_ = 0;
+  mutable std::unique_ptr<Decomposition> dist_;
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
   MpmSnapshots snaps_;

@@ -23,6 +23,33 @@ void particle_arrays(P& p, Fn&& fn) {
   fn("dttf", p.dttf); fn("jump_n", p.jump_n); fn("jump_t", p.jump_t); fn("ubar", p.ubar);
 }
 
+// A gathered checkpoint (save_state_gathered) lists a layer's entries by particle id
+// (NAME.ids), in another order than this solver's: its arrays (value, stride) are put in this
+// solver's entry order. The ids must be exactly the layer's.
+void reorder_by_ids(const StateReader& r, const std::string& name, const BoundaryLayer& L,
+                    std::size_t n, std::vector<std::pair<std::vector<double>*, int>> arrays) {
+  const std::size_t m = L.ids.size();
+  std::vector<std::uint32_t> ids;
+  r.get(name + ".ids", ids, m);
+  std::vector<long> at(n, -1);
+  for (std::size_t q = 0; q < m; ++q)
+    if (L.ids[q] < n) at[L.ids[q]] = static_cast<long>(q);
+  std::vector<std::uint8_t> hit(m, 0);
+  std::vector<long> to(m);
+  for (std::size_t q = 0; q < m; ++q) {
+    if (ids[q] >= n || at[ids[q]] < 0 || hit[at[ids[q]]]++)
+      r.fail(name + ": its entries are not this case's layer particles (a checkpoint of another "
+                    "case)");
+    to[q] = at[ids[q]];
+  }
+  for (auto& [v, st] : arrays) {
+    std::vector<double> out(v->size());
+    for (std::size_t q = 0; q < m; ++q)
+      std::copy_n(v->begin() + st * q, st, out.begin() + st * to[q]);
+    v->swap(out);
+  }
+}
+
 }  // namespace
 
 void Solver::save_state(StateWriter& w, const std::string& pre) const {
@@ -55,6 +82,87 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   w.put(pre + "field_boxes", boxes);
 }
 
+void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
+  // Every particle's record with, per layer that carries state, its entry's values.
+  std::vector<double> mine, all;
+  std::vector<std::vector<std::pair<std::size_t, int>>> entries(p.size());  // (layer, entry)
+  for (std::size_t k = 0; k < silents.size(); ++k)
+    if (silents[k].springs())
+      for (std::size_t q = 0; q < silents[k].layer.idx.size(); ++q)
+        entries[silents[k].layer.idx[q]].push_back({k, static_cast<int>(q)});
+  const std::size_t pml_tag = silents.size();
+  for (std::size_t q = 0; q < pml.layer.idx.size(); ++q)
+    entries[pml.layer.idx[q]].push_back({pml_tag, static_cast<int>(q)});
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    p.pack(k, mine);
+    mine.push_back(static_cast<double>(entries[k].size()));
+    for (const auto& [l, q] : entries[k]) {
+      mine.push_back(static_cast<double>(l));
+      if (l < pml_tag) {
+        mine.push_back(silents[l].ux[q]);
+        mine.push_back(silents[l].uy[q]);
+      } else {
+        for (const auto* v : {&pml.H, &pml.xi, &pml.zeta}) mine.insert(mine.end(), v->begin() + 4 * q, v->begin() + 4 * q + 4);
+        mine.insert(mine.end(), pml.u.begin() + 2 * q, pml.u.begin() + 2 * q + 2);
+      }
+    }
+  }
+  const Energies e = total_energy();
+  if (!dist_) all = mine;
+  else dist_->gather(mine, all);
+  if (dist_ && dist_->rank() != 0) return;
+  Particles q;
+  if (p.has_film()) q.enable_film();
+  std::vector<std::vector<double>> ux(silents.size()), uy(silents.size());
+  std::vector<std::vector<std::uint32_t>> sids(silents.size());
+  std::vector<double> H, xi, zeta, u;
+  std::vector<std::uint32_t> pids;
+  for (std::size_t r = 0; r < all.size();) {
+    r += q.unpack(all.data() + r);
+    const std::uint32_t id = q.id.back();
+    const auto ne = static_cast<std::size_t>(all[r++]);
+    for (std::size_t k = 0; k < ne; ++k) {
+      const auto l = static_cast<std::size_t>(all[r++]);
+      if (l < pml_tag) {
+        sids[l].push_back(id);
+        ux[l].push_back(all[r++]);
+        uy[l].push_back(all[r++]);
+      } else {
+        pids.push_back(id);
+        for (auto* v : {&H, &xi, &zeta}) v->insert(v->end(), all.begin() + r, all.begin() + r + 4), r += 4;
+        u.insert(u.end(), all.begin() + r, all.begin() + r + 2);
+        r += 2;
+      }
+    }
+  }
+  std::vector<std::uint32_t> by_id(q.size());
+  for (std::size_t k = 0; k < q.size(); ++k) by_id[q.id[k]] = static_cast<std::uint32_t>(k);
+  q.permute(by_id);
+  w.put(pre + "dt", dt);
+  w.put(pre + "t", t);
+  w.put(pre + "steps", static_cast<std::int64_t>(steps));
+  w.put(pre + "energy", e);
+  w.put(pre + "contact_dissipated", contact.dissipated);
+  w.put(pre + "film", static_cast<std::uint8_t>(q.has_film()));
+  particle_arrays(q, [&](const char* n, const auto& v) { w.put(pre + "p." + n, v); });
+  for (std::size_t k = 0; k < silents.size(); ++k) {
+    if (!silents[k].springs()) continue;
+    w.put(pre + "silent" + std::to_string(k) + ".ids", sids[k]);
+    w.put(pre + "silent" + std::to_string(k) + ".ux", ux[k]);
+    w.put(pre + "silent" + std::to_string(k) + ".uy", uy[k]);
+  }
+  if (!pml_bands.empty()) {
+    w.put(pre + "pml.ids", pids);
+    w.put(pre + "pml.H", H);
+    w.put(pre + "pml.u", u);
+    w.put(pre + "pml.xi", xi);
+    w.put(pre + "pml.zeta", zeta);
+  }
+  w.put(pre + "strips", static_cast<std::int32_t>(0));  // no strips: the reader re-sorts
+  w.put(pre + "ranges", std::vector<std::uint32_t>{});
+  w.put(pre + "field_boxes", std::vector<std::int32_t>{});
+}
+
 bool Solver::load_state(const StateReader& r, const std::string& pre) {
   const std::size_t n = p.size();
   if (r.get<std::uint8_t>(pre + "film") != static_cast<std::uint8_t>(p.has_film()))
@@ -64,8 +172,11 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
   for (std::size_t k = 0; k < silents.size(); ++k) {
     if (!silents[k].springs()) continue;
     const std::size_t m = silents[k].layer.ids.size();
-    r.get(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux, m);
-    r.get(pre + "silent" + std::to_string(k) + ".uy", silents[k].uy, m);
+    const std::string name = pre + "silent" + std::to_string(k);
+    r.get(name + ".ux", silents[k].ux, m);
+    r.get(name + ".uy", silents[k].uy, m);
+    if (r.has(name + ".ids"))
+      reorder_by_ids(r, name, silents[k].layer, n, {{&silents[k].ux, 1}, {&silents[k].uy, 1}});
   }
   if (pml.active()) {
     const std::size_t m = pml.layer.ids.size();
@@ -73,6 +184,9 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
     r.get(pre + "pml.u", pml.u, 2 * m);
     r.get(pre + "pml.xi", pml.xi, 4 * m);
     r.get(pre + "pml.zeta", pml.zeta, 4 * m);
+    if (r.has(pre + "pml.ids"))
+      reorder_by_ids(r, pre + "pml", pml.layer, n,
+                     {{&pml.H, 4}, {&pml.u, 2}, {&pml.xi, 4}, {&pml.zeta, 4}});
   }
   const double dt_saved = r.get<double>(pre + "dt");
   if (dt_saved != dt)

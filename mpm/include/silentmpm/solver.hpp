@@ -195,6 +195,11 @@ class Solver {
   // the checkpoint was cut into another number of strips (another thread count): the particles
   // are then re-sorted, and sums over them run in another order. Throws StateError.
   bool load_state(const StateReader& r, const std::string& prefix);
+  // Split over ranks: every rank takes part, rank 0 writes into w the state of the whole body in
+  // save_state's form (particles in the order of their ids, layer data with its particles' ids,
+  // the energy account summed, no strips: a restart re-sorts), which load_state reads into a
+  // solver built whole, on one process or before it is split again.
+  void save_state_gathered(StateWriter& w, const std::string& prefix) const;
 
  private:
   int nthreads_ = 1;
