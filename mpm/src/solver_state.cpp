@@ -50,16 +50,22 @@ void reorder_by_ids(const StateReader& r, const std::string& name, const Boundar
   }
 }
 
-}  // namespace
-
-void Solver::save_state(StateWriter& w, const std::string& pre) const {
+// The clock, the energy account and the particles' arrays: the head of a solver's state.
+void put_head(StateWriter& w, const std::string& pre, double dt, double t, long steps,
+              const Energies& e, double contact_dissipated, const Particles& p) {
   w.put(pre + "dt", dt);
   w.put(pre + "t", t);
   w.put(pre + "steps", static_cast<std::int64_t>(steps));
-  w.put(pre + "energy", energy);
-  w.put(pre + "contact_dissipated", contact.dissipated);
+  w.put(pre + "energy", e);
+  w.put(pre + "contact_dissipated", contact_dissipated);
   w.put(pre + "film", static_cast<std::uint8_t>(p.has_film()));
   particle_arrays(p, [&](const char* n, const auto& v) { w.put(pre + "p." + n, v); });
+}
+
+}  // namespace
+
+void Solver::save_state(StateWriter& w, const std::string& pre) const {
+  put_head(w, pre, dt, t, steps, energy, contact.dissipated, p);
   for (std::size_t k = 0; k < silents.size(); ++k) {
     if (!silents[k].springs()) continue;
     w.put(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux);
@@ -138,13 +144,7 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
   std::vector<std::uint32_t> by_id(q.size());
   for (std::size_t k = 0; k < q.size(); ++k) by_id[q.id[k]] = static_cast<std::uint32_t>(k);
   q.permute(by_id);
-  w.put(pre + "dt", dt);
-  w.put(pre + "t", t);
-  w.put(pre + "steps", static_cast<std::int64_t>(steps));
-  w.put(pre + "energy", e);
-  w.put(pre + "contact_dissipated", contact.dissipated);
-  w.put(pre + "film", static_cast<std::uint8_t>(q.has_film()));
-  particle_arrays(q, [&](const char* n, const auto& v) { w.put(pre + "p." + n, v); });
+  put_head(w, pre, dt, t, steps, e, contact.dissipated, q);
   for (std::size_t k = 0; k < silents.size(); ++k) {
     if (!silents[k].springs()) continue;
     w.put(pre + "silent" + std::to_string(k) + ".ids", sids[k]);

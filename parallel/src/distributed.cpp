@@ -418,10 +418,5 @@ void Distributed::sum(double* v, int n) {
 void Distributed::max(double* v, int n) {
   if (d_->size > 1) MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, d_->comm);
 }
-bool Distributed::any(bool b) {
-  int v = b ? 1 : 0;
-  if (d_->size > 1) MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_LOR, d_->comm);
-  return v != 0;
-}
 
 }  // namespace smpm

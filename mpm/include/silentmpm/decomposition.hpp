@@ -29,8 +29,6 @@ class Decomposition {
   // In place over the ranks.
   virtual void sum(double* v, int n) = 0;
   virtual void max(double* v, int n) = 0;
-  // Every rank learns whether any rank passed true.
-  virtual bool any(bool b) = 0;
   // Rank 0 receives every rank's `mine`, in rank order (the others receive nothing). Throws
   // std::runtime_error when the whole is too large for one message (2^31 - 1 doubles).
   virtual void gather(const std::vector<double>& mine, std::vector<double>& on_root) = 0;

@@ -39,7 +39,6 @@ class Distributed final : public Decomposition {
   bool migrate(Solver& s) override;
   void sum(double* v, int n) override;
   void max(double* v, int n) override;
-  bool any(bool b) override;
   void gather(const std::vector<double>& mine, std::vector<double>& on_root) override;
   Traffic traffic() const override;
 
