@@ -35,7 +35,6 @@ class MpmRegion final : public Region {
                                  "process, or without it");
       };
       if (c.output.snapshots > 0 && c.output.grid) refuse("output.grid");
-      if (s_.contact.multi()) refuse("multi-field contact");
     }
   }
 

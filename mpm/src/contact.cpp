@@ -62,12 +62,16 @@ void Contact::setup(Solver& s) {
   body_of_group_.assign(s.materials.size(), 0);
   for (std::size_t g = 0; g < G0; ++g) body_of_group_[g] = std::max(owner[g], 0);
   for (const auto& [gb, g] : split) body_of_group_[g] = gb.second;
+  force.assign(nb_, {0.0, 0.0});
+  dissipated = 0;
+  resize(s);
+}
+
+void Contact::resize(Solver& s) {
   const std::size_t n = s.grid.nodes();
   for (Field* f : {&m_, &px_, &py_, &fx_, &fy_, &gx_, &gy_, &vx_, &vy_, &vnx_, &vny_, &qx_, &qy_,
                    &xm_, &ym_, &sm_})
     f->assign(nb_, std::vector<double>(n, 0.0));
-  force.assign(nb_, {0.0, 0.0});
-  dissipated = 0;
   std::vector<NodalField> f(nb_);
   for (int b = 0; b < nb_; ++b)
     f[b] = NodalField{m_[b].data(),  px_[b].data(),  py_[b].data(),  fx_[b].data(),
@@ -226,7 +230,7 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
       }
       if (g.fix[i] & 1) ex = 0;
       if (g.fix[i] & 2) ey = 0;
-      if (count) {
+      if (count && s.owns_node(i)) {  // a node that ranks share is counted by its owner
         // Work of the impulse on the corrected velocity: zero for the normal part (the pair
         // moves together along n afterwards), impulse times remaining slip for friction.
         const double ax = vx[b][i] + ex, ay = vy[b][i] + ey;

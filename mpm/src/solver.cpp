@@ -1201,9 +1201,10 @@ void Solver::step_with() {
   switch (sc) {
     case Scheme::MUSL:
       g2p<S>(true, false);
-      if (dist_) {
-        double* q[2] = {grid.qx.data(), grid.qy.data()};
-        dist_->sum_halo(q, 2);
+      if (dist_) {  // every field's re-mapped momenta
+        std::vector<double*> q;
+        for (const VelocityField& F : fields_) q.insert(q.end(), {F.f.qx, F.f.qy});
+        dist_->sum_halo(q.data(), static_cast<int>(q.size()));
       }
       call([&](StepHooks& h) { h.after_remap(*this); });
       remapped_velocities();
@@ -1489,18 +1490,20 @@ ProbeSample Solver::region_mean(double x0, double y0, double x1, double y1, int 
     sxy += vk * p.sxy[k];
     j2 += vk * j2_of(p.sxx[k], p.syy[k], p.szz[k], p.sxy[k]);
   }
-  if (dist_) {
-    double s[9] = {m, v, px, py, sxx, syy, szz, sxy, j2};
-    dist_->sum(s, 9);
+  const bool has_force = body >= 0 && static_cast<std::size_t>(body) < contact.force.size();
+  double fc[2] = {has_force ? contact.force[body][0] : 0.0, has_force ? contact.force[body][1] : 0.0};
+  if (dist_) {  // each rank's own contact nodes' part of the force
+    double s[11] = {m, v, px, py, sxx, syy, szz, sxy, j2, fc[0], fc[1]};
+    dist_->sum(s, 11);
     m = s[0], v = s[1], px = s[2], py = s[3], sxx = s[4], syy = s[5], szz = s[6], sxy = s[7];
-    j2 = s[8];
+    j2 = s[8], fc[0] = s[9], fc[1] = s[10];
   }
   ProbeSample out;
   if (!(m > 0 && v > 0)) return out;
   out.valid = true;
-  if (body >= 0 && static_cast<std::size_t>(body) < contact.force.size()) {
-    out.fcx = contact.force[body][0];
-    out.fcy = contact.force[body][1];
+  if (has_force) {
+    out.fcx = fc[0];
+    out.fcy = fc[1];
   }
   out.px = px;
   out.py = py;

@@ -55,39 +55,63 @@ void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool das
   strips_ok_ = false;
 }
 
-// After the last particle was mapped: masses and momenta (unless summed already, USF), forces
-// and dashpot blocks. A node whose block only a neighbour assembled is listed here, so that the
-// grid update integrates it like the others.
-void Solver::sum_halo(bool momentum, bool force) {
-  double* f[8];
-  int n = 0;
-  if (momentum)
-    for (auto* v : {&grid.m, &grid.px, &grid.py}) f[n++] = v->data();
-  if (force) {
-    for (auto* v : {&grid.fx, &grid.fy}) f[n++] = v->data();
-    if (halo_dashpots_)
-      for (auto* v : {&grid.cxx, &grid.cxy, &grid.cyy}) f[n++] = v->data();
-  }
-  dist_->sum_halo(f, n);
-  if (!force || !halo_dashpots_) return;
-  if (dashpot_mark_.size() != grid.nodes()) dashpot_mark_.assign(grid.nodes(), 0);
-  auto scan = [&](long i) {
-    if (grid.cxx[i] != 0 || grid.cxy[i] != 0 || grid.cyy[i] != 0) {
-      add_dashpot_node(i);
-      has_nodal_dashpot_ = true;
-    }
-  };
-  // The shared nodes: those of the window within the halo's width of this rank's box's edges
-  // (inside it or beyond).
-  const long nnx = grid.nnx, w = halo_;
-  for (long j = 0; j < grid.nny; ++j) {
-    if (j < own_[2] + w || j > own_[3] - w) {
-      for (long i = 0; i < nnx; ++i) scan(j * nnx + i);
+// fn(i) for every node of the window within the halo's width of this rank's box's edges (inside
+// it or beyond): the nodes ranks share.
+template <class Fn>
+static void for_shared_nodes(const Grid& g, const NodeBox& own, long w, Fn&& fn) {
+  const long nnx = g.nnx;
+  for (long j = 0; j < g.nny; ++j) {
+    if (j < own[2] + w || j > own[3] - w) {
+      for (long i = 0; i < nnx; ++i) fn(i, j);
       continue;
     }
-    for (long i = 0; i < std::min<long>(nnx, own_[0] + w); ++i) scan(j * nnx + i);
-    for (long i = std::max<long>(own_[0] + w, own_[1] - w + 1); i < nnx; ++i) scan(j * nnx + i);
+    for (long i = 0; i < std::min<long>(nnx, own[0] + w); ++i) fn(i, j);
+    for (long i = std::max<long>(own[0] + w, own[1] - w + 1); i < nnx; ++i) fn(i, j);
   }
+}
+
+// After the last particle was mapped: masses and momenta (momentum: after the momentum p2g),
+// forces and dashpot blocks (force: after the loads). The bodies' fields of multi-field contact
+// too: their masses, momenta, mass gradients and centroid sums with the momenta, their forces
+// with the momenta where that p2g formed them (USL, MUSL) and with the loads under USF; a body's
+// node box then grows to the shared nodes where it now has mass. A node whose dashpot block
+// only a neighbour assembled is listed here, so that the grid update integrates it like the
+// others.
+void Solver::sum_halo(bool momentum, bool force) {
+  std::vector<double*> f;
+  const bool usf = opt.scheme == Scheme::USF;
+  if (momentum)
+    for (auto* v : {&grid.m, &grid.px, &grid.py}) f.push_back(v->data());
+  if (force) {
+    for (auto* v : {&grid.fx, &grid.fy}) f.push_back(v->data());
+    if (halo_dashpots_)
+      for (auto* v : {&grid.cxx, &grid.cxy, &grid.cyy}) f.push_back(v->data());
+  }
+  const bool bodies = !body_of_group_.empty();
+  if (bodies)
+    for (const VelocityField& F : fields_) {
+      const NodalField& b = F.f;
+      if (momentum) f.insert(f.end(), {b.m, b.px, b.py, b.gx, b.gy, b.xm, b.ym, b.sm});
+      if ((momentum && !usf) || (force && usf)) f.insert(f.end(), {b.fx, b.fy});
+    }
+  dist_->sum_halo(f.data(), static_cast<int>(f.size()));
+  if (bodies && momentum)
+    for (VelocityField& F : fields_)
+      for_shared_nodes(grid, own_, halo_, [&](long i, long j) {
+        if (F.f.m[j * grid.nnx + i] == 0) return;
+        NodeBox& x = F.box;
+        x = {std::min<int>(x[0], i), std::max<int>(x[1], i), std::min<int>(x[2], j),
+             std::max<int>(x[3], j)};
+      });
+  if (!force || !halo_dashpots_) return;
+  if (dashpot_mark_.size() != grid.nodes()) dashpot_mark_.assign(grid.nodes(), 0);
+  for_shared_nodes(grid, own_, halo_, [&](long i, long j) {
+    const long n = j * grid.nnx + i;
+    if (grid.cxx[n] != 0 || grid.cxy[n] != 0 || grid.cyy[n] != 0) {
+      add_dashpot_node(n);
+      has_nodal_dashpot_ = true;
+    }
+  });
 }
 
 void Solver::keep_particles(const std::vector<std::uint8_t>& keep) {

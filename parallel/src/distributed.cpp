@@ -172,8 +172,6 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across) : d_(std::make_un
   d.comm = comm;
   MPI_Comm_rank(comm, &d.rank);
   MPI_Comm_size(comm, &d.size);
-  if (s.contact.multi())
-    throw std::runtime_error("multi-field contact does not run on several MPI ranks yet");
   const Grid& g = s.grid;
   const int P = d.size;
   d.nnx = g.nnx;
@@ -273,6 +271,7 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across) : d_(std::make_un
     std::copy_n(g.fix.begin() + static_cast<long>(d.gy0 + j) * d.nnx + d.gx0, d.gnx,
                 win.fix.begin() + static_cast<long>(j) * d.gnx);
   s.grid = std::move(win);
+  if (s.contact.multi()) s.contact.resize(s);  // the bodies' fields over the window
   s.keep_particles(keep);
   const NodeBox own{static_cast<int>(xs - gxs), static_cast<int>(xs + xm - 1 - gxs),
                     static_cast<int>(ys - gys), static_cast<int>(ys + ym - 1 - gys)};

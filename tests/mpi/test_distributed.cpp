@@ -224,7 +224,8 @@ Outcome run_serial(const PlateSpec& c, int steps) {
   return {gather_serial(*s), s->energy, 0, layer_entries(*s)};
 }
 
-void expect_agreement(const Outcome& d, const Outcome& s, const std::string& what) {
+void expect_agreement(const Outcome& d, const Outcome& s, const std::string& what,
+                      double bound = 1e-12) {
   const auto diff = differences(d.f, s.f);
   const double de = energy_difference(d.e, s.e);
   if (ranks() == 1) {  // the same operations in the same order
@@ -232,8 +233,8 @@ void expect_agreement(const Outcome& d, const Outcome& s, const std::string& wha
     EXPECT_EQ(de, 0.0) << what << ": energies";
     return;
   }
-  for (int q = 0; q < 8; ++q) EXPECT_LE(diff[q], 1e-12) << what << ": field " << q;
-  EXPECT_LE(de, 1e-12) << what << ": energies";
+  for (int q = 0; q < 8; ++q) EXPECT_LE(diff[q], bound) << what << ": field " << q;
+  EXPECT_LE(de, bound) << what << ": energies";
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   if (rank == 0)
@@ -345,6 +346,64 @@ TEST(Ranks, MigrationKeepsIdsCountsAndLayers) {
         MPI_Comm_rank(MPI_COMM_WORLD, &rank);
         if (rank == 0) std::printf("%s: %ld particles moved between ranks\n", what.c_str(), d.sent);
       }
+    }
+  }
+}
+
+// Multi-field contact with friction: a block thrown down and sideways onto a plate; the
+// contact nodes lie on and across the borders (their bodies' fields are summed over the halo,
+// their impulses counted by the nodes' owners). Against one process within 1e-10 (fields and
+// energies), and the contact force on the block (a region probe of body 1) within 1e-10 of its
+// largest value. The bound is wider than the plate's: at a contact node the lighter body often
+// holds a sliver of mass, whose velocity p / m magnifies the order of the additions; measured
+// 1e-14 under MUSL and USF, 3e-12 to 4e-12 under USL, which strains the particles with those
+// nodes' updated velocities.
+std::unique_ptr<Solver> make_contact(Scheme sc) {
+  const double h = 1e-3;
+  auto s = std::make_unique<Solver>();
+  s->materials.push_back(tungsten());
+  s->materials.push_back(tungsten());
+  s->grid.init(-3 * h, -3 * h, h, 36, 36);
+  s->seed_rectangle(0, 0, 30 * h, 12 * h, 2, 0, 0, 0, 0);
+  s->seed_rectangle(8 * h, 12.25 * h, 22 * h, 26 * h, 2, 1, 1, 20, -100);
+  s->contact.type = ContactType::Multi;
+  s->contact.friction = 0.3;
+  s->opt.scheme = sc;
+  s->opt.threads = 1;
+  s->dt = 0.3 * h / s->materials[0].cd;
+  s->finalize();
+  return s;
+}
+
+TEST(Ranks, MultiFieldContactAgreesWithOneProcess) {
+  for (Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF}) {
+    const int steps = 250;
+    auto ref = make_contact(sc);
+    double fmax = 0;
+    std::vector<std::array<double, 2>> fs;
+    for (int n = 0; n < steps; ++n) {
+      ref->step();
+      const ProbeSample q = ref->region_mean(-1, -1, 1, 1, 1);
+      fs.push_back({q.fcx, q.fcy});
+      fmax = std::max({fmax, std::abs(q.fcx), std::abs(q.fcy)});
+    }
+    ref->update_energies();
+    const Outcome s{gather_serial(*ref), ref->energy, 0, 0};
+    EXPECT_GT(fmax, 0) << "the bodies met";
+    for (int a : layouts()) {
+      auto d = make_contact(sc);
+      Distributed dist(*d, MPI_COMM_WORLD, a);
+      double df = 0;
+      for (int n = 0; n < steps; ++n) {
+        d->step();
+        const ProbeSample q = d->region_mean(-1, -1, 1, 1, 1);
+        df = std::max({df, std::abs(q.fcx - fs[n][0]), std::abs(q.fcy - fs[n][1])});
+      }
+      d->update_energies();
+      const Outcome o{gather(*d), d->total_energy(), 0, 0};
+      const std::string what = std::string("contact, ") + scheme_name(sc) + ", " + layout_name(a);
+      expect_agreement(o, s, what, 1e-10);
+      EXPECT_LE(df, 1e-10 * fmax) << what << ": contact force";
     }
   }
 }

@@ -87,6 +87,9 @@ class Contact : public StepHooks {
   // particles of one body (a body's particles then form contiguous ranges), sizes the fields and
   // hands them to the solver (Solver::use_body_fields).
   void setup(Solver& s);
+  // Sizes the bodies' fields to the solver's grid and hands them to it: by setup, and again
+  // when a decomposition replaced the grid by a window of it.
+  void resize(Solver& s);
 
   // The hooks of the multi mode.
   void after_momentum(Solver& s) override;     // contact nodes

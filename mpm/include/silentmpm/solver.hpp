@@ -179,6 +179,12 @@ class Solver {
   void sort_particles();
   // The energy account over every rank (this rank's own without a decomposition).
   Energies total_energy() const;
+  // Whether node i of this solver's grid is this rank's own (every node without a decomposition).
+  bool owns_node(long i) const {
+    if (own_[1] < own_[0]) return true;
+    const long ii = i % grid.nnx, jj = i / grid.nnx;
+    return ii >= own_[0] && ii <= own_[1] && jj >= own_[2] && jj <= own_[3];
+  }
   // The cell row and column of a particle in this solver's grid.
   int cell_row(std::size_t k) const {
     return static_cast<int>(std::floor((p.y[k] - grid.y0) * grid.inv_h));

@@ -25,9 +25,8 @@ class Distributed final : public Decomposition {
   // Cuts a finalized solver, on which every rank of comm built the whole case, to this rank's
   // block and attaches itself to it (it must outlive the solver's steps). `across`: ranks
   // across x (1: slabs of rows; 0: the layout with the fewest shared nodes). Throws
-  // std::runtime_error, on every rank, when the ranks do not divide by `across`, the grid has
-  // fewer cells than the blocks need (the halo's width each way) or the case uses what the
-  // ranks cannot share yet (multi-field contact).
+  // std::runtime_error, on every rank, when the ranks do not divide by `across` or the grid has
+  // fewer cells than the blocks need (the halo's width each way).
   Distributed(Solver& s, MPI_Comm comm, int across = 0);
   ~Distributed() override;
   Distributed(const Distributed&) = delete;
