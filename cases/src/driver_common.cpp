@@ -88,6 +88,13 @@ void SnapshotList::open(SnapshotWriter& w, const std::string& out_dir) const {
 
 void GridSnapshots::open(const Solver& s, const std::string& out_dir, int compression,
                          const std::vector<double>& earlier) {
+  const Grid& g = s.grid;
+  open(g.x0, g.y0, g.h, g.nx, g.ny, out_dir, compression, earlier);
+}
+
+void GridSnapshots::open(double x0, double y0, double h, int nx, int ny,
+                         const std::string& out_dir, int compression,
+                         const std::vector<double>& earlier) {
   w_.set_compression(compression);
   if (!earlier.empty() && w_.resume(out_dir, "grid", earlier) == static_cast<int>(earlier.size()))
     return;
@@ -95,26 +102,27 @@ void GridSnapshots::open(const Solver& s, const std::string& out_dir, int compre
     std::fprintf(stderr, "note: %s/grid.h5 does not hold the %zu snapshot(s) written before the "
                          "checkpoint; grid.xdmf lists the snapshots from the restart on\n",
                  out_dir.c_str(), earlier.size());
-  const Grid& g = s.grid;
-  std::vector<double> xyz(3 * g.nodes());
-  for (int j = 0; j < g.nny; ++j)
-    for (int i = 0; i < g.nnx; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * g.nnx + i;
-      xyz[3 * k] = g.node_x(i);
-      xyz[3 * k + 1] = g.node_y(j);
+  const int nnx = nx + 1, nny = ny + 1;
+  std::vector<double> xyz(3 * static_cast<std::size_t>(nnx) * nny);
+  for (int j = 0; j < nny; ++j)
+    for (int i = 0; i < nnx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * nnx + i;
+      xyz[3 * k] = x0 + i * h;
+      xyz[3 * k + 1] = y0 + j * h;
     }
   std::vector<std::int64_t> cells;
-  cells.reserve(4 * static_cast<std::size_t>(g.nx) * g.ny);
-  for (int j = 0; j < g.ny; ++j)
-    for (int i = 0; i < g.nx; ++i) {
-      const std::int64_t n0 = static_cast<std::int64_t>(j) * g.nnx + i;
-      cells.insert(cells.end(), {n0, n0 + 1, n0 + 1 + g.nnx, n0 + g.nnx});  // counter-clockwise
+  cells.reserve(4 * static_cast<std::size_t>(nx) * ny);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const std::int64_t n0 = static_cast<std::int64_t>(j) * nnx + i;
+      cells.insert(cells.end(), {n0, n0 + 1, n0 + 1 + nnx, n0 + nnx});  // counter-clockwise
     }
-  w_.open(out_dir, "grid", xyz, cells, std::vector<std::int32_t>(static_cast<std::size_t>(g.nx) * g.ny, 0));
+  w_.open(out_dir, "grid", xyz, cells, std::vector<std::int32_t>(static_cast<std::size_t>(nx) * ny, 0));
 }
 
-void GridSnapshots::write(const Solver& s) {
-  const Solver::NodalProjection P = s.nodal_projection();
+void GridSnapshots::write(const Solver& s) { write(s.t, s.nodal_projection()); }
+
+void GridSnapshots::write(double t, const Solver::NodalProjection& P) {
   const std::size_t n = P.mass.size();
   std::vector<double> v(3 * n, 0.0), sig(9 * n, 0.0), j2(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -124,7 +132,7 @@ void GridSnapshots::write(const Solver& s) {
     t[0] = P.sxx[i]; t[1] = t[3] = P.sxy[i]; t[4] = P.syy[i]; t[8] = P.szz[i];
     j2[i] = j2_of(P.sxx[i], P.syy[i], P.szz[i], P.sxy[i]);
   }
-  w_.write(s.t, {{"mass", 1, "kg/m", P.mass.data()},
+  w_.write(t, {{"mass", 1, "kg/m", P.mass.data()},
                  {"velocity", 3, "m/s", v.data()},
                  {"stress", 9, "Pa", sig.data()},
                  {"J2", 1, "Pa^2", j2.data()}});
@@ -144,9 +152,19 @@ void MpmSnapshots::write(const Solver& s) {
   if (grid_on_) grid_.write(s);
 }
 
+void MpmSnapshots::open(const OutputSpec& out, const std::string& out_dir, double x0, double y0,
+                        double h, int nx, int ny) {
+  snap_.set_fields(out.fields);
+  snap_.set_compression(out.compression);
+  earlier_.open(snap_, out_dir);
+  grid_on_ = out.grid;
+  if (grid_on_) grid_.open(x0, y0, h, nx, ny, out_dir, out.compression, earlier_.times);
+}
+
 void MpmSnapshots::write(const Particles& p, long step, double time,
-                         const std::vector<std::uint8_t>& layer) {
+                         const std::vector<std::uint8_t>& layer, const Solver::NodalProjection* P) {
   snap_.write(p, step, time, &layer);
+  if (grid_on_ && P) grid_.write(time, *P);
 }
 
 void MpmSnapshots::close() {

@@ -49,7 +49,11 @@ class GridSnapshots {
   // `earlier`: the times of the snapshots before a restart (empty: a new file).
   void open(const Solver& s, const std::string& out_dir, int compression,
             const std::vector<double>& earlier);
+  // The same for a grid of nx x ny cells of h from (x0, y0) (several ranks: the whole grid).
+  void open(double x0, double y0, double h, int nx, int ny, const std::string& out_dir,
+            int compression, const std::vector<double>& earlier);
   void write(const Solver& s);
+  void write(double t, const Solver::NodalProjection& P);
   void close() { w_.close(); }
   int count() const { return w_.count(); }
 
@@ -66,8 +70,12 @@ class MpmSnapshots {
   void restore(const StateReader& r) { earlier_ = SnapshotList::read(r); }
   void open(const Solver& s, const OutputSpec& out, const std::string& out_dir);
   void write(const Solver& s);
-  // Particles gathered from several ranks (no grid snapshot).
-  void write(const Particles& p, long step, double time, const std::vector<std::uint8_t>& layer);
+  // Several ranks: rank 0 opens with the whole grid's geometry, and writes the particles and the
+  // grid's projection gathered from every rank (P: null without output.grid).
+  void open(const OutputSpec& out, const std::string& out_dir, double x0, double y0, double h,
+            int nx, int ny);
+  void write(const Particles& p, long step, double time, const std::vector<std::uint8_t>& layer,
+             const Solver::NodalProjection* P);
   void close();
   int count() const { return snap_.count(); }
 

@@ -28,14 +28,6 @@ class MpmRegion final : public Region {
     }
     // Under an MPI launcher every rank built the whole case; each keeps its block (split(),
     // after a restart has loaded the whole body's state).
-    if (const MpiModule* m = mpi(); m && m->size() > 1) {
-      auto refuse = [&](const std::string& what) {
-        throw std::runtime_error(what + " is not yet available on several MPI ranks (" +
-                                 std::to_string(m->size()) + " here): run the case on one "
-                                 "process, or without it");
-      };
-      if (c.output.snapshots > 0 && c.output.grid) refuse("output.grid");
-    }
   }
 
   // Cuts the solver to this rank's block, once (under an MPI launcher).
@@ -102,7 +94,9 @@ class MpmRegion final : public Region {
   bool ranks() const { return dist_ && dist_->size() > 1; }
   void open_snapshots(const std::string& out_dir) override {
     split();
-    if (!ranks() || dist_->rank() == 0) snaps_.open(s_, c_.output, out_dir);
+    if (!ranks()) snaps_.open(s_, c_.output, out_dir);
+    else if (dist_->rank() == 0)
+      snaps_.open(c_.output, out_dir, whole_.x0, whole_.y0, whole_.h, whole_.nx, whole_.ny);
   }
   void write_snapshot(const std::string&) override {
     split();
@@ -114,7 +108,34 @@ class MpmRegion final : public Region {
       mine.push_back(layer[k]);
     }
     dist_->gather(mine, all);
+    // The grid's projection (output.grid): each rank's own nodes, by their index in the whole
+    // grid.
+    std::vector<double> nodes_mine, nodes_all;
+    Solver::NodalProjection P;
+    if (c_.output.grid) {
+      P = s_.nodal_projection();
+      const auto own = dist_->own_nodes();
+      const auto org = dist_->window_origin();
+      const long wnnx = whole_.nx + 1;
+      for (int j = own[2]; j <= own[3]; ++j)
+        for (int i = own[0]; i <= own[1]; ++i) {
+          const long k = static_cast<long>(j - org[1]) * s_.grid.nnx + (i - org[0]);
+          nodes_mine.push_back(static_cast<double>(static_cast<long>(j) * wnnx + i));
+          for (const auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy})
+            nodes_mine.push_back((*v)[k]);
+        }
+      dist_->gather(nodes_mine, nodes_all);
+    }
     if (dist_->rank() != 0) return;
+    if (c_.output.grid) {
+      const std::size_t n = static_cast<std::size_t>(whole_.nx + 1) * (whole_.ny + 1);
+      for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) v->assign(n, 0.0);
+      for (std::size_t r = 0; r + 7 < nodes_all.size(); r += 8) {
+        const auto k = static_cast<std::size_t>(nodes_all[r]);
+        int q = 1;
+        for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) (*v)[k] = nodes_all[r + q++];
+      }
+    }
     Particles p;
     if (s_.p.has_film()) p.enable_film();
     std::vector<std::uint8_t> flags;
@@ -127,7 +148,7 @@ class MpmRegion final : public Region {
     p.permute(by_id);
     std::vector<std::uint8_t> f(flags.size());
     for (std::size_t k = 0; k < f.size(); ++k) f[k] = flags[by_id[k]];
-    snaps_.write(p, s_.steps, s_.t, f);
+    snaps_.write(p, s_.steps, s_.t, f, c_.output.grid ? &P : nullptr);
   }
   void finish() override {
     split();

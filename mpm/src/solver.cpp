@@ -1146,6 +1146,11 @@ void Solver::project(NodalProjection& o) const {
       o.sxy[i] += w * p.sxy[k];
     }
   }
+  if (dist_) {  // the shared nodes' sums over the ranks, before the division
+    double* f[7] = {o.mass.data(), o.vx.data(), o.vy.data(), o.sxx.data(),
+                    o.syy.data(),  o.szz.data(), o.sxy.data()};
+    dist_->sum_halo(f, 7);
+  }
   for (std::size_t i = 0; i < n; ++i) {
     if (!(o.mass[i] > 0)) {
       o.mass[i] = o.vx[i] = o.vy[i] = o.sxx[i] = o.syy[i] = o.szz[i] = o.sxy[i] = 0;

@@ -388,6 +388,13 @@ bool Distributed::migrate(Solver& s) {
 
 Decomposition::Traffic Distributed::traffic() const { return d_->t; }
 
+std::array<int, 4> Distributed::own_nodes() const {
+  const Impl& d = *d_;
+  return {d.Cx[d.pi], Impl::node_end(d.Cx, d.pi, d.nnx) - 1, d.Ry[d.pj],
+          Impl::node_end(d.Ry, d.pj, d.nny) - 1};
+}
+std::array<int, 2> Distributed::window_origin() const { return {d_->gx0, d_->gy0}; }
+
 void Distributed::gather(const std::vector<double>& mine, std::vector<double>& on_root) {
   Impl& d = *d_;
   const long long n = static_cast<long long>(mine.size());

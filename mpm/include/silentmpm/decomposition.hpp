@@ -9,6 +9,7 @@
 //   * move the particles that left the slab to the rank that owns them, at the end of the step;
 //   * sum and take maxima of the health checks' reductions over the ranks.
 // The serial solver has none and makes none of these calls.
+#include <array>
 #include <vector>
 
 namespace smpm {
@@ -29,6 +30,10 @@ class Decomposition {
   // In place over the ranks.
   virtual void sum(double* v, int n) = 0;
   virtual void max(double* v, int n) = 0;
+  // This rank's own nodes in the whole grid's numbering {i0, i1, j0, j1} (inclusive), and the
+  // whole grid's node of its window's node (0, 0).
+  virtual std::array<int, 4> own_nodes() const = 0;
+  virtual std::array<int, 2> window_origin() const = 0;
   // Rank 0 receives every rank's `mine`, in rank order (the others receive nothing). Throws
   // std::runtime_error when the whole is too large for one message (2^31 - 1 doubles).
   virtual void gather(const std::vector<double>& mine, std::vector<double>& on_root) = 0;

@@ -138,7 +138,7 @@ class Solver {
   // The particles projected onto the grid nodes with the run's shape functions, mass-weighted:
   // m_I = sum N_I m_p, and v_I, sigma_I = sum N_I m_p (v_p, sigma_p) / m_I (0 where m_I is 0).
   // The grid's picture of the particles at this instant, for snapshots (output.grid); node
-  // (i, j) is entry j * nnx + i.
+  // (i, j) is entry j * nnx + i. Split over ranks, every rank takes part and gets its window's.
   struct NodalProjection {
     std::vector<double> mass, vx, vy, sxx, syy, szz, sxy;
   };

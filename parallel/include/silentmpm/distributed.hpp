@@ -39,6 +39,8 @@ class Distributed final : public Decomposition {
   void sum(double* v, int n) override;
   void max(double* v, int n) override;
   void gather(const std::vector<double>& mine, std::vector<double>& on_root) override;
+  std::array<int, 4> own_nodes() const override;
+  std::array<int, 2> window_origin() const override;
   Traffic traffic() const override;
 
   // The blocks: rank r = b * across() + a owns the whole grid's cells
