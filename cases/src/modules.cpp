@@ -56,45 +56,37 @@ void* module_entry(const char* file, const char* entry) {
                            "SILENTMPM_MODULE_DIR to its folder)");
 }
 
+// A module's table, loaded on the first call (one per table type; a load that fails is tried
+// again on the next call).
 template <class Table>
 const Table& load_table(const char* file, const char* entry, int api) {
+  static std::mutex m;
+  static const Table* table = nullptr;
+  std::lock_guard<std::mutex> lock(m);
+  if (table) return *table;
   using Entry = const Table* (*)();
   const Table* t = reinterpret_cast<Entry>(module_entry(file, entry))();
   if (!t || t->api != api)
     throw std::runtime_error(std::string(file) + " was built from other sources (module interface " +
                              std::to_string(t ? t->api : -1) + ", this program needs " +
                              std::to_string(api) + "): rebuild both");
+  table = t;
   return *t;
 }
 
 }  // namespace
 
 const GmshModule& gmsh_module() {
-  static std::mutex m;
-  static const GmshModule* table = nullptr;
-  std::lock_guard<std::mutex> lock(m);
-  if (!table)
-    table = &load_table<GmshModule>("libsilentmpm_gmsh.so", "silentmpm_gmsh_module", kGmshModuleApi);
-  return *table;
+  return load_table<GmshModule>("libsilentmpm_gmsh.so", "silentmpm_gmsh_module", kGmshModuleApi);
 }
 
 const FarFieldModule& far_field_module() {
-  static std::mutex m;
-  static const FarFieldModule* table = nullptr;
-  std::lock_guard<std::mutex> lock(m);
-  if (!table)
-    table = &load_table<FarFieldModule>("libsilentmpm_fe.so", "silentmpm_fe_module",
-                                        kFarFieldModuleApi);
-  return *table;
+  return load_table<FarFieldModule>("libsilentmpm_fe.so", "silentmpm_fe_module",
+                                    kFarFieldModuleApi);
 }
 
 const MpiModule& mpi_module() {
-  static std::mutex m;
-  static const MpiModule* table = nullptr;
-  std::lock_guard<std::mutex> lock(m);
-  if (!table)
-    table = &load_table<MpiModule>("libsilentmpm_mpi.so", "silentmpm_mpi_module", kMpiModuleApi);
-  return *table;
+  return load_table<MpiModule>("libsilentmpm_mpi.so", "silentmpm_mpi_module", kMpiModuleApi);
 }
 
 }  // namespace smpm::detail

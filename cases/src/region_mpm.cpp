@@ -143,9 +143,7 @@ class MpmRegion final : public Region {
       r += p.unpack(all.data() + r);
       flags.push_back(static_cast<std::uint8_t>(all[r++]));
     }
-    std::vector<uint32_t> by_id(p.size());
-    for (std::size_t k = 0; k < p.size(); ++k) by_id[p.id[k]] = static_cast<uint32_t>(k);
-    p.permute(by_id);
+    const std::vector<uint32_t> by_id = p.sort_by_id();
     std::vector<std::uint8_t> f(flags.size());
     for (std::size_t k = 0; k < f.size(); ++k) f[k] = flags[by_id[k]];
     snaps_.write(p, s_.steps, s_.t, f, c_.output.grid ? &P : nullptr);

@@ -42,6 +42,13 @@ void Particles::permute(const std::vector<uint32_t>& perm) {
   apply(group, perm);
 }
 
+std::vector<uint32_t> Particles::sort_by_id() {
+  std::vector<uint32_t> perm(size());
+  for (std::size_t k = 0; k < size(); ++k) perm[id[k]] = static_cast<uint32_t>(k);
+  permute(perm);
+  return perm;
+}
+
 void Particles::pack(std::size_t k, std::vector<double>& out) const {
   for (auto* v : {&x, &y, &x0, &y0, &vx, &vy, &mass, &vol, &sxx, &syy, &szz, &sxy, &eps_p})
     out.push_back((*v)[k]);

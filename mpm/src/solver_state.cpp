@@ -141,9 +141,7 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
       }
     }
   }
-  std::vector<std::uint32_t> by_id(q.size());
-  for (std::size_t k = 0; k < q.size(); ++k) by_id[q.id[k]] = static_cast<std::uint32_t>(k);
-  q.permute(by_id);
+  q.sort_by_id();
   put_head(w, pre, dt, t, steps, e, contact.dissipated, q);
   for (std::size_t k = 0; k < silents.size(); ++k) {
     if (!silents[k].springs()) continue;

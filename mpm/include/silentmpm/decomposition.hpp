@@ -1,12 +1,12 @@
 #pragma once
-// A solver split over processes: each rank holds the particles of a slab of cell rows and a
-// window of the grid, its own node rows and copies of its neighbours' nearest rows (the halo).
+// A solver split over processes: each rank holds the particles of a block of cells and a window
+// of the grid, its own nodes and copies of its neighbours' nearest nodes (the halo).
 // The step asks its decomposition (set by Solver::set_decomposition; implemented over MPI in
 // parallel/) to
 //   * sum the nodal values every rank scattered into the nodes it shares with others, once all
 //     particles have been mapped and before any node is updated (every copy then holds the sum,
 //     and the grid update runs on all the window's nodes, the copies giving the same values);
-//   * move the particles that left the slab to the rank that owns them, at the end of the step;
+//   * move the particles that left the block to the rank that owns them, at the end of the step;
 //   * sum and take maxima of the health checks' reductions over the ranks.
 // The serial solver has none and makes none of these calls.
 #include <array>
@@ -24,7 +24,7 @@ class Decomposition {
   virtual int across() const = 0;  // ranks across x (the blocks' layout)
   // Sums the halo of the n grid arrays (each grid.nodes() long) over the ranks sharing nodes.
   virtual void sum_halo(double* const* fields, int n) = 0;
-  // Moves the particles outside this rank's cell rows (with their boundary-layer entries) to
+  // Moves the particles outside this rank's cells (with their boundary-layer entries) to
   // their owners; returns whether any particle left or arrived here.
   virtual bool migrate(Solver& s) = 0;
   // In place over the ranks.

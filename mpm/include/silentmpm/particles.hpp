@@ -53,6 +53,9 @@ struct Particles {
   // double); unpack appends such a record as a new particle and returns the doubles it read.
   void pack(std::size_t k, std::vector<double>& out) const;
   std::size_t unpack(const double* in);
+  // Puts the particles in the order of their ids, which must be 0 .. size() - 1; returns the
+  // permutation applied (new k was old perm[k]).
+  std::vector<uint32_t> sort_by_id();
   // Bytes per particle of the arrays every run carries, and of the film block.
   static constexpr std::size_t bytes_per_particle() {
     return 13 * sizeof(double) + sizeof(uint32_t) + 2 * sizeof(uint16_t);

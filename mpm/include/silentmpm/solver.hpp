@@ -166,7 +166,6 @@ class Solver {
   // Called after finalize and after the grid, particles and layers were cut to this rank's
   // share; the solver does not own d.
   void set_decomposition(Decomposition* d, NodeBox own, int halo, bool dashpots);
-  Decomposition* decomposition() const { return dist_; }
   // Keeps the particles with keep[k] != 0 and their boundary-layer entries (order kept).
   void keep_particles(const std::vector<std::uint8_t>& keep);
   // Appends to out[to[k]] a record of each particle with to[k] >= 0: its fields and its entries
