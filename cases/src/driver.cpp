@@ -319,7 +319,7 @@ RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt) {
                              std::to_string(process_count()) + " here): run it on one process");
   const std::unique_ptr<detail::Region> region =
       c.hybrid     ? detail::far_field_module().hybrid_region(c)
-      : c.solver   ? detail::mpm_region(c, opt.ranks_across)
+      : c.solver   ? detail::mpm_region(c, opt.ranks_across, !opt.restart.empty())
                    : detail::far_field_module().fem_region(c);
   return run_region(c, *region, out_dir, opt);
 }

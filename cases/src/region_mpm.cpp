@@ -19,15 +19,17 @@ namespace {
 
 class MpmRegion final : public Region {
  public:
-  MpmRegion(Case& c, int across)
+  MpmRegion(Case& c, int across, bool resuming)
       : c_(c), s_(*c.solver),
         whole_{s_.grid.x0, s_.grid.y0, s_.grid.h, s_.grid.nx, s_.grid.ny}, across_(across) {
     for (const auto& pr : c.probes) {
       pts_.push_back({pr.x, pr.y});
       bodies_.push_back(pr.body);
     }
-    // Under an MPI launcher every rank built the whole case; each keeps its block (split(),
-    // after a restart has loaded the whole body's state).
+    // Under an MPI launcher every rank built the whole case; each keeps its block, now (a layout
+    // the ranks cannot form is an error before the run) or after a restart has loaded the whole
+    // body's state.
+    if (!resuming) split();
   }
 
   // Cuts the solver to this rank's block, once (under an MPI launcher).
@@ -225,8 +227,8 @@ class MpmRegion final : public Region {
 
 }  // namespace
 
-std::unique_ptr<Region> mpm_region(Case& c, int across) {
-  return std::make_unique<MpmRegion>(c, across);
+std::unique_ptr<Region> mpm_region(Case& c, int across, bool resuming) {
+  return std::make_unique<MpmRegion>(c, across, resuming);
 }
 
 }  // namespace smpm::detail

@@ -52,8 +52,10 @@ class Region {
   virtual void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const = 0;
 };
 
-// `across`: ranks across x under an MPI launcher (RunOptions::ranks_across).
-std::unique_ptr<Region> mpm_region(Case& c, int across = 0);  // region_mpm.cpp
+// `across`: ranks across x under an MPI launcher (RunOptions::ranks_across); `resuming`: a
+// restart will load the state (the region is cut into blocks after it, else at once, so that a
+// layout the ranks cannot form is an error before the run).
+std::unique_ptr<Region> mpm_region(Case& c, int across = 0, bool resuming = false);  // region_mpm.cpp
 // In the far-field module (cases/fe/; the core reaches them through modules.hpp).
 std::unique_ptr<Region> fem_region(Case& c);     // region_fem.cpp
 std::unique_ptr<Region> hybrid_region(Case& c);  // region_hybrid.cpp

@@ -183,6 +183,8 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
   };
   const fs::path o = out_dir("refused");
   const std::vector<Bad> bad = {
+      {kCase + kShort + " --ranks-across 3",
+       "2 MPI ranks cannot form blocks 3 ranks across"},
       {source_file("studies/hybrid/cases/film_hybrid_dashpot.json") + " --set time.end=1e-11",
        "a hybrid (MPM and FEM) case does not run on several MPI ranks yet (2 here)"},
       {source_file("studies/pulse/cases/compressive_fem_dashpot.json") + " --set time.end=4e-6",
@@ -198,7 +200,7 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
          at = p.err.find("silentmpm: error", at + 1))
       ++n;
     EXPECT_EQ(n, 1u) << p.err;
-    EXPECT_FALSE(fs::exists(o / "summary.json"));
+    EXPECT_FALSE(fs::exists(o)) << "refused before the output folder is made";
   }
 }
 
