@@ -1,10 +1,13 @@
 // The FEM region of the run loop (a case with an FEM region and no MPM bodies): probes sampled
-// from the FE field, HDF5 + XDMF snapshots (fem.h5 + fem.xdmf).
+// from the FE field, HDF5 + XDMF snapshots (fem.h5 + fem.xdmf). Under an MPI launcher the far
+// field is split over the ranks (fem::Solver::distribute; docs/parallel.md): every rank calls
+// the same functions, rank 0 writes.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
 
 #include "driver_common.hpp"
+#include "modules.hpp"
 #include "run_loop.hpp"
 
 namespace smpm::detail {
@@ -13,7 +16,9 @@ namespace {
 
 class FemRegion final : public Region {
  public:
-  explicit FemRegion(Case& c) : c_(c), s_(*c.fem) {}
+  explicit FemRegion(Case& c) : c_(c), s_(*c.fem) {
+    if (mpi()) s_.distribute();
+  }
 
   double dt() const override { return s_.dt; }
   double time() const override { return s_.t; }
@@ -67,6 +72,16 @@ class FemRegion final : public Region {
     j["dofs"] = r.dofs;
     j["dof_updates_per_second"] = r.dof_updates_per_second;
     j["threads"] = s_.thread_count();
+    if (mpi()) {  // the ghost updates (every rank takes part)
+      const fem::Solver::Traffic t = s_.traffic();
+      const double steps = static_cast<double>(std::max<long>(1, t.updates));
+      j["mpi_ranks"] = s_.ranks();
+      j["mpi"] = {{"ghost_update_seconds_per_step", t.seconds / steps},
+                  {"ghost_bytes_per_step", t.bytes / steps},
+                  {"neighbours_most", t.neighbours},
+                  {"own_nodes_most", t.own_nodes},
+                  {"ghost_nodes_most", t.ghost_nodes}};
+    }
     j["fem"] = fem_json(s_);
     j["energy"] = energy_json(s_.energy);
     j["model"] = c_.notes;

@@ -313,8 +313,8 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
 }  // namespace
 
 RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt) {
-  if (process_count() > 1 && (c.hybrid || !c.solver))
-    throw std::runtime_error(std::string(c.hybrid ? "a hybrid (MPM and FEM) case" : "an FEM case") +
+  if (process_count() > 1 && c.hybrid)
+    throw std::runtime_error(std::string("a hybrid (MPM and FEM) case") +
                              " does not run on several MPI ranks yet (" +
                              std::to_string(process_count()) + " here): run it on one process");
   const std::unique_ptr<detail::Region> region =

@@ -53,6 +53,7 @@ struct Solver::Impl {
     // Cells in colour order (no two cells of a colour share a node): colour k holds cells
     // [colour_start[k], colour_start[k + 1]).
     std::vector<std::uint32_t> colour_start;
+    std::vector<std::uint32_t> cell;         // per cell: its index among the mesh's cells
     std::vector<std::uint32_t> cell_nodes;   // nb per cell
     std::vector<std::uint32_t> shape;        // per cell: its table in grad
     std::vector<double> grad;                // per shape, point, node: dN/dx, dN/dy
@@ -90,6 +91,7 @@ struct Solver::Impl {
   // Probes: shape values and gradients of the dofs of every cell containing the point (a point on
   // a cell edge or node belongs to 2 or 4 cells; their stresses are averaged).
   struct ProbePart {
+    std::uint32_t cell = 0;  // the cell's index among the mesh's cells
     std::vector<std::uint32_t> dofs;
     std::vector<std::uint8_t> comp;
     std::vector<double> N, dx, dy;
@@ -101,10 +103,49 @@ struct Solver::Impl {
   };
   std::vector<Probe> probes;
 
+  // Several processes (fem_parallel.cpp; docs/parallel.md): what this rank steps, whom it sends
+  // its nodes' values after each step and whose it receives. Null on one process.
+  struct Part {
+    int rank = 0, size = 1;
+    std::vector<std::uint32_t> cell_rank;   // per cell: the rank of its part (METIS)
+    std::vector<std::uint32_t> node_rank;   // per node: the lowest rank among its cells
+    std::vector<std::uint32_t> own;         // this rank's nodes, ascending
+    std::size_t own_cells = 0, ghosts = 0;
+    // The layer cells this rank steps (indices into pml's cells, by colour: colour k holds
+    // pml_cells[pml_colour_start[k] .. pml_colour_start[k + 1])), and the entries of pml.node
+    // that are its own nodes.
+    std::vector<std::uint32_t> pml_cells, pml_colour_start, pml_nodes;
+    struct Link {
+      int rank = 0;
+      std::vector<std::uint32_t> send, recv;  // nodes, ascending, the same lists on both sides
+    };
+    std::vector<Link> links;
+    std::vector<double> sendbuf, recvbuf;
+    double work = 0, absorbed = 0;  // this rank's share of the booked energies
+    double seconds = 0, bytes = 0;
+    long updates = 0;
+  };
+  std::unique_ptr<Part> part;
+
   std::unique_ptr<Deal> deal;
   int snapshots = 0;
   std::vector<double> snapshot_times;  // every snapshot's time (a restart's earlier ones too)
 };
+
+// The cells' parts for `parts` ranks (METIS through deal.II), in the mesh's cell order
+// (fem_setup.cpp).
+std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts);
+
+// Several processes (fem_parallel.cpp): copies the owners' u and v to the nodes this rank
+// receives; sums n values over the ranks, in place.
+void exchange_ghosts(Solver::Impl& m);
+void sum_over_ranks(const Solver::Impl& m, double* v, int n);
+// Items (nodes, layer cells ...) with an owning rank each: rank 0 receives every item's `width`
+// values of each array in `fields` from its owner into `out` (one array per field, the whole
+// size); the others send their own items' and leave `out` empty.
+void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& owner,
+                    const std::vector<const std::vector<double>*>& fields, int width,
+                    std::vector<std::vector<double>>& out);
 
 // Largest eigenvalue of the symmetric n x n matrix a (row-major; destroyed), cyclic Jacobi.
 double symmetric_max_eigenvalue(std::vector<double>& a, int n);

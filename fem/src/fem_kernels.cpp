@@ -86,14 +86,17 @@ std::vector<std::uint32_t> Solver::boundary_nodes(const std::vector<int>& curves
   return out;
 }
 
-void Solver::internal_force(const double* __restrict u, double* __restrict f) const {
-  const Impl& m = *impl_;
-  const std::int64_t n = static_cast<std::int64_t>(m.x.size());
+namespace {
+// f = -K u on the rows list[0 .. n) (LIST), or on rows 0 .. n.
+template <bool LIST>
+void minus_ku(const Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
+              const double* __restrict u, double* __restrict f) {
   const std::uint64_t* __restrict rp = m.rowptr.data();
   const std::uint32_t* __restrict cl = m.col.data();
   const double* __restrict kv = m.val.data();
 #pragma omp parallel for schedule(static) num_threads(m.threads) if (n >= kParallelMinimum)
-  for (std::int64_t i = 0; i < n; ++i) {
+  for (std::int64_t r = 0; r < n; ++r) {
+    const std::int64_t i = LIST ? list[r] : r;
     double fx = 0, fy = 0;
     for (std::uint64_t k = rp[i]; k < rp[i + 1]; ++k) {
       const double ux = u[2 * cl[k]], uy = u[2 * cl[k] + 1];
@@ -104,6 +107,15 @@ void Solver::internal_force(const double* __restrict u, double* __restrict f) co
     f[2 * i] = -fx;
     f[2 * i + 1] = -fy;
   }
+}
+}  // namespace
+
+void Solver::internal_force(const double* __restrict u, double* __restrict f) const {
+  const Impl& m = *impl_;
+  if (m.part)  // several ranks: this rank's own rows
+    minus_ku<true>(m, m.part->own.data(), static_cast<std::int64_t>(m.part->own.size()), u, f);
+  else
+    minus_ku<false>(m, nullptr, static_cast<std::int64_t>(m.x.size()), u, f);
 }
 
 namespace {
@@ -155,10 +167,14 @@ void pml_forces(Solver::Impl& m, double dt) {
   const double* __restrict u = m.u.data();
   for (const std::uint32_t nd : P.touched) f[2 * dn[nd]] = f[2 * dn[nd] + 1] = 0.0;
   const int nb = P.nb, nq = P.nq;
-  for (std::size_t colour = 0; colour + 1 < P.colour_start.size(); ++colour) {
-    const std::int64_t c0 = P.colour_start[colour], c1 = P.colour_start[colour + 1];
+  // Several ranks: the layer cells around this rank's nodes (Part::pml_cells), by colour.
+  const Solver::Impl::Part* part = m.part.get();
+  const std::vector<std::uint32_t>& starts = part ? part->pml_colour_start : P.colour_start;
+  for (std::size_t colour = 0; colour + 1 < starts.size(); ++colour) {
+    const std::int64_t c0 = starts[colour], c1 = starts[colour + 1];
 #pragma omp parallel for schedule(static) num_threads(m.threads) if (c1 - c0 >= 256)
-    for (std::int64_t c = c0; c < c1; ++c) {
+    for (std::int64_t cc = c0; cc < c1; ++cc) {
+      const std::int64_t c = part ? part->pml_cells[cc] : cc;
       const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
       const double* gs = P.grad.data() + static_cast<std::size_t>(P.shape[c]) * nq * nb * 2;
       double ux[9], uy[9], fx[9] = {0}, fy[9] = {0};
@@ -198,7 +214,9 @@ void pml_forces(Solver::Impl& m, double dt) {
       }
     }
   }
-  for (std::size_t j = 0; j < P.node.size(); ++j) {
+  const std::size_t nodes = part ? part->pml_nodes.size() : P.node.size();
+  for (std::size_t jj = 0; jj < nodes; ++jj) {
+    const std::size_t j = part ? part->pml_nodes[jj] : jj;
     const std::uint32_t i = P.node[j];
     for (int c = 0; c < 2; ++c)  // zeta: 2 memories per component
       f[2 * dn[i] + c] += pml_mass_term(P.m_sum[j], P.m_prod[j], P.alpha, u[2 * i + c],
@@ -209,10 +227,12 @@ void pml_forces(Solver::Impl& m, double dt) {
 // The explicit update of every node with skip == nullptr or skip[i] < 0: v+ = v + dt f / m, the
 // trapezoidal solve at a node with a dashpot block (dashpot.hpp), constraints; then u += dt v+.
 // Adds the work of f_ext (with the mid-step velocity) and the energy the dashpots absorb.
-void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __restrict f_int,
-                   const double* __restrict f_ext, double dt, bool parallel, double& work_out,
-                   double& absorbed_out) {
-  const std::int64_t n = static_cast<std::int64_t>(m.mass.size());
+// Several ranks: this rank's own nodes only (Part::own).
+template <bool LIST>
+void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
+                      const std::int64_t* skip, const double* __restrict f_int,
+                      const double* __restrict f_ext, double dt, bool parallel, double& work_out,
+                      double& absorbed_out) {
   const std::uint8_t* __restrict mask = m.mask.data();
   const std::int32_t* __restrict dn = m.dash_of_node.data();
   const double* __restrict im = m.inv_mass.data();
@@ -223,11 +243,11 @@ void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __re
   const double gx = m.spec.gravity_x, gy = m.spec.gravity_y;
   const bool gravity = gx != 0 || gy != 0;
   double work = 0, absorbed = 0;
-  if (m.pml.active()) pml_forces(m, dt);
   const double* __restrict pf = m.dash_force.data();
 #pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
     if (parallel)
-  for (std::int64_t i = 0; i < n; ++i) {
+  for (std::int64_t r = 0; r < n; ++r) {
+    const std::int64_t i = LIST ? list[r] : r;
     if (skip && skip[i] >= 0) continue;
     double fx = f_int[2 * i] + f_ext[2 * i], fy = f_int[2 * i + 1] + f_ext[2 * i + 1];
     if (gravity) {  // the lumped body force m_i g
@@ -258,6 +278,18 @@ void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* __re
   absorbed_out += absorbed;
   m.ku_valid = false;
 }
+
+void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* f_int,
+                   const double* f_ext, double dt, bool parallel, double& work_out,
+                   double& absorbed_out) {
+  if (m.pml.active()) pml_forces(m, dt);
+  if (m.part)
+    advance_nodes_on<true>(m, m.part->own.data(), static_cast<std::int64_t>(m.part->own.size()),
+                           skip, f_int, f_ext, dt, parallel, work_out, absorbed_out);
+  else
+    advance_nodes_on<false>(m, nullptr, static_cast<std::int64_t>(m.mass.size()), skip, f_int,
+                            f_ext, dt, parallel, work_out, absorbed_out);
+}
 }  // namespace
 
 void Solver::step() {
@@ -270,9 +302,14 @@ void Solver::step() {
   // are ever written): refresh just those, not the whole vector (a serial pass over every dof
   // would cap the two-thread speed-up).
   refresh_external_force(t, m.fext.data());
-  const bool parallel = static_cast<std::int64_t>(m.x.size()) >= kParallelMinimum;
-  advance_nodes(m, nullptr, m.ku.data(), m.fext.data(), dt, parallel, energy.external_work,
-                energy.absorbed);
+  const std::size_t rows = m.part ? m.part->own.size() : m.x.size();
+  const bool parallel = static_cast<std::int64_t>(rows) >= kParallelMinimum;
+  // Several ranks: each books its own nodes' work (update_energies adds them up), and then
+  // receives the nodes it reads from their owners.
+  advance_nodes(m, nullptr, m.ku.data(), m.fext.data(), dt, parallel,
+                m.part ? m.part->work : energy.external_work,
+                m.part ? m.part->absorbed : energy.absorbed);
+  if (m.part) exchange_ghosts(m);
   t += dt;
   ++steps;
   // ku now holds -K u^n (u^n = the displacement before this step), used by update_energies().
@@ -285,20 +322,30 @@ void Solver::advance_free_nodes(const std::int64_t* skip, const double* f_int, c
 
 void Solver::update_energies() {
   Impl& m = *impl_;
-  const std::int64_t n = static_cast<std::int64_t>(m.x.size());
+  const std::int64_t n = static_cast<std::int64_t>(m.part ? m.part->own.size() : m.x.size());
   double kin = 0, el = 0;
   // Elastic: 1/2 u^n K u^{n+1}; ku holds -K u^n from the last step (or -K u if never stepped).
   if (steps == 0 && !m.ku_valid) {
     internal_force(m.u.data(), m.ku.data());
     m.ku_valid = true;
   }
+  const std::uint32_t* own = m.part ? m.part->own.data() : nullptr;
 #pragma omp parallel for schedule(static) reduction(+ : kin, el) num_threads(m.threads) if (n >= kParallelMinimum)
-  for (std::int64_t i = 0; i < n; ++i) {
+  for (std::int64_t r = 0; r < n; ++r) {
+    const std::int64_t i = own ? own[r] : r;
     kin += 0.5 * m.mass[i] * (m.v[2 * i] * m.v[2 * i] + m.v[2 * i + 1] * m.v[2 * i + 1]);
     el -= 0.5 * (m.ku[2 * i] * m.u[2 * i] + m.ku[2 * i + 1] * m.u[2 * i + 1]);
   }
   energy.kinetic = kin;
   energy.elastic = el;
+  if (m.part) {  // several ranks: the sums of their own nodes' shares
+    double e[4] = {kin, el, m.part->work, m.part->absorbed};
+    sum_over_ranks(m, e, 4);
+    energy.kinetic = e[0];
+    energy.elastic = e[1];
+    energy.external_work = e[2];
+    energy.absorbed = e[3];
+  }
 }
 
 std::vector<Sample> Solver::sample() const {
@@ -308,6 +355,8 @@ std::vector<Sample> Solver::sample() const {
     Sample s;
     const double w = 1.0 / static_cast<double>(m.probes[p].parts.size());
     for (const auto& pr : m.probes[p].parts) {
+      // Several ranks: each part is read by the rank of its cell (which holds its nodes).
+      if (m.part && m.part->cell_rank[pr.cell] != static_cast<std::uint32_t>(m.part->rank)) continue;
       double g[2][2] = {{0, 0}, {0, 0}}, vel[2] = {0, 0};
       for (std::size_t k = 0; k < pr.dofs.size(); ++k) {
         const int c = pr.comp[k];
@@ -330,6 +379,16 @@ std::vector<Sample> Solver::sample() const {
     s.j2 = j2_of(s.sxx, s.syy, s.szz, s.sxy);
     out[p] = s;
   }
+  if (m.part && !out.empty()) {  // several ranks: each probe's parts added up over them
+    std::vector<double> b;
+    for (const Sample& s : out) b.insert(b.end(), {s.sxx, s.syy, s.szz, s.sxy, s.vx, s.vy, s.div, s.curl});
+    sum_over_ranks(m, b.data(), static_cast<int>(b.size()));
+    for (std::size_t p = 0; p < out.size(); ++p) {
+      const double* v = b.data() + 8 * p;
+      out[p] = Sample{v[0], v[1], v[2], v[3], 0.0, v[4], v[5], v[6], v[7]};
+      out[p].j2 = j2_of(v[0], v[1], v[2], v[3]);
+    }
+  }
   return out;
 }
 
@@ -339,20 +398,49 @@ namespace smpm::fem {
 
 // Checkpoints: displacement, velocity, -K u^n (the step and the elastic energy reuse it), the
 // clock, the energies and the snapshot times (fem.xdmf is rebuilt from them on restart).
+// Several ranks (every rank calls it): the booked energies summed, each node's state from its
+// owner and each layer cell's memories from its part's rank gathered on rank 0, which puts the
+// checkpoint of one process (the others put nothing of the far field).
 void Solver::save_state(StateWriter& w, const std::string& pre) const {
   const Impl& m = *impl_;
+  Energies e = energy;
+  const std::vector<double>*u = &m.u, *v = &m.v, *ku = &m.ku, *xi = &m.pml.xi, *zeta = &m.pml.zeta;
+  std::vector<std::vector<double>> nodes, cells, memories;
+  if (m.part) {
+    const Impl::Part& P = *m.part;
+    double b[2] = {P.work, P.absorbed};
+    sum_over_ranks(m, b, 2);
+    e.external_work = b[0];
+    e.absorbed = b[1];
+    gather_on_root(m, P.node_rank, {&m.u, &m.v, &m.ku}, 2, nodes);
+    if (m.pml.active()) {
+      std::vector<std::uint32_t> cell_owner(m.pml.cell.size()), node_owner(m.pml.node.size());
+      for (std::size_t c = 0; c < cell_owner.size(); ++c) cell_owner[c] = P.cell_rank[m.pml.cell[c]];
+      for (std::size_t j = 0; j < node_owner.size(); ++j) node_owner[j] = P.node_rank[m.pml.node[j]];
+      gather_on_root(m, cell_owner, {&m.pml.xi}, 4 * m.pml.nq, cells);
+      gather_on_root(m, node_owner, {&m.pml.zeta}, 4, memories);
+    }
+    if (P.rank != 0) return;
+    u = &nodes[0];
+    v = &nodes[1];
+    ku = &nodes[2];
+    if (m.pml.active()) {
+      xi = &cells[0];
+      zeta = &memories[0];
+    }
+  }
   w.put(pre + "dt", dt);
   w.put(pre + "t", t);
   w.put(pre + "steps", static_cast<std::int64_t>(steps));
-  w.put(pre + "energy", energy);
-  w.put(pre + "u", m.u);
-  w.put(pre + "v", m.v);
-  w.put(pre + "ku", m.ku);
+  w.put(pre + "energy", e);
+  w.put(pre + "u", *u);
+  w.put(pre + "v", *v);
+  w.put(pre + "ku", *ku);
   w.put(pre + "ku_valid", static_cast<std::uint8_t>(m.ku_valid));
   w.put(pre + "snapshot_times", snapshot_times());
   if (m.pml.active()) {
-    w.put(pre + "pml_xi", m.pml.xi);
-    w.put(pre + "pml_zeta", m.pml.zeta);
+    w.put(pre + "pml_xi", *xi);
+    w.put(pre + "pml_zeta", *zeta);
   }
 }
 
@@ -374,6 +462,10 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   if (m.pml.active()) {
     r.get(pre + "pml_xi", m.pml.xi, m.pml.xi.size());
     r.get(pre + "pml_zeta", m.pml.zeta, m.pml.zeta.size());
+  }
+  if (m.part) {  // several ranks: the booked energies stay with rank 0
+    m.part->work = m.part->rank == 0 ? energy.external_work : 0.0;
+    m.part->absorbed = m.part->rank == 0 ? energy.absorbed : 0.0;
   }
 }
 

@@ -13,6 +13,7 @@
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria.h>
+#include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/lac/vector.h>
 #include <omp.h>
 
@@ -191,6 +192,7 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
   // gradients, as they share their stiffness), and per quadrature point the weights
   // (d_y - d_x) JxW (lambda + 2 mu) and (d_y - d_x) JxW mu and d_x, d_y.
   struct Cell {
+    std::uint32_t index;  // among the mesh's cells
     std::vector<std::uint32_t> nodes;
     std::uint32_t shape;
     std::vector<double> kl, km, dx, dy;
@@ -201,6 +203,7 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
   for (const auto& cell : d.dofh.active_cell_iterators()) {
     fv.reinit(cell);
     Cell c;
+    c.index = static_cast<std::uint32_t>(cell->active_cell_index());
     c.dx.resize(q.size());
     c.dy.resize(q.size());
     bool inside = false;
@@ -257,6 +260,7 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
     for (std::size_t c = 0; c < cells.size(); ++c) {
       if (colour[c] != k) continue;
       const Cell& e = cells[c];
+      P.cell.push_back(e.index);
       P.cell_nodes.insert(P.cell_nodes.end(), e.nodes.begin(), e.nodes.end());
       P.shape.push_back(e.shape);
       P.kl.insert(P.kl.end(), e.kl.begin(), e.kl.end());
@@ -666,6 +670,20 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
 
 Solver::~Solver() = default;
 
+std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts) {
+  Triangulation<2>& tria = m.deal->tria;
+  try {
+    GridTools::partition_triangulation(parts, tria, SparsityTools::Partitioner::metis);
+  } catch (const std::exception& e) {
+    throw FemError("FEM: cutting the mesh into " + std::to_string(parts) + " parts (METIS): " +
+                   deal_message(e));
+  }
+  std::vector<std::uint32_t> out(tria.n_active_cells());
+  for (const auto& cell : tria.active_cell_iterators())
+    out[cell->active_cell_index()] = static_cast<std::uint32_t>(cell->subdomain_id());
+  return out;
+}
+
 int Solver::add_probe(double x, double y) {
   Impl& m = *impl_;
   Deal& d = *m.deal;
@@ -697,6 +715,7 @@ int Solver::add_probe(double x, double y) {
     fv.reinit(cell);
     cell->get_dof_indices(ld);
     Impl::ProbePart part;
+    part.cell = static_cast<std::uint32_t>(cell->active_cell_index());
     for (unsigned i = 0; i < dpc; ++i) {
       part.dofs.push_back(static_cast<std::uint32_t>(ld[i]));
       part.comp.push_back(static_cast<std::uint8_t>(d.fe->system_to_component_index(i).first));
@@ -747,6 +766,18 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
   Deal& d = *m.deal;
   const std::size_t nn = m.x.size();
+  if (m.part) {
+    // Several ranks: every node's u and v from its owner to rank 0, which writes.
+    std::vector<std::vector<double>> all;
+    gather_on_root(m, m.part->node_rank, {&m.u, &m.v}, 2, all);
+    if (m.part->rank != 0) {
+      m.snapshot_times.push_back(t);
+      ++m.snapshots;
+      return;
+    }
+    m.u = std::move(all[0]);
+    m.v = std::move(all[1]);
+  }
   try {
     if (!d.snap.is_open()) {
       std::vector<double> xyz;
@@ -815,6 +846,7 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
 void Solver::set_snapshot_compression(int level) { impl_->deal->snap.set_compression(level); }
 
 void Solver::close_snapshots() {
+  if (impl_->part && impl_->part->rank != 0) return;
   try {
     impl_->deal->snap.close();
   } catch (const std::exception& e) {
@@ -825,15 +857,23 @@ void Solver::close_snapshots() {
 int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
   int found = 0;
+  const bool writer = !m.part || m.part->rank == 0;
   try {
-    found = m.deal->snap.resume(dir, base, m.snapshot_times);
+    if (writer) found = m.deal->snap.resume(dir, base, m.snapshot_times);
   } catch (const std::exception& e) {
     throw FemError(dir + ": cannot reopen the FEM snapshots: " + deal_message(e));
+  }
+  if (m.part) {  // the others keep rank 0's count
+    double f = found;
+    if (!writer) f = 0;
+    sum_over_ranks(m, &f, 1);
+    found = static_cast<int>(f);
   }
   if (found == 0 && !m.snapshot_times.empty()) {
     // The earlier snapshots are gone: the file starts afresh and the count with it, so that a
     // later checkpoint lists only what the file holds.
-    std::fprintf(stderr, "note: %s/%s.h5 does not hold the %zu FE snapshot(s) written before the "
+    if (writer)
+      std::fprintf(stderr, "note: %s/%s.h5 does not hold the %zu FE snapshot(s) written before the "
                          "checkpoint; %s.xdmf lists the snapshots from the restart on\n",
                  dir.c_str(), base.c_str(), m.snapshot_times.size(), base.c_str());
     m.snapshot_times.clear();

@@ -63,6 +63,8 @@ struct Setup {
   // Cells before the boundary where the initial data ends (a layer's thickness plus 2), or -1:
   // not cut (LK, Kelvin-Voigt).
   double clear() const { return boundary == "damping" || boundary == "pml" ? band + 2 : -1.0; }
+  // FEM: split both runs over the MPI ranks (fem::Solver::distribute; MPI running).
+  bool distributed = false;
 };
 
 struct Result {
@@ -260,6 +262,7 @@ inline Result measure(const Setup& su) {
       v[2 * i + 1] = w.dy * gv;
     }
     if (s->add_probe(w.rx, w.ry) != 0) throw std::runtime_error("oblique: receiver outside the mesh");
+    if (su.distributed) s->distribute();
   }
   Result res;
   while (A->t < w.t_end) {

@@ -212,6 +212,30 @@ class Solver {
   // Human-readable lines describing the model (mesh, dofs, boundaries).
   std::vector<std::string> describe() const;
 
+  // ---- several processes (docs/parallel.md, "The FE far field") --------------------------------
+  // Splits the stepping over the ranks of MPI_COMM_WORLD (MPI initialised by the caller; every
+  // rank built the same model). METIS cuts the cells into one part per rank; a node belongs to
+  // the lowest rank among its cells; each rank steps its own nodes' rows of K, and the layer
+  // cells around them, and receives its neighbours' nodes it reads (u and v) after every step.
+  // Probes, energies, snapshots and checkpoints are reduced or gathered: rank 0 writes what one
+  // process would, and every other rank calls the same functions (they are collective). Throws
+  // FemError when MPI is not running or the mesh has fewer cells than ranks. Call it once, before
+  // or after load_state. The arrays (node_x(), displacement() ...) keep the whole mesh's size; on
+  // a rank only its own nodes and the ones it receives hold current values.
+  void distribute();
+  int rank() const;   // 0 on one process
+  int ranks() const;  // 1 on one process
+  // The nodes this rank steps, ascending (every node on one process).
+  std::vector<std::uint32_t> own_nodes() const;
+  // The ghost updates so far over all ranks (every rank calls it): the slowest rank's seconds,
+  // the bytes all ranks sent, and the largest rank's counts.
+  struct Traffic {
+    double seconds = 0, bytes = 0;
+    long updates = 0;
+    std::size_t own_nodes = 0, ghost_nodes = 0, neighbours = 0, own_cells = 0;
+  };
+  Traffic traffic() const;
+
   struct Impl;
 
  private:

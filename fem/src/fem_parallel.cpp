@@ -1,0 +1,243 @@
+// The FE far field over MPI ranks (docs/parallel.md, "The FE far field"): the split of the work
+// by METIS's cut of the cells, the ghost update after each step, sums and gathers over ranks.
+// Plain MPI point-to-point and collectives; no deal.II here (the cut is made in fem_setup.cpp).
+#include <mpi.h>
+
+#include <algorithm>
+#include <climits>
+#include <cstdio>
+#include <limits>
+
+#include "fem_impl.hpp"
+
+namespace smpm::fem {
+
+namespace {
+constexpr int kGhostTag = 7301;
+}  // namespace
+
+void Solver::distribute() {
+  Impl& m = *impl_;
+  if (m.part) throw FemError("FEM: the model is already split over the MPI ranks");
+  int running = 0;
+  MPI_Initialized(&running);
+  if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
+  auto part = std::make_unique<Impl::Part>();
+  Impl::Part& P = *part;
+  MPI_Comm_rank(MPI_COMM_WORLD, &P.rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &P.size);
+  const std::size_t nc = m.n_cells, nn = m.x.size();
+  const auto ranks = static_cast<std::size_t>(P.size);
+  if (nc < ranks)
+    throw FemError("FEM: fewer cells (" + std::to_string(nc) + ") than MPI ranks (" +
+                   std::to_string(P.size) + "): run it on fewer ranks or on a finer mesh");
+  // Rank 0 cuts the mesh and sends the cut to the others, so that every rank holds the same one.
+  P.cell_rank.assign(nc, 0);
+  if (P.rank == 0) P.cell_rank = partition_cells(m, static_cast<unsigned>(P.size));
+  MPI_Bcast(P.cell_rank.data(), static_cast<int>(nc), MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  std::vector<std::size_t> cells_of(ranks, 0);
+  for (const auto r : P.cell_rank) ++cells_of[r];
+  for (std::size_t r = 0; r < ranks; ++r)
+    if (cells_of[r] == 0)
+      throw FemError("FEM: METIS left rank " + std::to_string(r) + " of " + std::to_string(P.size) +
+                     " without cells (" + std::to_string(nc) + " cells): run it on fewer ranks");
+  P.own_cells = cells_of[static_cast<std::size_t>(P.rank)];
+
+  const std::size_t nb = static_cast<std::size_t>((m.degree + 1) * (m.degree + 1));
+  P.node_rank.assign(nn, std::numeric_limits<std::uint32_t>::max());
+  for (std::size_t c = 0; c < nc; ++c)
+    for (std::size_t a = 0; a < nb; ++a) {
+      auto& r = P.node_rank[m.cell_nodes[c * nb + a]];
+      r = std::min(r, P.cell_rank[c]);
+    }
+  const auto me = static_cast<std::uint32_t>(P.rank);
+  for (std::size_t i = 0; i < nn; ++i)
+    if (P.node_rank[i] == me) P.own.push_back(static_cast<std::uint32_t>(i));
+
+  // A cell is stepped by its part's rank and by the rank of each of its nodes (so that a rank
+  // holds every cell around its own nodes); each such rank reads all the cell's nodes, and
+  // receives those it does not own from their owners.
+  std::vector<std::vector<std::uint32_t>> send(ranks), recv(ranks);
+  std::vector<char> local(nc, 0);
+  std::vector<std::uint32_t> rs;
+  for (std::size_t c = 0; c < nc; ++c) {
+    rs.assign(1, P.cell_rank[c]);
+    for (std::size_t a = 0; a < nb; ++a) rs.push_back(P.node_rank[m.cell_nodes[c * nb + a]]);
+    std::sort(rs.begin(), rs.end());
+    rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
+    local[c] = std::binary_search(rs.begin(), rs.end(), me);
+    for (std::size_t a = 0; a < nb; ++a) {
+      const std::uint32_t n = m.cell_nodes[c * nb + a], o = P.node_rank[n];
+      for (const std::uint32_t q : rs) {
+        if (q == o) continue;
+        if (o == me) send[q].push_back(n);
+        if (q == me) recv[o].push_back(n);
+      }
+    }
+  }
+  for (std::size_t q = 0; q < ranks; ++q) {
+    for (auto* l : {&send[q], &recv[q]}) {
+      std::sort(l->begin(), l->end());
+      l->erase(std::unique(l->begin(), l->end()), l->end());
+    }
+    if (send[q].empty() && recv[q].empty()) continue;
+    P.ghosts += recv[q].size();
+    P.links.push_back({static_cast<int>(q), std::move(send[q]), std::move(recv[q])});
+  }
+
+  // The perfectly matched layers: the layer cells this rank steps, colour by colour, and its
+  // own nodes' memories.
+  if (m.pml.active()) {
+    const Impl::Pml& L = m.pml;
+    P.pml_colour_start.assign(1, 0);
+    for (std::size_t k = 0; k + 1 < L.colour_start.size(); ++k) {
+      for (std::uint32_t c = L.colour_start[k]; c < L.colour_start[k + 1]; ++c)
+        if (local[L.cell[c]]) P.pml_cells.push_back(c);
+      P.pml_colour_start.push_back(static_cast<std::uint32_t>(P.pml_cells.size()));
+    }
+    for (std::size_t j = 0; j < L.node.size(); ++j)
+      if (P.node_rank[L.node[j]] == me) P.pml_nodes.push_back(static_cast<std::uint32_t>(j));
+  }
+
+  // The booked energies stay with rank 0; every rank adds its own nodes' share from now on.
+  P.work = P.rank == 0 ? energy.external_work : 0.0;
+  P.absorbed = P.rank == 0 ? energy.absorbed : 0.0;
+  m.part = std::move(part);
+}
+
+int Solver::rank() const { return impl_->part ? impl_->part->rank : 0; }
+int Solver::ranks() const { return impl_->part ? impl_->part->size : 1; }
+
+std::vector<std::uint32_t> Solver::own_nodes() const {
+  if (impl_->part) return impl_->part->own;
+  std::vector<std::uint32_t> all(impl_->x.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+  return all;
+}
+
+Solver::Traffic Solver::traffic() const {
+  Traffic t;
+  const Impl& m = *impl_;
+  if (!m.part) {
+    t.own_nodes = m.x.size();
+    t.own_cells = m.n_cells;
+    return t;
+  }
+  const Impl::Part& P = *m.part;
+  double most[5] = {P.seconds, static_cast<double>(P.own.size()), static_cast<double>(P.ghosts),
+                    static_cast<double>(P.links.size()), static_cast<double>(P.own_cells)};
+  double bytes = P.bytes;
+  MPI_Allreduce(MPI_IN_PLACE, most, 5, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, &bytes, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  t.seconds = most[0];
+  t.bytes = bytes;
+  t.updates = P.updates;
+  t.own_nodes = static_cast<std::size_t>(most[1]);
+  t.ghost_nodes = static_cast<std::size_t>(most[2]);
+  t.neighbours = static_cast<std::size_t>(most[3]);
+  t.own_cells = static_cast<std::size_t>(most[4]);
+  return t;
+}
+
+void exchange_ghosts(Solver::Impl& m) {
+  Solver::Impl::Part& P = *m.part;
+  const double t0 = MPI_Wtime();
+  std::size_t ns = 0, nr = 0;
+  for (const auto& l : P.links) {
+    ns += l.send.size();
+    nr += l.recv.size();
+  }
+  P.sendbuf.resize(4 * ns);
+  P.recvbuf.resize(4 * nr);
+  std::vector<MPI_Request> req;
+  req.reserve(2 * P.links.size());
+  std::size_t off = 0;
+  for (const auto& l : P.links) {
+    if (!l.recv.empty()) {
+      req.emplace_back();
+      MPI_Irecv(P.recvbuf.data() + off, static_cast<int>(4 * l.recv.size()), MPI_DOUBLE, l.rank,
+                kGhostTag, MPI_COMM_WORLD, &req.back());
+    }
+    off += 4 * l.recv.size();
+  }
+  const double* u = m.u.data();
+  const double* v = m.v.data();
+  off = 0;
+  for (const auto& l : P.links) {
+    double* b = P.sendbuf.data() + off;
+    for (const std::uint32_t n : l.send) {
+      *b++ = u[2 * n];
+      *b++ = u[2 * n + 1];
+      *b++ = v[2 * n];
+      *b++ = v[2 * n + 1];
+    }
+    if (!l.send.empty()) {
+      req.emplace_back();
+      MPI_Isend(P.sendbuf.data() + off, static_cast<int>(4 * l.send.size()), MPI_DOUBLE, l.rank,
+                kGhostTag, MPI_COMM_WORLD, &req.back());
+    }
+    off += 4 * l.send.size();
+  }
+  MPI_Waitall(static_cast<int>(req.size()), req.data(), MPI_STATUSES_IGNORE);
+  const double* b = P.recvbuf.data();
+  for (const auto& l : P.links)
+    for (const std::uint32_t n : l.recv) {
+      m.u[2 * n] = *b++;
+      m.u[2 * n + 1] = *b++;
+      m.v[2 * n] = *b++;
+      m.v[2 * n + 1] = *b++;
+    }
+  P.seconds += MPI_Wtime() - t0;
+  P.bytes += 8.0 * 4.0 * static_cast<double>(ns);
+  ++P.updates;
+}
+
+void sum_over_ranks(const Solver::Impl& m, double* v, int n) {
+  if (m.part) MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+}
+
+void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& owner,
+                    const std::vector<const std::vector<double>*>& fields, int width,
+                    std::vector<std::vector<double>>& out) {
+  const Solver::Impl::Part& P = *m.part;
+  const auto me = static_cast<std::uint32_t>(P.rank);
+  const std::size_t w = static_cast<std::size_t>(width), items = owner.size();
+  std::vector<double> mine;
+  for (std::size_t i = 0; i < items; ++i) {
+    if (owner[i] != me) continue;
+    for (const auto* f : fields) mine.insert(mine.end(), f->begin() + w * i, f->begin() + w * (i + 1));
+  }
+  out.clear();
+  // Every rank's count first; the whole must fit one message's count.
+  const long long n = static_cast<long long>(mine.size());
+  std::vector<long long> counts(static_cast<std::size_t>(P.size), 0);
+  MPI_Gather(&n, 1, MPI_LONG_LONG, counts.data(), 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  long long total = 0;
+  for (const auto c : counts) total += c;
+  int fits = total <= INT_MAX ? 1 : 0;
+  MPI_Bcast(&fits, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!fits)
+    throw FemError("FEM: gathering the whole mesh on rank 0 needs " + std::to_string(total) +
+                   " values, more than one MPI message holds (2^31 - 1)");
+  std::vector<int> cnt(counts.size()), displs(counts.size(), 0);
+  for (std::size_t q = 0; q < counts.size(); ++q) {
+    cnt[q] = static_cast<int>(counts[q]);
+    if (q > 0) displs[q] = displs[q - 1] + cnt[q - 1];
+  }
+  std::vector<double> all(P.rank == 0 ? static_cast<std::size_t>(total) : 0);
+  MPI_Gatherv(mine.data(), static_cast<int>(n), MPI_DOUBLE, all.data(), cnt.data(), displs.data(),
+              MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  if (P.rank != 0) return;
+  out.assign(fields.size(), std::vector<double>(w * items, 0.0));
+  std::vector<std::size_t> pos(displs.begin(), displs.end());
+  for (std::size_t i = 0; i < items; ++i) {
+    std::size_t& p = pos[owner[i]];
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      std::copy(all.begin() + static_cast<std::ptrdiff_t>(p),
+                all.begin() + static_cast<std::ptrdiff_t>(p + w), out[f].begin() + w * i);
+      p += w;
+    }
+  }
+}
+
+}  // namespace smpm::fem

@@ -1,0 +1,189 @@
+// The FE far field split over MPI ranks (fem::Solver::distribute; docs/parallel.md, "The FE far
+// field") against the same model on one process, which every rank builds beside it. Run by
+// CTest on 1, 2 and 4 ranks.
+//   * K u on each rank's own rows equals the one-process K u (bound 1e-14 of max |K u|; a row
+//     is summed in the same order, so measured 0), Q1 and Q2; the ranks' own nodes cover the
+//     mesh once.
+//   * A square with every FE boundary (a traction pulse, PMLs on two sides meeting in a corner
+//     with dashpots behind them, a damping band in front of Kelvin-Voigt springs, gravity), 300
+//     steps: u and v on the own nodes as on one process (bound 1e-14 of their maxima; measured
+//     0), the probes within 1e-14 of their maxima, each energy term within 1e-14 of the largest
+//     and the balance kinetic + elastic + absorbed - work within 1e-13 of it.
+//   * The oblique study's measurement, P at 30 degrees on a 10-cell PML and on LK: the
+//     reflection coefficients as on one process (1e-12 relative), on 2 ranks.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../../studies/oblique/oblique.hpp"
+#include "fem_common.hpp"
+
+namespace smpm::fem_testing {
+namespace {
+
+int world_size() {
+  int n = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+bool root() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r == 0;
+}
+
+double max_over_ranks(double v) {
+  MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return v;
+}
+
+// A 40 x 40-cell steel square (1 mm cells) with every kind of FE boundary, or a plain one.
+fem::Spec square(int degree, bool boundaries) {
+  fem::Spec s;
+  const double h = 1e-3;
+  s.mesh = fem::load_mesh(rectangle_geo("ranks_square", 40 * h, 40 * h, h), h);
+  s.degree = degree;
+  s.materials = {elastic("steel", 2e11, 0.25, 7800)};
+  s.region_material = {{1, 0}};
+  s.threads = 1;
+  if (!boundaries) return s;
+  s.gravity_y = -2000;
+  fem::Boundary top = bc(fem::Boundary::Kind::Traction, 14, "pulse");
+  top.normal = -1e8;
+  top.tangential = 3e7;
+  top.fn = sin2_bell(4e-6);
+  s.boundaries.push_back(top);
+  for (const int curve : {12, 13}) {
+    fem::Boundary p = bc(fem::Boundary::Kind::Pml, curve, "pml");
+    p.width = 10 * h;
+    p.r0 = 1e-2;
+    s.boundaries.push_back(p);
+    s.boundaries.push_back(bc(fem::Boundary::Kind::Dashpot, curve, "lk"));
+  }
+  fem::Boundary band = bc(fem::Boundary::Kind::Damping, 11, "band");
+  band.width = 8 * h;
+  band.r0 = 0.1;
+  s.boundaries.push_back(band);
+  fem::Boundary kv = bc(fem::Boundary::Kind::Dashpot, 11, "kv");
+  kv.delta = 40 * h;
+  s.boundaries.push_back(kv);
+  return s;
+}
+
+TEST(FemRanks, InternalForceOnOwnRowsAsOneProcess) {
+  for (const int degree : {1, 2}) {
+    fem::Solver one(square(degree, false)), split(square(degree, false));
+    split.distribute();
+    ASSERT_EQ(split.ranks(), world_size());
+    const std::size_t n = one.nodes();
+    // The own nodes cover the mesh once.
+    const std::vector<std::uint32_t> own = split.own_nodes();
+    std::vector<double> count(n, 0.0);
+    for (const auto i : own) count[i] += 1;
+    MPI_Allreduce(MPI_IN_PLACE, count.data(), static_cast<int>(n), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    EXPECT_EQ(*std::min_element(count.begin(), count.end()), 1.0);
+    EXPECT_EQ(*std::max_element(count.begin(), count.end()), 1.0);
+    // A smooth field with every mode in it.
+    std::vector<double> u(2 * n), f1(2 * n, 0.0), f2(2 * n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = one.node_x()[i] * 157.0, y = one.node_y()[i] * 211.0;
+      u[2 * i] = 1e-6 * std::sin(x + 0.3) * std::cos(0.7 * y);
+      u[2 * i + 1] = 1e-6 * std::cos(1.3 * x) * std::sin(y + 0.1);
+    }
+    one.internal_force(u.data(), f1.data());
+    split.internal_force(u.data(), f2.data());
+    double worst = 0, scale = 0;
+    for (const auto i : own)
+      for (int c = 0; c < 2; ++c) {
+        worst = std::max(worst, std::fabs(f2[2 * i + c] - f1[2 * i + c]));
+        scale = std::max(scale, std::fabs(f1[2 * i + c]));
+      }
+    worst = max_over_ranks(worst);
+    scale = max_over_ranks(scale);
+    if (root()) std::printf("  Q%d on %d rank(s): max |K u| %.3e, largest difference %.3e\n", degree,
+                world_size(), scale, worst);
+    EXPECT_GT(scale, 0.0);
+    EXPECT_LE(worst, 1e-14 * scale);
+  }
+}
+
+TEST(FemRanks, SquareWithEveryBoundaryAsOneProcess) {
+  fem::Solver one(square(1, true)), split(square(1, true));
+  split.distribute();
+  for (fem::Solver* s : {&one, &split}) {
+    s->set_dt(0.5 * s->critical_dt());
+    ASSERT_EQ(s->add_probe(0.02, 0.02), 0);      // on a node: four cells' mean
+    ASSERT_EQ(s->add_probe(0.0335, 0.0065), 1);  // in the layers' corner
+  }
+  double worst_probe = 0, probe_scale = 0;
+  for (int n = 0; n < 300; ++n) {
+    one.step();
+    split.step();
+    const auto a = one.sample(), b = split.sample();
+    for (std::size_t p = 0; p < a.size(); ++p)
+      for (const auto& [x, y] : {std::pair{a[p].sxx, b[p].sxx}, {a[p].syy, b[p].syy},
+                                 {a[p].sxy, b[p].sxy}}) {
+        worst_probe = std::max(worst_probe, std::fabs(x - y));
+        probe_scale = std::max(probe_scale, std::fabs(x));
+      }
+  }
+  double worst = 0, scale = 0;
+  for (const auto i : split.own_nodes())
+    for (int c = 0; c < 2; ++c) {
+      worst = std::max({worst, std::fabs(split.displacement()[2 * i + c] - one.displacement()[2 * i + c]),
+                        std::fabs(split.velocity()[2 * i + c] - one.velocity()[2 * i + c])});
+      scale = std::max({scale, std::fabs(one.displacement()[2 * i + c]),
+                        std::fabs(one.velocity()[2 * i + c])});
+    }
+  worst = max_over_ranks(worst);
+  scale = max_over_ranks(scale);
+  one.update_energies();
+  split.update_energies();
+  const Energies& e1 = one.energy;
+  const Energies& e2 = split.energy;
+  const double big = std::max({std::fabs(e1.kinetic), std::fabs(e1.elastic), std::fabs(e1.absorbed),
+                               std::fabs(e1.external_work)});
+  const double energy_diff =
+      std::max({std::fabs(e2.kinetic - e1.kinetic), std::fabs(e2.elastic - e1.elastic),
+                std::fabs(e2.absorbed - e1.absorbed), std::fabs(e2.external_work - e1.external_work)});
+  const double balance = e2.kinetic + e2.elastic + e2.absorbed - e2.external_work;
+  if (root()) std::printf("  %d rank(s): u, v %.3e of %.3e; probes %.3e of %.3e; energies %.3e of %.3e, "
+              "balance %.3e (absorbed %.3e)\n",
+              world_size(), worst, scale, worst_probe, probe_scale, energy_diff, big, balance,
+              e2.absorbed);
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LE(worst, 1e-14 * scale);
+  EXPECT_LE(worst_probe, 1e-14 * probe_scale);
+  EXPECT_GT(e2.absorbed, 0.05 * big);  // the layers took part
+  EXPECT_LE(energy_diff, 1e-14 * big);
+  EXPECT_LE(std::fabs(balance), 1e-13 * big);
+}
+
+TEST(FemRanks, ObliqueReflectionAsOneProcess) {
+  if (world_size() != 2) GTEST_SKIP() << "the oblique measurement runs on 2 ranks only (its cost)";
+  for (const std::string boundary : {"pml", "lk"}) {
+    oblique::Setup s;
+    s.angle_deg = 30;
+    s.threads = 1;
+    s.boundary = boundary;
+    s.band = 10;
+    const oblique::Result a = oblique::measure(s);
+    s.distributed = true;
+    const oblique::Result b = oblique::measure(s);
+    if (root()) std::printf("  %s, P at 30 deg: |R_PP| %.6f / %.6f, |R_PS| %.6f / %.6f (one process / 2 ranks)\n",
+                boundary.c_str(), a.r_same, b.r_same, a.r_conv, b.r_conv);
+    EXPECT_NEAR(b.r_same, a.r_same, 1e-12 * a.r_same);
+    EXPECT_NEAR(b.r_conv, a.r_conv, 1e-12 * a.r_conv);
+    EXPECT_NEAR(b.incident, a.incident, 1e-12 * a.incident);
+  }
+}
+
+}  // namespace
+}  // namespace smpm::fem_testing
