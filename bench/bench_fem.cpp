@@ -9,8 +9,10 @@
 // (degree, threads) and the speed-up, and how close the rate comes to the host's memory
 // bandwidth: the triad measured in the same run (bench/triad.hpp) against the bytes a step moves,
 // counted as bench counts them (each array a pass reads once, each it writes once more):
-//   K u      R rowptr (8 per node), the blocks (32 values + 4 column per block), u (16 per node,
-//            its neighbours' entries from cache); W -K u (16 per node)
+//   K u      R rowptr (8 per node), the blocks (4 column per block; 32 values per stored block:
+//            every block, or where rows share their values (a structured mesh) each kind of row's
+//            once, and an offset of 4 per node), u (16 per node, its neighbours' entries from
+//            cache); W -K u (16 per node)
 //   advance  R -K u, f_ext (16 + 16), constraint mask (1), dashpot index (4), 1/m (8);
 //            RW v, u (32 + 32) per node
 #include <omp.h>
@@ -127,15 +129,17 @@ int main(int argc, char** argv) {
         for (int k = 0; k < steps; ++k) s.internal_force(s.displacement().data(), f.data());
         const double mv = static_cast<double>(s.dofs()) * steps / seconds(t1);
         if (th == threads.front()) base = rate;
-        const double bytes = 36.0 * s.matrix_blocks() + (8 + 16 + 16 + 109.0) * s.nodes();
+        const double bytes = 4.0 * s.matrix_blocks() + 32.0 * s.stored_blocks() +
+                             (8 + 16 + 16 + 109.0 + (s.rows_shared() ? 4 : 0)) * s.nodes();
         const double per_dof = bytes / s.dofs();
         const double gbs = rate * per_dof / 1e9;
         const std::size_t k = static_cast<std::size_t>(&th - threads.data());
         std::printf("Q%d  %8zu dofs  %zu cells  threads %d  setup %.2f s  step %.3f ms  "
                     "%.1f M dof-updates/s (K u alone %.1f M/s)  speed-up %.2f  %.0f B/dof-update  "
-                    "%.1f GB/s, %.0f%% of the triad\n",
+                    "%.1f GB/s, %.0f%% of the triad  (K: %zu of %zu blocks stored)\n",
                     degree, s.dofs(), s.cells(), th, setup, 1e3 * el / steps, rate / 1e6, mv / 1e6,
-                    rate / base, per_dof, gbs, 100 * gbs / triad[k]);
+                    rate / base, per_dof, gbs, 100 * gbs / triad[k], s.stored_blocks(),
+                    s.matrix_blocks());
       }
     }
   } catch (const std::exception& e) {

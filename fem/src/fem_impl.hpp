@@ -36,9 +36,12 @@ struct Solver::Impl {
 
   // Stiffness, node-block CSR: row i has blocks k in [rowptr[i], rowptr[i+1]), column col[k],
   // values val[4k..4k+3] = Kxx, Kxy, Kyx, Kyy.
+  // Rows equal to another's bit for bit may share values (fem_setup.cpp, share_equal_rows): with
+  // row_val non-empty, row i's values start at block row_val[i] of val, not at rowptr[i].
   std::vector<std::uint64_t> rowptr;
   std::vector<std::uint32_t> col;
   std::vector<double> val;
+  std::vector<std::uint32_t> row_val;
 
   // Dashpot blocks C per dashpot node (their trapezoidal update: dashpot.hpp).
   std::vector<Solver::DashpotBlock> dash;

@@ -56,6 +56,8 @@ double symmetric_max_eigenvalue(std::vector<double>& a, int n) {
 
 std::size_t Solver::nodes() const { return impl_->x.size(); }
 std::size_t Solver::matrix_blocks() const { return impl_->col.size(); }
+std::size_t Solver::stored_blocks() const { return impl_->val.size() / 4; }
+bool Solver::rows_shared() const { return !impl_->row_val.empty(); }
 std::size_t Solver::cells() const { return impl_->n_cells; }
 int Solver::degree() const { return impl_->degree; }
 int Solver::thread_count() const { return impl_->threads; }
@@ -87,20 +89,23 @@ std::vector<std::uint32_t> Solver::boundary_nodes(const std::vector<int>& curves
 }
 
 namespace {
-// f = -K u on the rows list[0 .. n) (LIST), or on rows 0 .. n.
-template <bool LIST>
+// f = -K u on the rows list[0 .. n) (LIST), or on rows 0 .. n; SHARED: rows share values
+// (Impl::row_val).
+template <bool LIST, bool SHARED>
 void minus_ku(const Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
               const double* __restrict u, double* __restrict f) {
   const std::uint64_t* __restrict rp = m.rowptr.data();
   const std::uint32_t* __restrict cl = m.col.data();
   const double* __restrict kv = m.val.data();
+  const std::uint32_t* __restrict rv = m.row_val.data();
 #pragma omp parallel for schedule(static) num_threads(m.threads) if (n >= kParallelMinimum)
   for (std::int64_t r = 0; r < n; ++r) {
     const std::int64_t i = LIST ? list[r] : r;
+    const double* __restrict row = kv + 4 * (SHARED ? std::uint64_t{rv[i]} : rp[i]);
     double fx = 0, fy = 0;
     for (std::uint64_t k = rp[i]; k < rp[i + 1]; ++k) {
       const double ux = u[2 * cl[k]], uy = u[2 * cl[k] + 1];
-      const double* b = kv + 4 * k;
+      const double* b = row + 4 * (k - rp[i]);
       fx += b[0] * ux + b[1] * uy;
       fy += b[2] * ux + b[3] * uy;
     }
@@ -112,10 +117,16 @@ void minus_ku(const Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
 
 void Solver::internal_force(const double* __restrict u, double* __restrict f) const {
   const Impl& m = *impl_;
-  if (m.part)  // several ranks: this rank's own rows
-    minus_ku<true>(m, m.part->own.data(), static_cast<std::int64_t>(m.part->own.size()), u, f);
-  else
-    minus_ku<false>(m, nullptr, static_cast<std::int64_t>(m.x.size()), u, f);
+  const bool shared = !m.row_val.empty();
+  if (m.part) {  // several ranks: this rank's own rows
+    const auto n = static_cast<std::int64_t>(m.part->own.size());
+    if (shared) minus_ku<true, true>(m, m.part->own.data(), n, u, f);
+    else minus_ku<true, false>(m, m.part->own.data(), n, u, f);
+  } else {
+    const auto n = static_cast<std::int64_t>(m.x.size());
+    if (shared) minus_ku<false, true>(m, nullptr, n, u, f);
+    else minus_ku<false, false>(m, nullptr, n, u, f);
+  }
 }
 
 namespace {

@@ -133,6 +133,11 @@ class Solver {
   std::size_t dofs() const { return 2 * nodes(); }
   // 2 x 2 blocks of the stiffness (node-block CSR: a node and each node it shares a cell with).
   std::size_t matrix_blocks() const;
+  // The blocks whose values K stores: matrix_blocks(), or far fewer when rows equal bit for bit
+  // share their values (a structured mesh's few kinds of rows; then each row also keeps an
+  // offset to its kind's values, rows_shared() true).
+  std::size_t stored_blocks() const;
+  bool rows_shared() const;
   std::size_t cells() const;
   int degree() const;
   int thread_count() const;
