@@ -684,7 +684,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
     }
     if (lam_springs > 0 && m.crit_dt > 0)
       m.crit_dt = 2.0 / std::sqrt(4.0 / (m.crit_dt * m.crit_dt) + lam_springs);
-    share_equal_rows(m);
+    if (spec.share_rows) share_equal_rows(m);
     m.dash_of_node.assign(nn, -1);
     for (const auto& [node, c] : cblocks) {
       m.dash_of_node[node] = static_cast<std::int32_t>(m.dash.size());

@@ -108,6 +108,9 @@ struct Spec {
   std::vector<Boundary> boundaries;
   int threads = 0;                         // 0: OpenMP default
   double gravity_x = 0, gravity_y = 0;     // body force per unit mass (m/s^2), lumped: f_i = m_i g
+  // Rows of K equal bit for bit share one copy of their values (Solver::rows_shared); false
+  // keeps every row's own (the tests compare the two).
+  bool share_rows = true;
 };
 
 // What a probe reads at a point: stresses, velocity, div u and curl u = du_y/dx - du_x/dy.
