@@ -90,6 +90,13 @@ void parallel_finalize() {
 }
 
 struct Distributed::Impl {
+  // PETSc's and MPI's objects are freed here, so that a constructor that fails after creating
+  // them (a check below) leaves nothing behind either.
+  ~Impl() {
+    for (auto& [n, s] : sf) PetscSFDestroy(&s);
+    if (da) DMDestroy(&da);
+    if (graph != MPI_COMM_NULL) MPI_Comm_free(&graph);
+  }
   MPI_Comm comm = MPI_COMM_NULL;
   MPI_Comm graph = MPI_COMM_NULL;  // the neighbours, sides and corners
   int rank = 0, size = 1;
@@ -278,11 +285,7 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across) : d_(std::make_un
   s.set_decomposition(this, own, d.w, dashpots);
 }
 
-Distributed::~Distributed() {
-  for (auto& [n, s] : d_->sf) PetscSFDestroy(&s);
-  if (d_->da) DMDestroy(&d_->da);
-  if (d_->graph != MPI_COMM_NULL) MPI_Comm_free(&d_->graph);
-}
+Distributed::~Distributed() = default;
 
 int Distributed::rank() const { return d_->rank; }
 int Distributed::size() const { return d_->size; }
