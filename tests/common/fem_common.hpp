@@ -42,6 +42,19 @@ inline Material elastic(const std::string& name, double E, double nu, double rho
 
 inline Material tungsten() { return elastic("tungsten", 411e9, 0.28, 15000); }
 
+// A steel rectangle of nx x ny square cells of 1 mm (the groups of rectangle_geo), Q`degree`,
+// one thread, no boundary conditions.
+inline fem::Spec steel_rectangle(const std::string& name, int nx, int ny, int degree) {
+  fem::Spec s;
+  const double h = 1e-3;
+  s.mesh = fem::load_mesh(rectangle_geo(name, nx * h, ny * h, h), h);
+  s.degree = degree;
+  s.materials = {elastic("steel", 2e11, 0.25, 7800)};
+  s.region_material = {{1, 0}};
+  s.threads = 1;
+  return s;
+}
+
 inline fem::Boundary bc(fem::Boundary::Kind k, int curve, const std::string& name) {
   fem::Boundary b;
   b.kind = k;

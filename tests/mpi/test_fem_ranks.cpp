@@ -46,13 +46,8 @@ double max_over_ranks(double v) {
 
 // A 40 x 40-cell steel square (1 mm cells) with every kind of FE boundary, or a plain one.
 fem::Spec square(int degree, bool boundaries) {
-  fem::Spec s;
+  fem::Spec s = steel_rectangle("ranks_square", 40, 40, degree);
   const double h = 1e-3;
-  s.mesh = fem::load_mesh(rectangle_geo("ranks_square", 40 * h, 40 * h, h), h);
-  s.degree = degree;
-  s.materials = {elastic("steel", 2e11, 0.25, 7800)};
-  s.region_material = {{1, 0}};
-  s.threads = 1;
   if (!boundaries) return s;
   s.gravity_y = -2000;
   fem::Boundary top = bc(fem::Boundary::Kind::Traction, 14, "pulse");

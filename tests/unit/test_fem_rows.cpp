@@ -21,17 +21,11 @@ namespace smpm::fem_testing {
 namespace {
 
 fem::Spec rectangle(int degree, bool share, bool springs) {
-  fem::Spec s;
-  const double h = 1e-3;
-  s.mesh = fem::load_mesh(rectangle_geo("rows_rect", 40 * h, 30 * h, h), h);
-  s.degree = degree;
-  s.materials = {elastic("steel", 2e11, 0.25, 7800)};
-  s.region_material = {{1, 0}};
-  s.threads = 1;
+  fem::Spec s = steel_rectangle("rows_rect", 40, 30, degree);
   s.share_rows = share;
   if (springs) {
     fem::Boundary kv = bc(fem::Boundary::Kind::Dashpot, 12, "kv");
-    kv.delta = 10 * h;
+    kv.delta = 10e-3;
     s.boundaries.push_back(kv);
   }
   return s;
