@@ -7,6 +7,7 @@
 #include <climits>
 #include <cstdio>
 #include <limits>
+#include <string>
 
 #include "fem_impl.hpp"
 
@@ -32,8 +33,20 @@ void Solver::distribute() {
     throw FemError("FEM: fewer cells (" + std::to_string(nc) + ") than MPI ranks (" +
                    std::to_string(P.size) + "): run it on fewer ranks or on a finer mesh");
   // Rank 0 cuts the mesh and sends the cut to the others, so that every rank holds the same one.
+  // It says first whether the cut worked, so that a failure stops every rank (with rank 0's
+  // reason printed by rank 0), not rank 0 alone while the others wait for the cut.
   P.cell_rank.assign(nc, 0);
-  if (P.rank == 0) P.cell_rank = partition_cells(m, static_cast<unsigned>(P.size));
+  std::string why;
+  if (P.rank == 0) {
+    try {
+      P.cell_rank = partition_cells(m, static_cast<unsigned>(P.size));
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+  }
+  int cut = why.empty() ? 1 : 0;
+  MPI_Bcast(&cut, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!cut) throw FemError(P.rank == 0 ? why : "FEM: rank 0 could not cut the mesh");
   MPI_Bcast(P.cell_rank.data(), static_cast<int>(nc), MPI_UINT32_T, 0, MPI_COMM_WORLD);
   std::vector<std::size_t> cells_of(ranks, 0);
   for (const auto r : P.cell_rank) ++cells_of[r];
