@@ -313,6 +313,10 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
 }  // namespace
 
 RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt) {
+  if (process_count() > 1 && !c.solver && !c.hybrid && opt.ranks_across > 0)
+    throw std::runtime_error("--ranks-across " + std::to_string(opt.ranks_across) +
+                             " lays out the blocks of an MPM grid; an FE case's mesh is cut by "
+                             "METIS: leave the option out");
   if (process_count() > 1 && c.hybrid)
     throw std::runtime_error(std::string("a hybrid (MPM and FEM) case") +
                              " does not run on several MPI ranks yet (" +

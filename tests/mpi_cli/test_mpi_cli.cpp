@@ -191,7 +191,9 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
        "2 MPI ranks cannot form blocks 3 ranks across"},
       {source_file("studies/hybrid/cases/film_hybrid_dashpot.json") + " --set time.end=1e-11",
        "a hybrid (MPM and FEM) case does not run on several MPI ranks yet (2 here)"},
-      {kFem + " --set fem.size=0.04", "FEM: fewer cells (1) than MPI ranks (2)"}};
+      {kFem + " --set fem.size=0.04", "FEM: fewer cells (1) than MPI ranks (2)"},
+      {kFem + " --ranks-across 2", "--ranks-across 2 lays out the blocks of an MPM grid; an FE "
+                                   "case's mesh is cut by METIS"}};
   int k = 0;
   for (const Bad& b : bad) {
     const Proc p = run(2, b.args + " --out " + o.string(), "refused" + std::to_string(k++));
