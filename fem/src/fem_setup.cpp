@@ -805,22 +805,10 @@ static void snapshot_mesh(const Solver::Impl& m, const Deal& d, std::vector<doub
   }
 }
 
-void Solver::write_snapshot(const std::string& dir, const std::string& base) {
-  Impl& m = *impl_;
+// One snapshot of m's u and v at time t into DIR/BASE.h5 (throws FemError).
+static void write_fields(Solver::Impl& m, const std::string& dir, const std::string& base, double t) {
   Deal& d = *m.deal;
   const std::size_t nn = m.x.size();
-  if (m.part) {
-    // Several ranks: every node's u and v from its owner to rank 0, which writes.
-    std::vector<std::vector<double>> all;
-    gather_on_root(m, m.part->node_rank, {&m.u, &m.v}, 2, all);
-    if (m.part->rank != 0) {
-      m.snapshot_times.push_back(t);
-      ++m.snapshots;
-      return;
-    }
-    m.u = std::move(all[0]);
-    m.v = std::move(all[1]);
-  }
   try {
     if (!d.snap.is_open()) {
       std::vector<double> xyz;
@@ -882,6 +870,32 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   } catch (const std::exception& e) {
     throw FemError(dir + ": cannot write the FEM snapshot: " + deal_message(e));
   }
+}
+
+void Solver::write_snapshot(const std::string& dir, const std::string& base) {
+  Impl& m = *impl_;
+  if (m.part) {
+    // Several ranks: every node's u and v from its owner to rank 0, which writes; whether it
+    // could is told to every rank, so that a failure stops them all.
+    std::vector<std::vector<double>> all;
+    gather_on_root(m, m.part->node_rank, {&m.u, &m.v}, 2, all);
+    std::string why;
+    if (m.part->rank == 0) {
+      m.u = std::move(all[0]);
+      m.v = std::move(all[1]);
+      try {
+        write_fields(m, dir, base, t);
+      } catch (const std::exception& e) {
+        why = e.what();
+      }
+    }
+    double failed = why.empty() ? 0.0 : 1.0;
+    sum_over_ranks(m, &failed, 1);
+    if (failed > 0)
+      throw FemError(m.part->rank == 0 ? why : dir + ": rank 0 could not write the FEM snapshot");
+  } else {
+    write_fields(m, dir, base, t);
+  }
   m.snapshot_times.push_back(t);
   ++m.snapshots;
 }
@@ -901,17 +915,19 @@ int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
   int found = 0;
   const bool writer = !m.part || m.part->rank == 0;
+  std::string why;
   try {
     if (writer) found = m.deal->snap.resume(dir, base, m.snapshot_times);
   } catch (const std::exception& e) {
-    throw FemError(dir + ": cannot reopen the FEM snapshots: " + deal_message(e));
+    why = dir + ": cannot reopen the FEM snapshots: " + deal_message(e);
+    found = -1;
   }
-  if (m.part) {  // the others keep rank 0's count
-    double f = found;
-    if (!writer) f = 0;
+  if (m.part) {  // the others keep rank 0's count, or stop with it
+    double f = writer ? found : 0;
     sum_over_ranks(m, &f, 1);
     found = static_cast<int>(f);
   }
+  if (found < 0) throw FemError(writer ? why : dir + ": rank 0 could not reopen the FEM snapshots");
   if (found == 0 && !m.snapshot_times.empty()) {
     // The earlier snapshots are gone: the file starts afresh and the count with it, so that a
     // later checkpoint lists only what the file holds.

@@ -159,7 +159,8 @@ class Solver {
   // Probes: add_probe returns the probe index, or -1 if the point is outside the mesh.
   int add_probe(double x, double y);
   std::vector<Sample> sample() const;
-  // Updates `energy` (kinetic, elastic; absorbed and external work accumulate in step()).
+  // Updates `energy` (kinetic, elastic; absorbed and external work accumulate in step(), and
+  // after distribute() are the sums over ranks as of this call).
   void update_energies();
 
   // Snapshots: DIR/BASE.h5 (the mesh once, then a group per snapshot) and DIR/BASE.xdmf, which
@@ -191,7 +192,7 @@ class Solver {
   const std::vector<double>& mass() const;          // lumped nodal mass (per component)
   std::vector<double>& displacement();               // 2 per node, interleaved
   std::vector<double>& velocity();                   // 2 per node, v^{n+1/2}
-  // f = -K u (2 per node). u and f must not alias.
+  // f = -K u (2 per node; after distribute(), this rank's own rows only). u and f must not alias.
   void internal_force(const double* u, double* f) const;
   struct DashpotBlock {
     std::uint32_t node;
@@ -227,9 +228,11 @@ class Solver {
   // cells around them, and receives its neighbours' nodes it reads (u and v) after every step.
   // Probes, energies, snapshots and checkpoints are reduced or gathered: rank 0 writes what one
   // process would, and every other rank calls the same functions (they are collective). Throws
-  // FemError when MPI is not running or the mesh has fewer cells than ranks. Call it once, before
-  // or after load_state. The arrays (node_x(), displacement() ...) keep the whole mesh's size; on
-  // a rank only its own nodes and the ones it receives hold current values.
+  // FemError, on every rank, when MPI is not running, the model is split already, METIS fails,
+  // the mesh has fewer cells than ranks or a part is empty. Call it once, before or after
+  // load_state. advance_free_nodes (the hybrid's) refuses a split model. The arrays (node_x(),
+  // displacement() ...) keep the whole mesh's size; on a rank only its own nodes and the ones it
+  // receives hold current values.
   void distribute();
   int rank() const;   // 0 on one process
   int ranks() const;  // 1 on one process
