@@ -113,7 +113,7 @@ struct Solver::Impl {
     std::vector<std::uint32_t> cell_rank;   // per cell: the rank of its part (METIS)
     std::vector<std::uint32_t> node_rank;   // per node: the lowest rank among its cells
     std::vector<std::uint32_t> own;         // this rank's nodes, ascending
-    std::size_t own_cells = 0, ghosts = 0;
+    std::size_t ghosts = 0;
     // The layer cells this rank steps (indices into pml's cells, by colour: colour k holds
     // pml_cells[pml_colour_start[k] .. pml_colour_start[k + 1])), and the entries of pml.node
     // that are its own nodes.

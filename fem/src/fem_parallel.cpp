@@ -54,7 +54,6 @@ void Solver::distribute() {
     if (cells_of[r] == 0)
       throw FemError("FEM: METIS left rank " + std::to_string(r) + " of " + std::to_string(P.size) +
                      " without cells (" + std::to_string(nc) + " cells): run it on fewer ranks");
-  P.own_cells = cells_of[static_cast<std::size_t>(P.rank)];
 
   const std::size_t nb = static_cast<std::size_t>((m.degree + 1) * (m.degree + 1));
   P.node_rank.assign(nn, std::numeric_limits<std::uint32_t>::max());
@@ -118,7 +117,6 @@ void Solver::distribute() {
   m.part = std::move(part);
 }
 
-int Solver::rank() const { return impl_->part ? impl_->part->rank : 0; }
 int Solver::ranks() const { return impl_->part ? impl_->part->size : 1; }
 
 std::vector<std::uint32_t> Solver::own_nodes() const {
@@ -133,14 +131,13 @@ Solver::Traffic Solver::traffic() const {
   const Impl& m = *impl_;
   if (!m.part) {
     t.own_nodes = m.x.size();
-    t.own_cells = m.n_cells;
     return t;
   }
   const Impl::Part& P = *m.part;
-  double most[5] = {P.seconds, static_cast<double>(P.own.size()), static_cast<double>(P.ghosts),
-                    static_cast<double>(P.links.size()), static_cast<double>(P.own_cells)};
+  double most[4] = {P.seconds, static_cast<double>(P.own.size()), static_cast<double>(P.ghosts),
+                    static_cast<double>(P.links.size())};
   double bytes = P.bytes;
-  MPI_Allreduce(MPI_IN_PLACE, most, 5, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, most, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &bytes, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   t.seconds = most[0];
   t.bytes = bytes;
@@ -148,7 +145,6 @@ Solver::Traffic Solver::traffic() const {
   t.own_nodes = static_cast<std::size_t>(most[1]);
   t.ghost_nodes = static_cast<std::size_t>(most[2]);
   t.neighbours = static_cast<std::size_t>(most[3]);
-  t.own_cells = static_cast<std::size_t>(most[4]);
   return t;
 }
 
@@ -162,7 +158,7 @@ void exchange_ghosts(Solver::Impl& m) {
   }
   P.sendbuf.resize(4 * ns);
   P.recvbuf.resize(4 * nr);
-  std::vector<MPI_Request> req;
+  std::vector<MPI_Request> req;  // a few per step: not worth keeping
   req.reserve(2 * P.links.size());
   std::size_t off = 0;
   for (const auto& l : P.links) {

@@ -19,17 +19,14 @@
 #include <vector>
 
 #include "common.hpp"
+#include "mpi_testing.hpp"
 #include "silentmpm/distributed.hpp"
 #include "silentmpm/solver.hpp"
 
 namespace smpm::testing {
 namespace {
 
-int ranks() {
-  int n = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
+int ranks() { return mpi_testing::world_size(); }
 
 // The layouts every test runs: slabs of rows (1 across), columns (every rank across), and on
 // 4 ranks 2 x 2 blocks.

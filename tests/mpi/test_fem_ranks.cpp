@@ -23,26 +23,14 @@
 
 #include "../../studies/oblique/oblique.hpp"
 #include "fem_common.hpp"
+#include "mpi_testing.hpp"
 
 namespace smpm::fem_testing {
 namespace {
 
-int world_size() {
-  int n = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
-
-bool root() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r == 0;
-}
-
-double max_over_ranks(double v) {
-  MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return v;
-}
+using mpi_testing::max_over_ranks;
+using mpi_testing::world_size;
+bool root() { return mpi_testing::world_rank() == 0; }
 
 // A 40 x 40-cell steel square (1 mm cells) with every kind of FE boundary, or a plain one.
 fem::Spec square(int degree, bool boundaries) {

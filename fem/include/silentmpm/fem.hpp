@@ -234,7 +234,6 @@ class Solver {
   // displacement() ...) keep the whole mesh's size; on a rank only its own nodes and the ones it
   // receives hold current values.
   void distribute();
-  int rank() const;   // 0 on one process
   int ranks() const;  // 1 on one process
   // The nodes this rank steps, ascending (every node on one process).
   std::vector<std::uint32_t> own_nodes() const;
@@ -243,7 +242,7 @@ class Solver {
   struct Traffic {
     double seconds = 0, bytes = 0;
     long updates = 0;
-    std::size_t own_nodes = 0, ghost_nodes = 0, neighbours = 0, own_cells = 0;
+    std::size_t own_nodes = 0, ghost_nodes = 0, neighbours = 0;
   };
   Traffic traffic() const;
 
