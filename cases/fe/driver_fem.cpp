@@ -1,6 +1,8 @@
 // The run loop's pieces for the FE region (driver_common.hpp) that call the far field.
 #include "driver_common.hpp"
 
+#include <algorithm>
+
 namespace smpm::detail {
 
 double probe_field(const fem::Sample& s, const std::string& f) {
@@ -17,6 +19,16 @@ nlohmann::ordered_json fem_json(const fem::Solver& s) {
                                 {"degree", s.degree()},
                                 {"critical_dt", s.critical_dt()},
                                 {"dashpot_nodes", s.dashpots().size()}};
+}
+
+nlohmann::ordered_json fem_traffic_json(const fem::Solver& s) {
+  const fem::Solver::Traffic t = s.traffic();
+  const double steps = static_cast<double>(std::max<long>(1, t.updates));
+  return {{"ghost_update_seconds_per_step", t.seconds / steps},
+          {"ghost_bytes_per_step", t.bytes / steps},
+          {"neighbours_most", t.neighbours},
+          {"own_nodes_most", t.own_nodes},
+          {"ghost_nodes_most", t.ghost_nodes}};
 }
 
 }  // namespace smpm::detail

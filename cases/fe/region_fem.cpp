@@ -73,14 +73,8 @@ class FemRegion final : public Region {
     j["dof_updates_per_second"] = r.dof_updates_per_second;
     j["threads"] = s_.thread_count();
     if (mpi()) {  // the ghost updates (every rank takes part)
-      const fem::Solver::Traffic t = s_.traffic();
-      const double steps = static_cast<double>(std::max<long>(1, t.updates));
       j["mpi_ranks"] = s_.ranks();
-      j["mpi"] = {{"ghost_update_seconds_per_step", t.seconds / steps},
-                  {"ghost_bytes_per_step", t.bytes / steps},
-                  {"neighbours_most", t.neighbours},
-                  {"own_nodes_most", t.own_nodes},
-                  {"ghost_nodes_most", t.ghost_nodes}};
+      j["mpi"] = fem_traffic_json(s_);
     }
     j["fem"] = fem_json(s_);
     j["energy"] = energy_json(s_.energy);

@@ -1,12 +1,15 @@
 // The hybrid region of the run loop (MPM + FEM coupled): each probe read from the region holding
 // its point, the energy terms of both regions summed, particle snapshots (particles.h5/.xdmf) and
-// FEM snapshots (fem.h5 + fem.xdmf), both regions' blocks in summary.json.
+// FEM snapshots (fem.h5 + fem.xdmf), both regions' blocks in summary.json. Under an MPI launcher
+// the grid is cut into blocks (MpmRanks), the far field by METIS (fem::Solver::distribute), and
+// the coupling sums its interface over the ranks (Hybrid::distribute; docs/parallel.md).
 #include <algorithm>
 #include <array>
 #include <filesystem>
 #include <stdexcept>
 
 #include "driver_common.hpp"
+#include "modules.hpp"
 #include "run_loop.hpp"
 #include "silentmpm/output.hpp"
 
@@ -16,13 +19,23 @@ namespace {
 
 class HybridRegion final : public Region {
  public:
-  explicit HybridRegion(Case& c) : c_(c), hy_(*c.hybrid), s_(*c.solver), fe_(*c.fem) {
+  HybridRegion(Case& c, int across, bool resuming)
+      : c_(c), hy_(*c.hybrid), s_(*c.solver), fe_(*c.fem), ranks_(s_, across) {
     for (const auto& pr : c.probes) {
       if (pr.fem_index < 0) {
         pts_.push_back({pr.x, pr.y});
         bodies_.push_back(pr.body);
       }
     }
+    // As the MPM region: split now, or after a restart has read the whole state.
+    if (!resuming) split();
+  }
+
+  // Under an MPI launcher, once: the grid into blocks, the far field by METIS, the interface.
+  void split() const {
+    if (!ranks_.split()) return;
+    fe_.distribute();
+    hy_.distribute(*ranks_.dist());
   }
 
   double dt() const override { return hy_.dt(); }
@@ -35,9 +48,13 @@ class HybridRegion final : public Region {
     remove_fem_snapshots(out_dir, resuming ? fe_.snapshot_count() : 0);
   }
 
-  void step() override { hy_.step(); }
+  void step() override {
+    split();
+    hy_.step();
+  }
 
   void record(std::vector<double>& row) override {
+    split();
     const auto ms = s_.sample(pts_, bodies_);
     const auto fs = fe_.sample();
     hy_.update_energies();
@@ -58,50 +75,67 @@ class HybridRegion final : public Region {
                                " (t = " + std::to_string(s_.t) + " s): energy is not finite");
   }
 
+  // Several ranks: one process's checkpoint, written by rank 0 (Hybrid::save_state).
   void save(StateWriter& w) const override {
+    split();
     hy_.save_state(w);
     snaps_.save(w);
   }
   bool restore(const StateReader& r) override {
     snaps_.restore(r);
-    return hy_.load_state(r);
+    const bool same_order = hy_.load_state(r);
+    if (!mpi()) return same_order;
+    const Energies e = s_.energy;
+    split();
+    ranks_.keep_account_on_root(e);
+    return false;  // the particles were re-cut into blocks and re-sorted
   }
 
   void open_snapshots(const std::string& out_dir) override {
-    snaps_.open(s_, c_.output, out_dir);
+    split();
+    ranks_.open_snapshots(snaps_, c_.output, out_dir);
     fe_.set_snapshot_compression(c_.output.compression);
     fe_.resume_snapshots(out_dir, "fem");
   }
   void write_snapshot(const std::string& out_dir) override {
-    snaps_.write(s_);
+    split();
+    ranks_.write_snapshot(snaps_, c_.output.grid);
     fe_.write_snapshot(out_dir, "fem");
   }
   void finish() override {
-    snaps_.close();
+    split();
+    ranks_.close_snapshots(snaps_);
     fe_.close_snapshots();
     hy_.update_energies();
   }
 
   void rates(RunResult& r, long steps_run, double step_seconds) const override {
+    split();
+    r.particles = static_cast<std::size_t>(ranks_.total(static_cast<double>(s_.p.size())));
     r.particle_updates_per_second =
-        static_cast<double>(s_.p.size()) * steps_run / std::max(step_seconds, 1e-12);
+        static_cast<double>(r.particles) * steps_run / std::max(step_seconds, 1e-12);
     r.dofs = fe_.dofs();
     r.dof_updates_per_second =
         static_cast<double>(fe_.dofs()) * steps_run / std::max(step_seconds, 1e-12);
   }
 
+  // Every rank calls it (sums over the ranks); rank 0 writes it.
   void summary(nlohmann::ordered_json& j, const RunResult& r, bool snapshots) const override {
-    j["particles"] = s_.p.size();
+    j["particles"] = r.particles;
     j["particle_updates_per_second"] = r.particle_updates_per_second;
     j["dofs"] = r.dofs;
     j["dof_updates_per_second"] = r.dof_updates_per_second;
     j["threads"] = s_.thread_count();
+    if (ranks_.dist()) {  // the grid's halo sums and migrations, the far field's ghost updates
+      ranks_.put_traffic(j, r.steps);
+      j["mpi"]["fem"] = fem_traffic_json(fe_);
+    }
     put_mpm_scheme(j, s_);
     j["fem"] = fem_json(fe_);
     j["hybrid"] = {{"shared_nodes", hy_.shared().size()},
                    {"interface_nodes", hy_.interface_nodes()}};
     j["energy"] = energy_json(hy_.energy);
-    j["energy_mpm"] = energy_json(s_.energy);
+    j["energy_mpm"] = energy_json(hy_.mpm_energy());
     j["energy_fem"] = energy_json(fe_.energy);
     j["energy_regions_note"] = "energy_mpm and energy_fem hold each region's own terms; their "
                                "imbalances are the energy that crossed the MPM-FEM interface and "
@@ -109,6 +143,7 @@ class HybridRegion final : public Region {
     j["silent_boundaries"] = silents_json(s_);
     j["loads"] = c_.notes;
     j["bodies"] = bodies_json(c_, s_);
+    ranks_.total_counts(j);
     j["curve_probes"] = curve_probes_json(c_.probes);
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
@@ -124,6 +159,7 @@ class HybridRegion final : public Region {
   Hybrid& hy_;
   Solver& s_;
   fem::Solver& fe_;
+  mutable MpmRanks ranks_;
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
   MpmSnapshots snaps_;
@@ -131,6 +167,8 @@ class HybridRegion final : public Region {
 
 }  // namespace
 
-std::unique_ptr<Region> hybrid_region(Case& c) { return std::make_unique<HybridRegion>(c); }
+std::unique_ptr<Region> hybrid_region(Case& c, int across, bool resuming) {
+  return std::make_unique<HybridRegion>(c, across, resuming);
+}
 
 }  // namespace smpm::detail

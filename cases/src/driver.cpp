@@ -317,12 +317,8 @@ RunResult run_case(Case& c, const std::string& out_dir, const RunOptions& opt) {
     throw std::runtime_error("--ranks-across " + std::to_string(opt.ranks_across) +
                              " lays out the blocks of an MPM grid; an FE case's mesh is cut by "
                              "METIS: leave the option out");
-  if (process_count() > 1 && c.hybrid)
-    throw std::runtime_error(std::string("a hybrid (MPM and FEM) case") +
-                             " does not run on several MPI ranks yet (" +
-                             std::to_string(process_count()) + " here): run it on one process");
   const std::unique_ptr<detail::Region> region =
-      c.hybrid     ? detail::far_field_module().hybrid_region(c)
+      c.hybrid     ? detail::far_field_module().hybrid_region(c, opt.ranks_across, !opt.restart.empty())
       : c.solver   ? detail::mpm_region(c, opt.ranks_across, !opt.restart.empty())
                    : detail::far_field_module().fem_region(c);
   return run_region(c, *region, out_dir, opt);

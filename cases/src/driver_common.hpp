@@ -5,11 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "silentmpm/case.hpp"
+#include "silentmpm/decomposition.hpp"
 #include "silentmpm/driver.hpp"
 #include "silentmpm/output.hpp"
 #include "silentmpm/state_io.hpp"
@@ -86,6 +88,44 @@ class MpmSnapshots {
   bool grid_on_ = false;
 };
 
+// An MPM solver under an MPI launcher (the MPM and the hybrid regions): every rank built the
+// whole case; each keeps its block once split() has cut it (docs/parallel.md). Its snapshots
+// are gathered on rank 0, its counts and energies summed over the ranks. On one process
+// nothing is cut and every call is the solver's own.
+class MpmRanks {
+ public:
+  MpmRanks(Solver& s, int across);
+  // Cuts the solver to this rank's block, once (nothing on one process); true when it cut now.
+  bool split();
+  Decomposition* dist() const { return dist_.get(); }
+  bool several() const;  // split over more than one rank
+  // After a whole checkpoint was read and split() cut it: the energy account's booked terms
+  // (as read, in `whole`) stay with rank 0; each rank's kinetic and elastic energy are its
+  // particles'.
+  void keep_account_on_root(const Energies& whole);
+  void open_snapshots(MpmSnapshots& snaps, const OutputSpec& out, const std::string& out_dir);
+  // Every rank calls it; rank 0 writes the particles (by id) and the grid's projection gathered.
+  void write_snapshot(MpmSnapshots& snaps, bool grid);
+  void close_snapshots(MpmSnapshots& snaps);
+  double total(double v) const;  // summed over the ranks (itself on one process)
+  // summary.json: "mpi_ranks", "mpi_ranks_across" and "mpi" (the halo sums' and migrations'
+  // time and bytes per step of `steps`), when split; every rank calls it.
+  void put_traffic(nlohmann::ordered_json& j, long steps) const;
+  // The whole grid's geometry: "origin", "cells", "cell".
+  nlohmann::ordered_json grid_json() const;
+  // The particle counts of the "bodies" and "silent_boundaries" blocks, summed over the ranks.
+  void total_counts(nlohmann::ordered_json& j) const;
+
+ private:
+  Solver& s_;
+  struct {
+    double x0, y0, h;
+    int nx, ny;
+  } whole_;  // the grid of the whole case (a rank's solver holds its window of it)
+  int across_ = 0;
+  std::unique_ptr<Decomposition> dist_;
+};
+
 // Writes `bytes` to `dst` whole or not at all: a temporary file beside it, every write, the
 // flush, fsync and close checked, then a rename. Throws naming dst and the cause.
 void write_file_atomically(const std::filesystem::path& dst, const std::string& bytes);
@@ -130,6 +170,9 @@ nlohmann::ordered_json summary_head(const Case& c, const RunResult& r, double dt
 nlohmann::ordered_json energy_json(const Energies& e);       // "energy"
 nlohmann::ordered_json silents_json(const Solver& s);        // "silent_boundaries"
 nlohmann::ordered_json fem_json(const fem::Solver& s);       // "fem"
+// The FE far field's ghost updates over ranks (collective when it is split): time and bytes
+// per step, the largest rank's counts.
+nlohmann::ordered_json fem_traffic_json(const fem::Solver& s);
 void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s);  // "scheme", "flip", "grid"
 // DIR/probes.csv: one row per probe column group of history.csv, "name,x,y,along,s" (along: the
 // probe along a curve a point belongs to, s its arc length; empty for a point probe).

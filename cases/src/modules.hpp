@@ -31,14 +31,14 @@
 namespace smpm::detail {
 
 // Bumped whenever the table or a signature in it changes (as kGmshModuleApi).
-inline constexpr int kFarFieldModuleApi = 1;
+inline constexpr int kFarFieldModuleApi = 2;
 
 struct FarFieldModule {
   int api;
   Case (*build_fem_case)(const Ctx& ctx, const ojson& doc);     // cases/fe/case_fem.cpp
   Case (*build_hybrid_case)(const Ctx& ctx, const ojson& doc);  // cases/fe/case_hybrid.cpp
   std::unique_ptr<Region> (*fem_region)(Case& c);               // cases/fe/region_fem.cpp
-  std::unique_ptr<Region> (*hybrid_region)(Case& c);            // cases/fe/region_hybrid.cpp
+  std::unique_ptr<Region> (*hybrid_region)(Case& c, int across, bool resuming);  // region_hybrid.cpp
   // The FE region's line of `silentmpm check`.
   std::string (*fem_check_line)(const Case& c);
 };

@@ -1,5 +1,6 @@
 // The MPM region of the run loop (a case with bodies and no FEM region): probes sampled from the
-// particles, particle snapshots (particles.h5 + particles.xdmf).
+// particles, particle snapshots (particles.h5 + particles.xdmf). Under an MPI launcher the
+// solver is cut into blocks (MpmRanks, shared with the hybrid region).
 #include <algorithm>
 #include <array>
 #include <stdexcept>
@@ -15,13 +16,127 @@ namespace smpm::detail {
 static_assert(kLayerSilent == 1 && kLayerTraction == 2 && kLayerSpring == 4 &&
               kLayerDamping == 8 && kLayerPml == 16);
 
+MpmRanks::MpmRanks(Solver& s, int across)
+    : s_(s), whole_{s.grid.x0, s.grid.y0, s.grid.h, s.grid.nx, s.grid.ny}, across_(across) {}
+
+bool MpmRanks::split() {
+  if (dist_ || !mpi()) return false;
+  dist_ = mpi()->distribute(s_, across_);
+  return true;
+}
+
+bool MpmRanks::several() const { return dist_ && dist_->size() > 1; }
+
+void MpmRanks::keep_account_on_root(const Energies& e) {
+  if (!dist_) return;
+  const bool root = dist_->rank() == 0;
+  s_.energy.initial = root ? e.initial : 0.0;
+  s_.energy.dissipated = root ? e.dissipated : 0.0;
+  s_.energy.absorbed = root ? e.absorbed : 0.0;
+  s_.energy.external_work = root ? e.external_work : 0.0;
+}
+
+void MpmRanks::open_snapshots(MpmSnapshots& snaps, const OutputSpec& out,
+                              const std::string& out_dir) {
+  if (!several()) snaps.open(s_, out, out_dir);
+  else if (dist_->rank() == 0)
+    snaps.open(out, out_dir, whole_.x0, whole_.y0, whole_.h, whole_.nx, whole_.ny);
+}
+
+void MpmRanks::write_snapshot(MpmSnapshots& snaps, bool grid) {
+  if (!several()) return snaps.write(s_);
+  std::vector<double> mine, all;
+  const auto layer = s_.layer_flags();
+  for (std::size_t k = 0; k < s_.p.size(); ++k) {
+    s_.p.pack(k, mine);
+    mine.push_back(layer[k]);
+  }
+  dist_->gather(mine, all);
+  // The grid's projection (output.grid): each rank's own nodes, by their index in the whole
+  // grid.
+  std::vector<double> nodes_mine, nodes_all;
+  Solver::NodalProjection P;
+  if (grid) {
+    P = s_.nodal_projection();
+    const auto own = dist_->own_nodes();
+    const auto org = dist_->window_origin();
+    const long wnnx = whole_.nx + 1;
+    for (int j = own[2]; j <= own[3]; ++j)
+      for (int i = own[0]; i <= own[1]; ++i) {
+        const long k = static_cast<long>(j - org[1]) * s_.grid.nnx + (i - org[0]);
+        nodes_mine.push_back(static_cast<double>(static_cast<long>(j) * wnnx + i));
+        for (const auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy})
+          nodes_mine.push_back((*v)[k]);
+      }
+    dist_->gather(nodes_mine, nodes_all);
+  }
+  if (dist_->rank() != 0) return;
+  if (grid) {
+    const std::size_t n = static_cast<std::size_t>(whole_.nx + 1) * (whole_.ny + 1);
+    for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) v->assign(n, 0.0);
+    for (std::size_t r = 0; r + 7 < nodes_all.size(); r += 8) {
+      const auto k = static_cast<std::size_t>(nodes_all[r]);
+      int q = 1;
+      for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) (*v)[k] = nodes_all[r + q++];
+    }
+  }
+  Particles p;
+  if (s_.p.has_film()) p.enable_film();
+  std::vector<std::uint8_t> flags;
+  for (std::size_t r = 0; r < all.size();) {
+    r += p.unpack(all.data() + r);
+    flags.push_back(static_cast<std::uint8_t>(all[r++]));
+  }
+  const std::vector<uint32_t> by_id = p.sort_by_id();
+  std::vector<std::uint8_t> f(flags.size());
+  for (std::size_t k = 0; k < f.size(); ++k) f[k] = flags[by_id[k]];
+  snaps.write(p, s_.steps, s_.t, f, grid ? &P : nullptr);
+}
+
+void MpmRanks::close_snapshots(MpmSnapshots& snaps) {
+  if (!several() || dist_->rank() == 0) snaps.close();
+}
+
+double MpmRanks::total(double v) const {
+  if (dist_) dist_->sum(&v, 1);
+  return v;
+}
+
+void MpmRanks::put_traffic(nlohmann::ordered_json& j, long steps) const {
+  if (!dist_) return;
+  // Communication per step: the slowest rank's seconds, every rank's bytes.
+  const Decomposition::Traffic t = dist_->traffic();
+  double slow[2] = {t.halo_seconds, t.migration_seconds};
+  double bytes[3] = {t.halo_bytes, t.migration_bytes, static_cast<double>(t.particles_sent)};
+  dist_->max(slow, 2);
+  dist_->sum(bytes, 3);
+  const double n = std::max(1.0, static_cast<double>(steps));
+  j["mpi_ranks"] = dist_->size();
+  j["mpi_ranks_across"] = dist_->across();
+  j["mpi"] = {{"halo_seconds_per_step", slow[0] / n},
+              {"migration_seconds_per_step", slow[1] / n},
+              {"halo_bytes_per_step", bytes[0] / n},
+              {"migration_bytes_per_step", bytes[1] / n},
+              {"particles_migrated", bytes[2]}};
+}
+
+nlohmann::ordered_json MpmRanks::grid_json() const {
+  return {{"origin", {whole_.x0, whole_.y0}}, {"cells", {whole_.nx, whole_.ny}}, {"cell", whole_.h}};
+}
+
+void MpmRanks::total_counts(nlohmann::ordered_json& j) const {
+  if (!dist_) return;
+  for (auto& sl : j["silent_boundaries"])
+    sl["particles"] = static_cast<std::size_t>(total(sl["particles"].get<double>()));
+  for (auto& b : j["bodies"])
+    b["particles"] = static_cast<std::size_t>(total(b["particles"].get<double>()));
+}
+
 namespace {
 
 class MpmRegion final : public Region {
  public:
-  MpmRegion(Case& c, int across, bool resuming)
-      : c_(c), s_(*c.solver),
-        whole_{s_.grid.x0, s_.grid.y0, s_.grid.h, s_.grid.nx, s_.grid.ny}, across_(across) {
+  MpmRegion(Case& c, int across, bool resuming) : c_(c), s_(*c.solver), ranks_(s_, across) {
     for (const auto& pr : c.probes) {
       pts_.push_back({pr.x, pr.y});
       bodies_.push_back(pr.body);
@@ -33,10 +148,7 @@ class MpmRegion final : public Region {
   }
 
   // Cuts the solver to this rank's block, once (under an MPI launcher).
-  void split() const {
-    if (dist_ || !mpi()) return;
-    dist_ = mpi()->distribute(s_, across_);
-  }
+  void split() const { ranks_.split(); }
 
   double dt() const override { return s_.dt; }
   double time() const override { return s_.t; }
@@ -71,7 +183,7 @@ class MpmRegion final : public Region {
   // on any number of ranks, or on one process, reads whole before it splits.
   void save(StateWriter& w) const override {
     split();
-    if (ranks()) s_.save_state_gathered(w, "mpm.");
+    if (ranks_.several()) s_.save_state_gathered(w, "mpm.");
     else s_.save_state(w, "mpm.");
     snaps_.save(w);
   }
@@ -81,84 +193,29 @@ class MpmRegion final : public Region {
     if (!mpi()) return same_order;
     const Energies e = s_.energy;
     split();
-    // The account's booked terms stay with rank 0; every rank's kinetic and elastic energy are
-    // its particles'.
-    const bool root = dist_->rank() == 0;
-    s_.energy.initial = root ? e.initial : 0.0;
-    s_.energy.dissipated = root ? e.dissipated : 0.0;
-    s_.energy.absorbed = root ? e.absorbed : 0.0;
-    s_.energy.external_work = root ? e.external_work : 0.0;
+    ranks_.keep_account_on_root(e);
     return false;  // the particles were re-cut into blocks and re-sorted
   }
 
   // Several ranks: rank 0 writes the snapshots of every rank's particles, gathered (in the
   // order of their ids).
-  bool ranks() const { return dist_ && dist_->size() > 1; }
   void open_snapshots(const std::string& out_dir) override {
     split();
-    if (!ranks()) snaps_.open(s_, c_.output, out_dir);
-    else if (dist_->rank() == 0)
-      snaps_.open(c_.output, out_dir, whole_.x0, whole_.y0, whole_.h, whole_.nx, whole_.ny);
+    ranks_.open_snapshots(snaps_, c_.output, out_dir);
   }
   void write_snapshot(const std::string&) override {
     split();
-    if (!ranks()) return snaps_.write(s_);
-    std::vector<double> mine, all;
-    const auto layer = s_.layer_flags();
-    for (std::size_t k = 0; k < s_.p.size(); ++k) {
-      s_.p.pack(k, mine);
-      mine.push_back(layer[k]);
-    }
-    dist_->gather(mine, all);
-    // The grid's projection (output.grid): each rank's own nodes, by their index in the whole
-    // grid.
-    std::vector<double> nodes_mine, nodes_all;
-    Solver::NodalProjection P;
-    if (c_.output.grid) {
-      P = s_.nodal_projection();
-      const auto own = dist_->own_nodes();
-      const auto org = dist_->window_origin();
-      const long wnnx = whole_.nx + 1;
-      for (int j = own[2]; j <= own[3]; ++j)
-        for (int i = own[0]; i <= own[1]; ++i) {
-          const long k = static_cast<long>(j - org[1]) * s_.grid.nnx + (i - org[0]);
-          nodes_mine.push_back(static_cast<double>(static_cast<long>(j) * wnnx + i));
-          for (const auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy})
-            nodes_mine.push_back((*v)[k]);
-        }
-      dist_->gather(nodes_mine, nodes_all);
-    }
-    if (dist_->rank() != 0) return;
-    if (c_.output.grid) {
-      const std::size_t n = static_cast<std::size_t>(whole_.nx + 1) * (whole_.ny + 1);
-      for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) v->assign(n, 0.0);
-      for (std::size_t r = 0; r + 7 < nodes_all.size(); r += 8) {
-        const auto k = static_cast<std::size_t>(nodes_all[r]);
-        int q = 1;
-        for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) (*v)[k] = nodes_all[r + q++];
-      }
-    }
-    Particles p;
-    if (s_.p.has_film()) p.enable_film();
-    std::vector<std::uint8_t> flags;
-    for (std::size_t r = 0; r < all.size();) {
-      r += p.unpack(all.data() + r);
-      flags.push_back(static_cast<std::uint8_t>(all[r++]));
-    }
-    const std::vector<uint32_t> by_id = p.sort_by_id();
-    std::vector<std::uint8_t> f(flags.size());
-    for (std::size_t k = 0; k < f.size(); ++k) f[k] = flags[by_id[k]];
-    snaps_.write(p, s_.steps, s_.t, f, c_.output.grid ? &P : nullptr);
+    ranks_.write_snapshot(snaps_, c_.output.grid);
   }
   void finish() override {
     split();
-    if (!ranks() || dist_->rank() == 0) snaps_.close();
+    ranks_.close_snapshots(snaps_);
     s_.update_energies();
   }
 
   void rates(RunResult& r, long steps_run, double step_seconds) const override {
     split();
-    r.particles = static_cast<std::size_t>(total(static_cast<double>(s_.p.size())));
+    r.particles = static_cast<std::size_t>(ranks_.total(static_cast<double>(s_.p.size())));
     r.particle_updates_per_second =
         static_cast<double>(r.particles) * steps_run / std::max(step_seconds, 1e-12);
   }
@@ -168,34 +225,14 @@ class MpmRegion final : public Region {
     j["particles"] = r.particles;
     j["particle_updates_per_second"] = r.particle_updates_per_second;
     j["threads"] = s_.thread_count();
-    if (dist_) {
-      // Communication per step: the slowest rank's seconds, every rank's bytes.
-      const Decomposition::Traffic t = dist_->traffic();
-      double slow[2] = {t.halo_seconds, t.migration_seconds};
-      double bytes[3] = {t.halo_bytes, t.migration_bytes, static_cast<double>(t.particles_sent)};
-      dist_->max(slow, 2);
-      dist_->sum(bytes, 3);
-      const double n = std::max(1.0, static_cast<double>(r.steps));
-      j["mpi_ranks"] = dist_->size();
-      j["mpi_ranks_across"] = dist_->across();
-      j["mpi"] = {{"halo_seconds_per_step", slow[0] / n},
-                  {"migration_seconds_per_step", slow[1] / n},
-                  {"halo_bytes_per_step", bytes[0] / n},
-                  {"migration_bytes_per_step", bytes[1] / n},
-                  {"particles_migrated", bytes[2]}};
-    }
+    ranks_.put_traffic(j, r.steps);
     put_mpm_scheme(j, s_);
-    j["grid"] = {{"origin", {whole_.x0, whole_.y0}}, {"cells", {whole_.nx, whole_.ny}},
-                 {"cell", whole_.h}};
+    j["grid"] = ranks_.grid_json();
     j["energy"] = energy_json(s_.total_energy());
     j["silent_boundaries"] = silents_json(s_);
-    for (std::size_t q = 0; q < s_.silents.size(); ++q)
-      j["silent_boundaries"][q]["particles"] =
-          static_cast<std::size_t>(total(static_cast<double>(s_.silents[q].layer.idx.size())));
     j["loads"] = c_.notes;
     j["bodies"] = bodies_json(c_, s_);
-    for (auto& b : j["bodies"])
-      b["particles"] = static_cast<std::size_t>(total(b["particles"].get<double>()));
+    ranks_.total_counts(j);
     j["curve_probes"] = curve_probes_json(c_.probes);
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
@@ -205,21 +242,9 @@ class MpmRegion final : public Region {
   }
 
  private:
-  // A count summed over the ranks (itself on one process).
-  double total(double v) const {
-    if (dist_) dist_->sum(&v, 1);
-    return v;
-  }
-
   Case& c_;
   Solver& s_;
-  // The grid of the whole case (a rank's solver holds its window of it).
-  struct {
-    double x0, y0, h;
-    int nx, ny;
-  } whole_;
-  int across_ = 0;
-  mutable std::unique_ptr<Decomposition> dist_;
+  mutable MpmRanks ranks_;
   std::vector<std::array<double, 2>> pts_;
   std::vector<int> bodies_;
   MpmSnapshots snaps_;

@@ -58,6 +58,7 @@ class Region {
 std::unique_ptr<Region> mpm_region(Case& c, int across = 0, bool resuming = false);  // region_mpm.cpp
 // In the far-field module (cases/fe/; the core reaches them through modules.hpp).
 std::unique_ptr<Region> fem_region(Case& c);     // region_fem.cpp
-std::unique_ptr<Region> hybrid_region(Case& c);  // region_hybrid.cpp
+// The hybrid: `across` and `resuming` as for mpm_region (the grid's blocks).
+std::unique_ptr<Region> hybrid_region(Case& c, int across = 0, bool resuming = false);  // region_hybrid.cpp
 
 }  // namespace smpm::detail

@@ -120,7 +120,11 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
       }
 
   // Particles: none in an FE cell; volume per grid cell.
-  check_particles_in_fe_cells(true);
+  gx0_ = g.x0;
+  gy0_ = g.y0;
+  gnx_ = g.nx;
+  gny_ = g.ny;
+  if (const long k = particle_in_fe_cell(true); k >= 0) report_particle_in_fe_cell(k, true);
   std::vector<double> cell_vol(fe_cell_.size(), 0.0);
   const Particles& P = mpm_.p;
   for (std::size_t k = 0; k < P.size(); ++k) {
@@ -243,6 +247,10 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   fext_.assign(2 * nfe, 0.0);
   mpm_v_.assign(2 * shared_.size(), 0.0);
   sum_v_.assign(2 * shared_.size(), 0.0);
+  node_.resize(shared_.size());
+  for (std::size_t k = 0; k < shared_.size(); ++k) node_[k] = shared_[k][1];
+  fe_own_.assign(shared_.size(), 1);
+  mpm_own_.assign(shared_.size(), 1);
   fe_.internal_force(fe_.displacement().data(), fint_.data());
   fe_energies(false);
   fe_initial_ = fe_kinetic_ + fe_elastic_;
@@ -268,7 +276,7 @@ void Hybrid::set_dt(double dt) {
   mpm_.dt = dt;
 }
 
-void Hybrid::check_particles_in_fe_cells(bool at_setup) const {
+long Hybrid::particle_in_fe_cell(bool at_setup) const {
   const Grid& g = mpm_.grid;
   const Particles& P = mpm_.p;
   const long n = static_cast<long>(P.size());
@@ -278,25 +286,72 @@ void Hybrid::check_particles_in_fe_cells(bool at_setup) const {
     // those rows holds an FE cell (the film: particles above the interface), nothing to check.
     long lo, hi;
     mpm_.occupied_rows(lo, hi);
-    if (lo > hi || hi < fe_row_lo_ || lo > fe_row_hi_) return;
+    if (lo > hi || hi + org_j_ < fe_row_lo_ || lo + org_j_ > fe_row_hi_) return -1;
   }
+  // In the whole grid's cells (a rank's window starts elsewhere).
+  const double x0 = gx0_, y0 = gy0_;
+  const long nx = gnx_, ny = gny_;
   long first = n;
 #pragma omp parallel for schedule(static) reduction(min : first) num_threads(mpm_.thread_count())
   for (long k = 0; k < n; ++k) {
-    const long i = static_cast<long>(std::floor((P.x[k] - g.x0) * g.inv_h));
-    const long j = static_cast<long>(std::floor((P.y[k] - g.y0) * g.inv_h));
-    if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) continue;  // Solver reports leaving the grid
-    if (fc[j * g.nx + i] && k < first) first = k;
+    const long i = static_cast<long>(std::floor((P.x[k] - x0) * g.inv_h));
+    const long j = static_cast<long>(std::floor((P.y[k] - y0) * g.inv_h));
+    if (i < 0 || j < 0 || i >= nx || j >= ny) continue;  // Solver reports leaving the grid
+    if (fc[j * nx + i] && k < first) first = k;
   }
-  if (first == n) return;
+  return first == n ? -1 : first;
+}
+
+void Hybrid::report_particle_in_fe_cell(long k, bool at_setup) const {
+  const Particles& P = mpm_.p;
+  double id = k >= 0 ? static_cast<double>(P.id[k]) : -1, x = 0, y = 0;
+  if (k >= 0) {
+    x = P.x[k];
+    y = P.y[k];
+  }
+  if (dist_) {  // the lowest id over the ranks, and where it is
+    double neg = k >= 0 ? -id : -1e300;
+    dist_->max(&neg, 1);
+    const bool mine = k >= 0 && -neg == id;
+    double where[3] = {mine ? x : 0.0, mine ? y : 0.0, mine ? 1.0 : 0.0};
+    dist_->sum(where, 3);
+    id = -neg;
+    x = where[0] / std::max(1.0, where[2]);
+    y = where[1] / std::max(1.0, where[2]);
+  }
   std::ostringstream o;
-  o << "hybrid: particle " << P.id[first] << " at " << pt(P.x[first], P.y[first]) << " is inside an "
-    << "FE cell";
+  o << "hybrid: particle " << static_cast<std::uint64_t>(id) << " at " << pt(x, y)
+    << " is inside an FE cell";
   if (at_setup) o << " at setup: the MPM bodies overlap the FEM mesh";
   else
     o << " at step " << mpm_.steps << " (t = " << mpm_.t
       << " s): particles may not enter the FEM region; enlarge the MPM region";
   throw HybridError(o.str());
+}
+
+void Hybrid::share(std::vector<double>& v) const {
+  if (dist_) dist_->sum(v.data(), static_cast<int>(v.size()));
+}
+
+void Hybrid::distribute(Decomposition& d) {
+  if (dist_) throw HybridError("hybrid: the coupling is already split over the MPI ranks");
+  dist_ = &d;
+  const Grid& g = mpm_.grid;
+  const auto org = d.window_origin();
+  const auto own = d.own_nodes();
+  org_i_ = org[0];
+  org_j_ = org[1];
+  const long wnnx = gnx_ + 1;
+  for (std::size_t k = 0; k < shared_.size(); ++k) {
+    const long i = static_cast<long>(shared_[k][1]) % wnnx, j = static_cast<long>(shared_[k][1]) / wnnx;
+    const long li = i - org_i_, lj = j - org_j_;
+    node_[k] = li >= 0 && lj >= 0 && li < g.nnx && lj < g.nny ? lj * g.nnx + li : -1;
+    mpm_own_[k] = i >= own[0] && i <= own[1] && j >= own[2] && j <= own[3];
+    fe_own_[k] = fe_.node_owner(shared_[k][0]) == d.rank();
+  }
+  fe_own_nodes_ = fe_.own_nodes();
+  // The FE terms booked so far stay with rank 0 (each rank books its own nodes' from now on).
+  if (d.rank() != 0) fe_absorbed_ = fe_work_ = 0;
 }
 
 // ---- the hooks of the coupled step ----------------------------------------------------------
@@ -317,20 +372,32 @@ void Hybrid::after_forces(Solver& S) {
   fe_.refresh_external_force(S.t, fext_.data());
   const auto& mfe = fe_.mass();
   const std::vector<double>& v = fe_.velocity();
-  for (std::size_t k = 0; k < shared_.size(); ++k) {
-    const std::uint32_t e = shared_[k][0], n = shared_[k][1];
-    // The particles' own velocity at the node, for their FLIP increment (before_g2p).
-    mpm_v_[2 * k] = g.m[n] > 0 ? g.px[n] / g.m[n] : 0.0;
-    mpm_v_[2 * k + 1] = g.m[n] > 0 ? g.py[n] / g.m[n] : 0.0;
+  const std::size_t ns = shared_.size();
+  // The FE forces of the shared nodes (split: from their FE owners, summed over the ranks).
+  force_.assign(2 * ns, 0.0);
+  for (std::size_t k = 0; k < ns; ++k) {
+    const std::uint32_t e = shared_[k][0];
     if (has_mpm_mass_[k] && (fext_[2 * e] != 0 || fext_[2 * e + 1] != 0))
       throw HybridError("hybrid: an FEM boundary load acts on the interface node at " +
                         pt(fe_.node_x()[e], fe_.node_y()[e]) +
                         ": no external load may act on a node shared with the MPM region");
+    if (!fe_own_[k]) continue;
+    force_[2 * k] = fint_[2 * e] + fext_[2 * e];
+    force_[2 * k + 1] = fint_[2 * e + 1] + fext_[2 * e + 1];
+  }
+  share(force_);
+  for (std::size_t k = 0; k < ns; ++k) {
+    const std::uint32_t e = shared_[k][0];
+    const std::int64_t n = node_[k];
+    if (n < 0) continue;  // not in this rank's window
+    // The particles' own velocity at the node, for their FLIP increment (before_g2p).
+    mpm_v_[2 * k] = g.m[n] > 0 ? g.px[n] / g.m[n] : 0.0;
+    mpm_v_[2 * k + 1] = g.m[n] > 0 ? g.py[n] / g.m[n] : 0.0;
     g.m[n] += mfe[e];
     g.px[n] += mfe[e] * v[2 * e];
     g.py[n] += mfe[e] * v[2 * e + 1];
-    g.fx[n] += fint_[2 * e] + fext_[2 * e];
-    g.fy[n] += fint_[2 * e + 1] + fext_[2 * e + 1];
+    g.fx[n] += force_[2 * k];
+    g.fy[n] += force_[2 * k + 1];
   }
 }
 
@@ -342,8 +409,9 @@ void Hybrid::after_grid_update(Solver& S) {
   const auto& D = fe_.dashpots();
   double absorbed = 0;
   for (std::size_t k = 0; k < shared_.size(); ++k) {
-    const std::uint32_t e = shared_[k][0], n = shared_[k][1];
-    if (dash_of_fe_[e] < 0) continue;
+    const std::uint32_t e = shared_[k][0];
+    const std::int64_t n = node_[k];
+    if (n < 0 || dash_of_fe_[e] < 0) continue;
     const auto& c = D[dash_of_fe_[e]];
     const double vx = g.vx[n], vy = g.vy[n];
     double a, b;
@@ -351,6 +419,7 @@ void Hybrid::after_grid_update(Solver& S) {
                      g.fy[n], dt, g.fix[n], a, b);
     g.vnx[n] = a;
     g.vny[n] = b;
+    if (!mpm_own_[k]) continue;  // every copy updates; the owner books
     const double bx = 0.5 * (vx + a), by = 0.5 * (vy + b);
     absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
   }
@@ -367,12 +436,25 @@ void Hybrid::before_g2p(Solver& S) {
   // velocity as the old one: Sum_p m_p dv_p + m_FE dv_FE = m v+ - p_MPM - m_FE v_FE = dt f, so the
   // total momentum changes only by the external forces. (The summed velocity (p_MPM + m_FE v_FE)/m
   // would leave m_FE m_MPM / m (v_MPM - v_FE) unbalanced at every shared node.)
-  for (std::size_t k = 0; k < shared_.size(); ++k) {
-    const std::uint32_t n = shared_[k][1];
-    sum_v_[2 * k] = g.vx[n];
-    sum_v_[2 * k + 1] = g.vy[n];
+  // The summed velocity and v+ of every shared node (split: from their MPM owners).
+  const std::size_t ns = shared_.size();
+  vel_.assign(4 * ns, 0.0);
+  for (std::size_t k = 0; k < ns; ++k) {
+    const std::int64_t n = node_[k];
+    if (n < 0) continue;
+    if (mpm_own_[k]) {
+      vel_[4 * k] = g.vx[n];
+      vel_[4 * k + 1] = g.vy[n];
+      vel_[4 * k + 2] = g.vnx[n];
+      vel_[4 * k + 3] = g.vny[n];
+    }
     if (!(g.fix[n] & 1)) g.vx[n] = mpm_v_[2 * k];
     if (!(g.fix[n] & 2)) g.vy[n] = mpm_v_[2 * k + 1];
+  }
+  share(vel_);
+  for (std::size_t k = 0; k < ns; ++k) {
+    sum_v_[2 * k] = vel_[4 * k];
+    sum_v_[2 * k + 1] = vel_[4 * k + 1];
   }
 
   // FE nodes not shared: their own update in the fem library (lumped mass, semi-implicit
@@ -380,12 +462,14 @@ void Hybrid::before_g2p(Solver& S) {
   // velocity differs from v+ only at nodes with particle mass, the shared ones, done below).
   fe_.advance_free_nodes(grid_of_fe_.data(), fint_.data(), fext_.data(), dt, fe_work_, absorbed);
   // Shared nodes take the grid velocity; FE loads there (FE-only nodes) do work with it.
-  for (std::size_t k = 0; k < shared_.size(); ++k) {
-    const std::uint32_t e = shared_[k][0], n = shared_[k][1];
-    fe_work_ += dt * (fext_[2 * e] * 0.5 * (sum_v_[2 * k] + g.vnx[n]) +
-                      fext_[2 * e + 1] * 0.5 * (sum_v_[2 * k + 1] + g.vny[n]));
-    v[2 * e] = g.vnx[n];
-    v[2 * e + 1] = g.vny[n];
+  for (std::size_t k = 0; k < ns; ++k) {
+    const std::uint32_t e = shared_[k][0];
+    const double vnx = vel_[4 * k + 2], vny = vel_[4 * k + 3];
+    if (fe_own_[k])
+      fe_work_ += dt * (fext_[2 * e] * 0.5 * (sum_v_[2 * k] + vnx) +
+                        fext_[2 * e + 1] * 0.5 * (sum_v_[2 * k + 1] + vny));
+    v[2 * e] = vnx;
+    v[2 * e + 1] = vny;
   }
   fe_absorbed_ += absorbed;
 }
@@ -399,39 +483,57 @@ void Hybrid::after_remap(Solver& S) {
   const auto& mfe = fe_.mass();
   const std::vector<double>& v = fe_.velocity();
   for (std::size_t k = 0; k < shared_.size(); ++k) {
-    const std::uint32_t e = shared_[k][0], n = shared_[k][1];
+    const std::uint32_t e = shared_[k][0];
+    const std::int64_t n = node_[k];
+    if (n < 0) continue;
     g.qx[n] += mfe[e] * v[2 * e];
     g.qy[n] += mfe[e] * v[2 * e + 1];
   }
 }
 
+// The shared nodes' displacements advance with the velocity that strains the particles (MUSL:
+// the re-mapped q / m, USL: v+); split, from their MPM owners, in one sum with the particle
+// check's verdict.
 void Hybrid::end_of_step(Solver& S) {
   Grid& g = S.grid;
-  if (S.opt.scheme == Scheme::MUSL) advance_shared_displacement(g.qx, g.qy);
-  else advance_shared_displacement(g.vnx, g.vny);
+  const bool musl = S.opt.scheme == Scheme::MUSL;
+  const std::vector<double>& wx = musl ? g.qx : g.vnx;
+  const std::vector<double>& wy = musl ? g.qy : g.vny;
+  const std::size_t ns = shared_.size();
+  const long bad = particle_in_fe_cell(false);
+  disp_.assign(2 * ns + 1, 0.0);
+  for (std::size_t k = 0; k < ns; ++k) {
+    const std::int64_t n = node_[k];
+    if (n < 0 || !mpm_own_[k]) continue;
+    disp_[2 * k] = wx[n];
+    disp_[2 * k + 1] = wy[n];
+  }
+  disp_[2 * ns] = bad >= 0 ? 1.0 : 0.0;
+  share(disp_);
+  double* u = fe_.displacement().data();
+  const double dt = S.dt;
+  for (std::size_t k = 0; k < ns; ++k) {
+    const std::uint32_t e = shared_[k][0];
+    u[2 * e] += dt * disp_[2 * k];
+    u[2 * e + 1] += dt * disp_[2 * k + 1];
+  }
   fe_.t = S.t;
   ++fe_.steps;
-  check_particles_in_fe_cells(false);
-}
-
-// u^{n+1} = u^n + dt w at the shared nodes, w the grid velocity that strains the particles.
-void Hybrid::advance_shared_displacement(const std::vector<double>& wx, const std::vector<double>& wy) {
-  double* u = fe_.displacement().data();
-  const double dt = mpm_.dt;
-  for (const auto& s : shared_) {
-    u[2 * s[0]] += dt * wx[s[1]];
-    u[2 * s[0] + 1] += dt * wy[s[1]];
-  }
+  if (disp_[2 * ns] > 0) report_particle_in_fe_cell(bad, false);
 }
 
 // FE energies: kinetic 1/2 v M v; elastic 1/2 u^n K u^{n+1} (fint_ = -K u^n of the last step) or
 // 1/2 u K u before the first step.
+// Split over ranks: this rank's own nodes' shares.
 void Hybrid::fe_energies(bool) {
   const auto& m = fe_.mass();
   const auto& v = fe_.velocity();
   const auto& u = fe_.displacement();
+  const bool split = dist_ != nullptr;
+  const std::size_t n = split ? fe_own_nodes_.size() : m.size();
   double kin = 0, el = 0;
-  for (std::size_t i = 0; i < m.size(); ++i) {
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = split ? fe_own_nodes_[r] : r;
     kin += 0.5 * m[i] * (v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1]);
     el -= 0.5 * (fint_[2 * i] * u[2 * i] + fint_[2 * i + 1] * u[2 * i + 1]);
   }
@@ -442,17 +544,20 @@ void Hybrid::fe_energies(bool) {
 void Hybrid::update_energies() {
   mpm_.update_energies();
   fe_energies(true);
-  fe_.energy.kinetic = fe_kinetic_;
-  fe_.energy.elastic = fe_elastic_;
-  fe_.energy.absorbed = fe_absorbed_;
-  fe_.energy.external_work = fe_work_;
+  double fe[4] = {fe_kinetic_, fe_elastic_, fe_absorbed_, fe_work_};
+  if (dist_) dist_->sum(fe, 4);
+  fe_.energy.kinetic = fe[0];
+  fe_.energy.elastic = fe[1];
+  fe_.energy.absorbed = fe[2];
+  fe_.energy.external_work = fe[3];
   fe_.energy.initial = fe_initial_;
-  const Energies& a = mpm_.energy;
-  energy.kinetic = a.kinetic + fe_kinetic_;
-  energy.elastic = a.elastic + fe_elastic_;
+  mpm_total_ = mpm_.total_energy();
+  const Energies& a = mpm_total_;
+  energy.kinetic = a.kinetic + fe[0];
+  energy.elastic = a.elastic + fe[1];
   energy.dissipated = a.dissipated;
-  energy.absorbed = a.absorbed + fe_absorbed_;
-  energy.external_work = a.external_work + fe_work_;
+  energy.absorbed = a.absorbed + fe[2];
+  energy.external_work = a.external_work + fe[3];
 }
 
 std::array<double, 2> Hybrid::momentum() const {
@@ -464,11 +569,15 @@ std::array<double, 2> Hybrid::momentum() const {
   }
   const auto& m = fe_.mass();
   const auto& v = fe_.velocity();
-  for (std::size_t i = 0; i < m.size(); ++i) {
+  const std::size_t n = dist_ ? fe_own_nodes_.size() : m.size();
+  for (std::size_t r = 0; r < n; ++r) {
+    const std::size_t i = dist_ ? fe_own_nodes_[r] : r;
     mx += m[i] * v[2 * i];
     my += m[i] * v[2 * i + 1];
   }
-  return {mx, my};
+  double sum[2] = {mx, my};
+  if (dist_) dist_->sum(sum, 2);
+  return {sum[0], sum[1]};
 }
 
 }  // namespace smpm
@@ -477,19 +586,27 @@ namespace smpm {
 
 // Checkpoints: both regions' states and the coupling's own accounts (the FE region's energy
 // terms as the coupled step books them) and work arrays.
+// Split over ranks (every rank calls it; rank 0's writer holds one process's checkpoint): the
+// particles gathered, the FE state and -K u^n from each node's owner, the booked terms summed.
+// (mpm_v and sum_v live within a step; they are saved as this rank holds them.)
 void Hybrid::save_state(StateWriter& w) const {
-  mpm_.save_state(w, "mpm.");
+  if (dist_) mpm_.save_state_gathered(w, "mpm.");
+  else mpm_.save_state(w, "mpm.");
   fe_.save_state(w, "fem.");
   w.put("hybrid.energy", energy);
-  w.put("hybrid.fe_terms", std::vector<double>{step_absorbed_, fe_kinetic_, fe_elastic_,
-                                               fe_absorbed_, fe_work_, fe_initial_});
-  w.put("hybrid.fint", fint_);
+  std::vector<double> terms{step_absorbed_, fe_kinetic_, fe_elastic_, fe_absorbed_, fe_work_};
+  if (dist_) dist_->sum(terms.data(), static_cast<int>(terms.size()));
+  terms.push_back(fe_initial_);
+  w.put("hybrid.fe_terms", terms);
+  w.put("hybrid.fint", fe_.gathered(fint_));
   w.put("hybrid.fext", fext_);
   w.put("hybrid.mpm_v", mpm_v_);
   w.put("hybrid.sum_v", sum_v_);
 }
 
+// Reads one process's checkpoint into an unsplit coupling (distribute() after it).
 bool Hybrid::load_state(const StateReader& r) {
+  if (dist_) throw HybridError("hybrid: a checkpoint is read before the coupling is split over ranks");
   const bool same_order = mpm_.load_state(r, "mpm.");
   fe_.load_state(r, "fem.");
   energy = r.get<Energies>("hybrid.energy");

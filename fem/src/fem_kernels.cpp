@@ -328,10 +328,8 @@ void Solver::step() {
 
 void Solver::advance_free_nodes(const std::int64_t* skip, const double* f_int, const double* f_ext,
                                 double dt, double& work_out, double& absorbed_out) {
-  if (impl_->part)
-    throw FemError("FEM: the coupled update of an FE far field split over MPI ranks is not "
-                   "supported yet (run the hybrid on one process)");
   advance_nodes(*impl_, skip, f_int, f_ext, dt, true, work_out, absorbed_out);
+  if (impl_->part) exchange_ghosts(*impl_);
 }
 
 void Solver::update_energies() {

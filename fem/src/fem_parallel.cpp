@@ -126,6 +126,18 @@ std::vector<std::uint32_t> Solver::own_nodes() const {
   return all;
 }
 
+int Solver::node_owner(std::uint32_t node) const {
+  return impl_->part ? static_cast<int>(impl_->part->node_rank[node]) : 0;
+}
+
+std::vector<double> Solver::gathered(const std::vector<double>& per_node) const {
+  const Impl& m = *impl_;
+  if (!m.part) return per_node;
+  std::vector<std::vector<double>> out;
+  gather_on_root(m, m.part->node_rank, {&per_node}, 2, out);
+  return out.empty() ? std::vector<double>() : std::move(out[0]);
+}
+
 Solver::Traffic Solver::traffic() const {
   Traffic t;
   const Impl& m = *impl_;

@@ -141,6 +141,53 @@ inline HybRun make_strip(const Strip& c) {
   return m;
 }
 
+// The uniform-strain patch: uniaxial strain eps across the interface of a strip (c's sizes are
+// set here: 30 cells, 12 of particles on a 2 x 2 lattice, 4 high, rollers on top and bottom).
+// The particles carry sigma = C eps, the FE nodes u_x = eps x, and the traction sigma_xx acts on
+// both ends (MPM left, FE right): every node is in equilibrium.
+inline HybRun make_uniform_strain_patch(Strip& c, double eps) {
+  const Material mat = smpm::testing::tungsten();
+  const double sxx = mat.lambda * eps + 2 * mat.mu * eps, syy = mat.lambda * eps;
+  c.cells = 30;
+  c.mpm_cells = 12;
+  if (c.height < 4) c.height = 4;
+  c.ppc_side = 2;
+  c.load = false;
+  HybRun m = make_strip(c);
+  const double L = c.cells * c.h, H = c.height * c.h;
+  // Rebuild with the loads: particles' stress, MPM traction on the left, FE traction on the right.
+  {
+    Solver& s = *m.mpm;
+    for (std::size_t k = 0; k < s.p.size(); ++k) {
+      s.p.sxx[k] = sxx; s.p.syy[k] = syy; s.p.szz[k] = syy; s.p.sxy[k] = 0;
+    }
+    TractionLoad tl;
+    tl.layer = s.select_layer("left", 0, 0, H, 0, 0, -1, 0, c.h);
+    tl.normal = sxx;  // t = sigma n, n = (-1, 0): t . n = sigma_xx
+    s.tractions.push_back(tl);
+    s.finalize();
+  }
+  {
+    fem::Spec spec;
+    spec.mesh = fem::load_mesh(box_geo("patch", c.mpm_cells * c.h, 0, L, H, c.h), c.h);
+    spec.materials = {mat};
+    spec.region_material = {{1, 0}};
+    spec.threads = 1;
+    auto b13 = fe_bc(fem::Boundary::Kind::Roller, 13, "bottom");
+    auto b14 = fe_bc(fem::Boundary::Kind::Roller, 14, "top");
+    b13.component = b14.component = 1;
+    auto right = fe_bc(fem::Boundary::Kind::Traction, 12, "right");
+    right.normal = sxx;
+    spec.boundaries = {b13, b14, right};
+    m.hyb.reset();
+    m.fe = std::make_unique<fem::Solver>(spec);
+    for (std::size_t i = 0; i < m.fe->nodes(); ++i) m.fe->displacement()[2 * i] = eps * m.fe->node_x()[i];
+    m.hyb = std::make_unique<Hybrid>(*m.mpm, *m.fe);
+    m.hyb->set_dt(m.dt);
+  }
+  return m;
+}
+
 inline TimeFunction bell(double duration) {
   TimeFunction f;
   f.kind = TimeFunction::Kind::Sin2Pulse;

@@ -127,43 +127,7 @@ TEST(HybridConservation, UniformStrainPatch) {
   const double eps = -1e-4;
   const double sxx = mat.lambda * eps + 2 * mat.mu * eps, syy = mat.lambda * eps;
   Strip c;
-  c.cells = 30;
-  c.mpm_cells = 12;
-  c.height = 4;
-  c.ppc_side = 2;
-  c.load = false;
-  HybRun m = make_strip(c);
-  const double L = c.cells * c.h, H = c.height * c.h;
-  // Rebuild with the loads: particles' stress, MPM traction on the left, FE traction on the right.
-  {
-    Solver& s = *m.mpm;
-    for (std::size_t k = 0; k < s.p.size(); ++k) {
-      s.p.sxx[k] = sxx; s.p.syy[k] = syy; s.p.szz[k] = syy; s.p.sxy[k] = 0;
-    }
-    TractionLoad tl;
-    tl.layer = s.select_layer("left", 0, 0, H, 0, 0, -1, 0, c.h);
-    tl.normal = sxx;  // t = sigma n, n = (-1, 0): t . n = sigma_xx
-    s.tractions.push_back(tl);
-    s.finalize();
-  }
-  {
-    fem::Spec spec;
-    spec.mesh = fem::load_mesh(box_geo("patch", c.mpm_cells * c.h, 0, L, H, c.h), c.h);
-    spec.materials = {mat};
-    spec.region_material = {{1, 0}};
-    spec.threads = 1;
-    auto b13 = fe_bc(fem::Boundary::Kind::Roller, 13, "bottom");
-    auto b14 = fe_bc(fem::Boundary::Kind::Roller, 14, "top");
-    b13.component = b14.component = 1;
-    auto right = fe_bc(fem::Boundary::Kind::Traction, 12, "right");
-    right.normal = sxx;
-    spec.boundaries = {b13, b14, right};
-    m.hyb.reset();
-    m.fe = std::make_unique<fem::Solver>(spec);
-    for (std::size_t i = 0; i < m.fe->nodes(); ++i) m.fe->displacement()[2 * i] = eps * m.fe->node_x()[i];
-    m.hyb = std::make_unique<Hybrid>(*m.mpm, *m.fe);
-    m.hyb->set_dt(m.dt);
-  }
+  HybRun m = make_uniform_strain_patch(c, eps);
   std::vector<int> probes;
   for (double x : {13.3, 17.5, 22.25, 29.9})
     for (double y : {0.5, 2.0, 3.7}) probes.push_back(m.fe->add_probe(x * c.h, y * c.h));

@@ -33,12 +33,20 @@
 //   * an MPM cell touching the interface must be full (particle volume h^2 within 0.1 %);
 //   * no MPM traction on an interface node (setup) and no FE load on an interface node carrying
 //     MPM mass (checked every step: the FE load is evaluated there anyway).
+//
+// Over MPI ranks (distribute(); docs/parallel.md) the grid is cut into blocks and the FE mesh by
+// METIS, independently. A shared node's grid copies lie in the windows of one or more ranks, its
+// FE row on one: the step sums three short vectors over the ranks, each entry written by one
+// rank only (so the sums are exact): the FE forces of the shared nodes from their FE owners
+// (after the MPM forces), their v and v+ from their MPM owners (after the grid update), and the
+// velocity that advances their displacement (with the particle check's verdict, at the end).
 #include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "silentmpm/decomposition.hpp"
 #include "silentmpm/fem.hpp"
 #include "silentmpm/solver.hpp"
 
@@ -81,10 +89,17 @@ class Hybrid : public StepHooks {
   // The loads' power is taken with v+ (the coupled MUSL step books it before the re-map).
   bool remapped_power() const override { return false; }
 
+  // Several processes: call once on every rank, after the MPM solver was cut by `d` (which
+  // must outlive the steps) and the FE far field split (fem::Solver::distribute). Maps the
+  // shared nodes to this rank's window of the grid; the energy booked so far stays with rank 0.
+  void distribute(Decomposition& d);
+
   // Energies of both regions summed (kinetic, elastic; dissipated, absorbed and external work
-  // accumulate in step()); also refreshes mpm.energy and fe.energy.
+  // accumulate in step()); also refreshes mpm.energy and fe.energy (split over ranks: the sums
+  // over the ranks, collective; mpm.energy keeps this rank's share, mpm_energy() the sum).
   void update_energies();
   Energies energy;
+  const Energies& mpm_energy() const { return mpm_total_; }
 
   // Interface: (FE node, grid node) pairs of the shared nodes, and how many of them carry MPM
   // mass at setup (the interface proper).
@@ -94,7 +109,7 @@ class Hybrid : public StepHooks {
   const std::vector<std::uint8_t>& fe_cells() const { return fe_cell_; }
 
   // Total momentum of both regions (particles + FE nodes not shared + FE mass at shared nodes
-  // with the shared velocity).
+  // with the shared velocity); over ranks, the sum (collective).
   std::array<double, 2> momentum() const;
 
   // Checkpoints: both regions (blocks "mpm." and "fem.") and the coupling's accounts. load_state
@@ -121,10 +136,26 @@ class Hybrid : public StepHooks {
   double fe_kinetic_ = 0, fe_elastic_ = 0;
   double fe_absorbed_ = 0, fe_work_ = 0;
   double fe_initial_ = 0;
+  Energies mpm_total_;
+  // Per shared node: its node in the solver's grid (this rank's window when split; -1 when the
+  // window lacks it), whether this rank owns its FE row and its grid node (both 1 on one
+  // process); the vectors the step sums over the ranks.
+  std::vector<std::int64_t> node_;
+  std::vector<std::uint8_t> fe_own_, mpm_own_;
+  std::vector<double> force_, vel_, disp_;
+  std::vector<std::uint32_t> fe_own_nodes_;  // split: this rank's FE nodes
+  Decomposition* dist_ = nullptr;
+  // The whole grid (the particle check works in its cells) and this rank's window's origin.
+  double gx0_ = 0, gy0_ = 0;
+  long gnx_ = 0, gny_ = 0, org_i_ = 0, org_j_ = 0;
 
-  void check_particles_in_fe_cells(bool at_setup) const;
+  // The first particle (this rank's index) inside an FE cell, or -1; the error naming the one
+  // with the lowest id over all ranks (every rank calls it when any found one).
+  long particle_in_fe_cell(bool at_setup) const;
+  [[noreturn]] void report_particle_in_fe_cell(long k, bool at_setup) const;
+  // Sums v over the ranks (nothing on one process).
+  void share(std::vector<double>& v) const;
   void fe_energies(bool with_step_force);
-  void advance_shared_displacement(const std::vector<double>& wx, const std::vector<double>& wy);
 };
 
 }  // namespace smpm

@@ -212,7 +212,8 @@ class Solver {
   // forces f = f_int + f_ext (2 per node) and the current v: v+ = v + dt f / m, semi-implicit at a
   // node with a dashpot block (dashpot.hpp), constraints; then u += dt v+. Adds the work of f_ext
   // and the energy the dashpots absorb on those nodes to work and absorbed. The MPM-FEM hybrid
-  // advances its FE-only nodes with it (its shared nodes follow the grid).
+  // advances its FE-only nodes with it (its shared nodes follow the grid). Split over ranks:
+  // this rank's own nodes, then the ghost update (every rank calls it).
   void advance_free_nodes(const std::int64_t* skip, const double* f_int, const double* f_ext,
                           double dt, double& work, double& absorbed);
   // Nodes on the given boundary ids (physical curve tags), sorted.
@@ -230,13 +231,19 @@ class Solver {
   // process would, and every other rank calls the same functions (they are collective). Throws
   // FemError, on every rank, when MPI is not running, the model is split already, METIS fails,
   // the mesh has fewer cells than ranks or a part is empty. Call it once, before or after
-  // load_state. advance_free_nodes (the hybrid's) refuses a split model. The arrays (node_x(),
-  // displacement() ...) keep the whole mesh's size; on a rank only its own nodes and the ones it
-  // receives hold current values.
+  // load_state. The arrays (node_x(), displacement() ...) keep the whole mesh's size; on a rank
+  // only its own nodes and the ones it receives hold current values. The hybrid's calls work on
+  // a split model too: internal_force fills the own rows, advance_free_nodes advances the own
+  // nodes and then receives the neighbours' (collective).
   void distribute();
   int ranks() const;  // 1 on one process
   // The nodes this rank steps, ascending (every node on one process).
   std::vector<std::uint32_t> own_nodes() const;
+  // The rank that steps `node` (0 on one process).
+  int node_owner(std::uint32_t node) const;
+  // A per-node array (2 values a node, the whole mesh's size) as each node's owner holds it,
+  // on rank 0 (collective: the other ranks get an empty vector); on one process a copy.
+  std::vector<double> gathered(const std::vector<double>& per_node) const;
   // The ghost updates so far over all ranks (every rank calls it): the slowest rank's seconds,
   // the bytes all ranks sent, and the largest rank's counts.
   struct Traffic {
