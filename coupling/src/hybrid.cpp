@@ -53,6 +53,16 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   const auto& X = fe_.node_x();
   const auto& Y = fe_.node_y();
   const std::size_t nfe = X.size();
+  const auto fg = fe_.gravity();
+  if (fg[0] != mpm_.opt.gravity_x || fg[1] != mpm_.opt.gravity_y) {
+    std::ostringstream o;
+    o << "hybrid: the MPM region's gravity (" << mpm_.opt.gravity_x << ", " << mpm_.opt.gravity_y
+      << ") m/s^2 differs from the FEM region's (" << fg[0] << ", " << fg[1]
+      << "): give both regions the same body force";
+    throw HybridError(o.str());
+  }
+  gx_ = fg[0];
+  gy_ = fg[1];
 
   // FE nodes at grid nodes.
   grid_of_fe_.assign(nfe, -1);
@@ -398,6 +408,10 @@ void Hybrid::after_forces(Solver& S) {
     g.py[n] += mfe[e] * v[2 * e + 1];
     g.fx[n] += force_[2 * k];
     g.fy[n] += force_[2 * k + 1];
+    if (gx_ != 0 || gy_ != 0) {  // the FE mass's weight (the MPM step's covers m_MPM only)
+      g.fx[n] += mfe[e] * gx_;
+      g.fy[n] += mfe[e] * gy_;
+    }
   }
 }
 

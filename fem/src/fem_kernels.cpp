@@ -62,6 +62,9 @@ std::size_t Solver::cells() const { return impl_->n_cells; }
 int Solver::degree() const { return impl_->degree; }
 int Solver::thread_count() const { return impl_->threads; }
 std::array<double, 4> Solver::bounds() const { return impl_->box; }
+std::array<double, 2> Solver::gravity() const {
+  return {impl_->spec.gravity_x, impl_->spec.gravity_y};
+}
 double Solver::critical_dt() const { return impl_->crit_dt; }
 int Solver::snapshot_count() const { return impl_->snapshots; }
 std::vector<double> Solver::snapshot_times() const { return impl_->snapshot_times; }

@@ -53,6 +53,7 @@ struct Strip {
   Scheme scheme = Scheme::MUSL;
   double v0 = 0;          // initial x velocity of the particles
   bool load = true;       // the traction on the left end
+  double gravity_x = 0, gravity_y = 0;  // both regions' (m/s^2)
 };
 
 struct HybRun {
@@ -80,6 +81,8 @@ inline std::unique_ptr<fem::Solver> strip_fe(const Strip& c, double x0, bool loa
   s.materials = {testing::tungsten()};
   s.region_material = {{1, 0}};
   s.threads = 1;
+  s.gravity_x = c.gravity_x;
+  s.gravity_y = c.gravity_y;
   if (c.rollers) {
     auto b13 = fe_bc(fem::Boundary::Kind::Roller, 13, "bottom");
     auto b14 = fe_bc(fem::Boundary::Kind::Roller, 14, "top");
@@ -125,6 +128,8 @@ inline HybRun make_strip(const Strip& c) {
     }
     s->opt.scheme = c.scheme;
     s->opt.threads = 1;
+    s->opt.gravity_x = c.gravity_x;
+    s->opt.gravity_y = c.gravity_y;
     s->dt = dt;
     s->finalize();
     m.mpm = std::move(s);

@@ -153,3 +153,14 @@ TEST(HybridErrors, TimeStepAboveTheElementBound) {
   const std::string e = error_of([&] { hy.set_dt(2 * hy.critical_dt()); });
   EXPECT_NE(e.find("stability limit"), std::string::npos) << e;
 }
+
+// Both regions must pull with one gravity (a shared node weighs m_MPM + m_FE).
+TEST(HybridErrors, GravityDiffersBetweenTheRegions) {
+  auto s = particles();
+  s->opt.gravity_y = -9.81;
+  auto f = elements(20e-3, 1e-3);
+  const std::string e = error_of([&] { Hybrid hy(*s, *f); });
+  EXPECT_NE(e.find("the MPM region's gravity (0, -9.81) m/s^2 differs from the FEM region's (0, 0)"),
+            std::string::npos)
+      << e;
+}

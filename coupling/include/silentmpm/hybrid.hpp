@@ -32,7 +32,10 @@
 //   * a particle inside an FE cell (at setup and after every step);
 //   * an MPM cell touching the interface must be full (particle volume h^2 within 0.1 %);
 //   * no MPM traction on an interface node (setup) and no FE load on an interface node carrying
-//     MPM mass (checked every step: the FE load is evaluated there anyway).
+//     MPM mass (checked every step: the FE load is evaluated there anyway);
+//   * the same gravity in both regions (a shared node's weight is (m_MPM + m_FE) g: the MPM
+//     step puts m_MPM g on the grid and books the work of the whole nodal mass, the coupling
+//     adds m_FE g).
 //
 // Over MPI ranks (distribute(); docs/parallel.md) the grid is cut into blocks and the FE mesh by
 // METIS, independently. A shared node's grid copies lie in the windows of one or more ranks, its
@@ -131,6 +134,7 @@ class Hybrid : public StepHooks {
   std::vector<std::uint8_t> has_mpm_mass_; // per shared pair: node had MPM mass at setup
   std::size_t interface_count_ = 0;
   std::vector<double> fint_, fext_;        // FE per-dof work arrays
+  double gx_ = 0, gy_ = 0;                 // gravity (both regions')
   std::vector<double> mpm_v_, sum_v_;      // per shared node: p_MPM / m_MPM, (p_MPM + m_FE v_FE) / m
   double step_absorbed_ = 0;               // FE dashpot energy of this step at shared nodes
   double fe_kinetic_ = 0, fe_elastic_ = 0;

@@ -144,6 +144,8 @@ class Solver {
   std::size_t cells() const;
   int degree() const;
   int thread_count() const;
+  // The body force per unit mass (Spec::gravity_x, gravity_y).
+  std::array<double, 2> gravity() const;
   // Bounding box of the mesh: x0, y0, x1, y1.
   std::array<double, 4> bounds() const;
 
