@@ -1,5 +1,7 @@
 #include "silentmpm/gmsh_session.hpp"
 
+#include <omp.h>
+
 #include <atomic>
 #include <cstdio>
 #include <fstream>
@@ -46,7 +48,7 @@ std::string first_logged_error() {
 
 }  // namespace
 
-GmshSession::GmshSession() : lock_(gmsh_mutex()) {
+GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threads()) {
   static char name[] = "silentmpm";
   char* argv[] = {name, nullptr};
   gmsh::initialize(1, argv, /*readConfigFiles=*/false);
@@ -68,6 +70,7 @@ GmshSession::~GmshSession() {
     gmsh::finalize();
   } catch (...) {
   }
+  omp_set_num_threads(omp_threads_);
 }
 
 std::string GmshSession::call_error(const std::function<void()>& call) const {

@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include <omp.h>
 #include <unistd.h>
 
 #include "silentmpm/case.hpp"
@@ -155,6 +156,17 @@ void check_area(const Geometry& g, double exact_area, double perimeter, const ch
     }
     EXPECT_GT(full, 50) << what;
   }
+}
+
+// gmsh's start-up sets OpenMP's thread count to its own option (1): reading a geometry must
+// leave the process's count as it was, or every case with a geometry would step on one core.
+TEST(GeometrySeeding, ReadingKeepsTheThreadCount) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(3);
+  const Geometry g = load_geometry(write_file("rect_threads.geo", kRectangle).string(), 0.5 * kH);
+  EXPECT_GT(g.x.size(), 0u);
+  EXPECT_EQ(omp_get_max_threads(), 3);
+  omp_set_num_threads(before);
 }
 
 TEST(GeometrySeeding, DiskAreaAndPpc) {

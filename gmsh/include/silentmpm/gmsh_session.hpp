@@ -41,6 +41,11 @@ class GmshSession {
 
  private:
   std::unique_lock<std::mutex> lock_;
+  // gmsh's start-up sets OpenMP's thread count to its own option (General.NumThreads, 1), under
+  // which its meshers run (they are not safe on more threads in this gmsh): the process's
+  // count, saved here, is restored when the session ends, so that a case read through gmsh
+  // still steps on every core.
+  int omp_threads_ = 1;
 };
 
 // Pre-flight checks of a gmsh input, before anything is read or meshed ("" when fine):
