@@ -301,15 +301,19 @@ long Hybrid::particle_in_fe_cell(bool at_setup) const {
   // In the whole grid's cells (a rank's window starts elsewhere).
   const double x0 = gx0_, y0 = gy0_;
   const long nx = gnx_, ny = gny_;
-  long first = n;
-#pragma omp parallel for schedule(static) reduction(min : first) num_threads(mpm_.thread_count())
+  // The one with the lowest id (whatever order the particles are sorted in, on any rank).
+  std::uint64_t lowest = std::numeric_limits<std::uint64_t>::max();
+#pragma omp parallel for schedule(static) reduction(min : lowest) num_threads(mpm_.thread_count())
   for (long k = 0; k < n; ++k) {
     const long i = static_cast<long>(std::floor((P.x[k] - x0) * g.inv_h));
     const long j = static_cast<long>(std::floor((P.y[k] - y0) * g.inv_h));
     if (i < 0 || j < 0 || i >= nx || j >= ny) continue;  // Solver reports leaving the grid
-    if (fc[j * nx + i] && k < first) first = k;
+    if (fc[j * nx + i]) lowest = std::min<std::uint64_t>(lowest, P.id[k]);
   }
-  return first == n ? -1 : first;
+  if (lowest == std::numeric_limits<std::uint64_t>::max()) return -1;
+  for (long k = 0; k < n; ++k)
+    if (P.id[k] == lowest) return k;
+  return -1;
 }
 
 void Hybrid::report_particle_in_fe_cell(long k, bool at_setup) const {

@@ -153,8 +153,8 @@ class Hybrid : public StepHooks {
   double gx0_ = 0, gy0_ = 0;
   long gnx_ = 0, gny_ = 0, org_i_ = 0, org_j_ = 0;
 
-  // The first particle (this rank's index) inside an FE cell, or -1; the error naming the one
-  // with the lowest id over all ranks (every rank calls it when any found one).
+  // The particle inside an FE cell with the lowest id (this rank's index), or -1; the error
+  // naming the one with the lowest id over all ranks (every rank calls it when any found one).
   long particle_in_fe_cell(bool at_setup) const;
   [[noreturn]] void report_particle_in_fe_cell(long k, bool at_setup) const;
   // Sums v over the ranks (nothing on one process).
