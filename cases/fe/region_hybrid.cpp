@@ -126,9 +126,15 @@ class HybridRegion final : public Region {
     j["dofs"] = r.dofs;
     j["dof_updates_per_second"] = r.dof_updates_per_second;
     j["threads"] = s_.thread_count();
-    if (ranks_.dist()) {  // the grid's halo sums and migrations, the far field's ghost updates
+    if (ranks_.dist()) {  // the grid's halo sums and migrations, the far field's ghost updates,
+                          // the interface's sums (the slowest rank's seconds)
       ranks_.put_traffic(j, r.steps);
       j["mpi"]["fem"] = fem_traffic_json(fe_);
+      double slow = hy_.interface_seconds();
+      ranks_.dist()->max(&slow, 1);
+      const double n = std::max(1.0, static_cast<double>(r.steps));
+      j["mpi"]["interface_seconds_per_step"] = slow / n;
+      j["mpi"]["interface_values_per_step"] = hy_.interface_values() / n;
     }
     put_mpm_scheme(j, s_);
     j["fem"] = fem_json(fe_);

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -344,7 +345,11 @@ void Hybrid::report_particle_in_fe_cell(long k, bool at_setup) const {
 }
 
 void Hybrid::share(std::vector<double>& v) const {
-  if (dist_) dist_->sum(v.data(), static_cast<int>(v.size()));
+  if (!dist_) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  dist_->sum(v.data(), static_cast<int>(v.size()));
+  share_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  share_values_ += static_cast<double>(v.size());
 }
 
 void Hybrid::distribute(Decomposition& d) {

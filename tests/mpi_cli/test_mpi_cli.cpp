@@ -261,7 +261,7 @@ TEST(MpiCli, FarFieldOnOneToFourRanksAsOneProcess) {
 // On 1 rank history.csv is byte-identical to the plain run; on more, every column within 1e-10
 // of the largest of its kind, both snapshot files dataset by dataset (particles by id) within
 // 1e-10 of their largest values, the counts of summary.json equal and each energy term within
-// 1e-10 of the work done.
+// 1e-10 of the work done; the interface's sums carry 8 values a shared node and step, and one.
 TEST(MpiCli, HybridOnOneToFourRanksAsOneProcess) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const std::string pulse = source_file("studies/hybrid/cases/pulse_hybrid_dashpot.json") +
@@ -303,6 +303,10 @@ TEST(MpiCli, HybridOnOneToFourRanksAsOneProcess) {
     EXPECT_EQ(hf.status, 0) << tag << ": " << hf.out << hf.err;
     const nlohmann::json sa = summary(a), sb = summary(b);
     EXPECT_EQ(sb["mpi_ranks"], r.np);
+    // The interface's three sums: 2 + 4 + 2 values a shared node, and the guard's verdict.
+    EXPECT_EQ(sb["mpi"]["interface_values_per_step"].get<double>(),
+              8.0 * sa["hybrid"]["shared_nodes"].get<double>() + 1)
+        << tag;
     for (const char* k : {"particles", "dofs", "hybrid", "bodies", "fem", "outputs"})
       EXPECT_EQ(sb[k], sa[k]) << tag << " " << k;
     for (const char* e : {"kinetic", "elastic", "absorbed", "external_work"})

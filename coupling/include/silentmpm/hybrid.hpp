@@ -103,6 +103,10 @@ class Hybrid : public StepHooks {
   void update_energies();
   Energies energy;
   const Energies& mpm_energy() const { return mpm_total_; }
+  // Split over ranks: this rank's seconds in the interface's sums over the ranks so far, and
+  // the values it put into them.
+  double interface_seconds() const { return share_seconds_; }
+  double interface_values() const { return share_values_; }
 
   // Interface: (FE node, grid node) pairs of the shared nodes, and how many of them carry MPM
   // mass at setup (the interface proper).
@@ -149,6 +153,7 @@ class Hybrid : public StepHooks {
   std::vector<double> force_, vel_, disp_;
   std::vector<std::uint32_t> fe_own_nodes_;  // split: this rank's FE nodes
   Decomposition* dist_ = nullptr;
+  mutable double share_seconds_ = 0, share_values_ = 0;
   // The whole grid (the particle check works in its cells) and this rank's window's origin.
   double gx0_ = 0, gy0_ = 0;
   long gnx_ = 0, gny_ = 0, org_i_ = 0, org_j_ = 0;
