@@ -243,7 +243,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
         if (type == "traction")
           o.allow({"type", "name", "curve", "normal", "tangential", "vector", "time"}, where);
         if (type == "fixed") o.allow({"type", "name", "curve"}, where);
-        if (type == "damping_layer") o.allow({"type", "name", "curve", "width", "r0", "power"}, where);
+        if (type == "damping_layer") o.allow({"type", "name", "curve", "width", "r0", "power", "beta"}, where);
         if (type == "pml") o.allow({"type", "name", "curve", "width", "r0", "power", "alpha"}, where);
         if (type == "roller") o.allow({"type", "name", "curve", "component"}, where);
         fem::Boundary bc;
@@ -302,6 +302,9 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
           if (type == "pml") {
             bc.alpha = o.num("alpha", 0.0);
             o.ge("alpha", bc.alpha, 0);
+          } else {
+            bc.beta = o.num("beta", 0.0);
+            o.ge("beta", bc.beta, 0);
           }
         } else if (type == "fixed") {
           bc.kind = fem::Boundary::Kind::Fixed;

@@ -75,7 +75,21 @@ struct Solver::Impl {
     bool active() const { return !touched.empty(); }
   };
   Pml pml;
-  std::vector<double> dash_force;  // 2 per dashpot block: the PML's explicit forces (else 0)
+  // The damping layers' stiffness-proportional part (docs/physics.md section 9.2): at each
+  // listed node sqrt(beta_i); its force -sqrt(beta_i) (K w)_i, w = sqrt(beta) v, enters through
+  // the node's dashpot block as an explicit force (dash_force).
+  struct Viscous {
+    std::vector<std::uint32_t> node;  // ascending
+    std::vector<double> root_beta;    // per listed node
+    std::vector<std::uint32_t> rows;  // indices into node of the ones this rank steps
+    std::vector<std::uint32_t> row_node;
+    std::vector<double> w, kw;        // 2 per mesh node (zero away from the listed nodes)
+    bool active() const { return !node.empty(); }
+  };
+  Viscous visc;
+  // 2 per dashpot block: the explicit forces of the PML and of the damping layers'
+  // stiffness-proportional part (else 0).
+  std::vector<double> dash_force;
 
   // Traction loads: f_ext(t) = sum_l fn_l(t) F_l, F_l sparse over its nodes.
   struct Load {

@@ -293,10 +293,38 @@ void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n
   m.ku_valid = false;
 }
 
+// The damping layers' stiffness-proportional forces, -sqrt(beta_i) (K w)_i with w = sqrt(beta) v
+// (the velocity of the last step), added to the listed nodes' explicit forces; several ranks:
+// the rows of this rank's listed nodes (w reads its ghosts, which hold current v).
+void viscous_forces(Solver::Impl& m) {
+  Solver::Impl::Viscous& V = m.visc;
+  const double* __restrict v = m.v.data();
+  double* __restrict w = V.w.data();
+  for (std::size_t r = 0; r < V.node.size(); ++r) {
+    const std::uint32_t i = V.node[r];
+    w[2 * i] = V.root_beta[r] * v[2 * i];
+    w[2 * i + 1] = V.root_beta[r] * v[2 * i + 1];
+  }
+  const auto n = static_cast<std::int64_t>(V.row_node.size());
+  if (m.row_val.empty()) minus_ku<true, false>(m, V.row_node.data(), n, w, V.kw.data());
+  else minus_ku<true, true>(m, V.row_node.data(), n, w, V.kw.data());
+  double* __restrict f = m.dash_force.data();
+  const std::int32_t* __restrict dn = m.dash_of_node.data();
+  for (std::size_t q = 0; q < V.rows.size(); ++q) {
+    const std::uint32_t r = V.rows[q], i = V.node[r];
+    f[2 * dn[i]] += V.root_beta[r] * V.kw[2 * i];
+    f[2 * dn[i] + 1] += V.root_beta[r] * V.kw[2 * i + 1];
+  }
+}
+
 void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* f_int,
                    const double* f_ext, double dt, bool parallel, double& work_out,
                    double& absorbed_out) {
+  if (m.visc.active())  // these nodes' explicit forces start from zero (the PML's zeroes its own)
+    for (const std::uint32_t i : m.visc.node)
+      m.dash_force[2 * m.dash_of_node[i]] = m.dash_force[2 * m.dash_of_node[i] + 1] = 0.0;
   if (m.pml.active()) pml_forces(m, dt);
+  if (m.visc.active()) viscous_forces(m);
   if (m.part)
     advance_nodes_on<true>(m, m.part->own.data(), static_cast<std::int64_t>(m.part->own.size()),
                            skip, f_int, f_ext, dt, parallel, work_out, absorbed_out);

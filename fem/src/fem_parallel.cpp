@@ -112,6 +112,16 @@ void Solver::distribute() {
   }
 
   // The booked energies stay with rank 0; every rank adds its own nodes' share from now on.
+  // The damping layers' stiffness-proportional rows this rank steps: its own listed nodes.
+  if (m.visc.active()) {
+    m.visc.rows.clear();
+    m.visc.row_node.clear();
+    for (std::size_t r = 0; r < m.visc.node.size(); ++r)
+      if (P.node_rank[m.visc.node[r]] == static_cast<std::uint32_t>(P.rank)) {
+        m.visc.rows.push_back(static_cast<std::uint32_t>(r));
+        m.visc.row_node.push_back(m.visc.node[r]);
+      }
+  }
   P.work = P.rank == 0 ? energy.external_work : 0.0;
   P.absorbed = P.rank == 0 ? energy.absorbed : 0.0;
   m.part = std::move(part);

@@ -640,7 +640,9 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
         }
       }
     }
-    // Damping layers: C_i += alpha(x_i) m_i I at every node within `width` of the curves.
+    // Damping layers: C_i += alpha(x_i) m_i I at every node within `width` of the curves, and
+    // their stiffness-proportional parts beta_i (summed over the layers).
+    std::map<std::uint32_t, double> betas;
     for (std::size_t b = 0; b < spec.boundaries.size(); ++b) {
       const Boundary& bc = spec.boundaries[b];
       if (bc.kind != Boundary::Kind::Damping || dseg[b].empty()) continue;
@@ -655,12 +657,24 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
           dist = std::min(dist, std::hypot(m.x[i] - sg[0] - t * ex, m.y[i] - sg[1] - t * ey));
         }
         if (!(dist < bc.width)) continue;
-        const double alpha = a0 * std::pow(1.0 - dist / bc.width, bc.power);
+        const double ramp = std::pow(1.0 - dist / bc.width, bc.power);
+        if (bc.beta > 0 && bc.beta * ramp > 0) {
+          betas[static_cast<std::uint32_t>(i)] += bc.beta * ramp;
+          cblocks[static_cast<std::uint32_t>(i)];  // the force enters through a block
+        }
+        const double alpha = a0 * ramp;
         if (alpha == 0) continue;
         auto& c = cblocks[static_cast<std::uint32_t>(i)];
         c[0] += alpha * m.mass[i];
         c[2] += alpha * m.mass[i];
       }
+    }
+    double beta_max = 0;
+    m.visc = Impl::Viscous();
+    for (const auto& [node, beta] : betas) {
+      m.visc.node.push_back(node);
+      m.visc.root_beta.push_back(std::sqrt(beta));
+      beta_max = std::max(beta_max, beta);
     }
     // Perfectly matched layers: the cells that reach into a layer, and the nodal damping
     // m_i (d_x + d_y) in the dashpot blocks (every node of such a cell gets a block, through
@@ -684,6 +698,21 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
     }
     if (lam_springs > 0 && m.crit_dt > 0)
       m.crit_dt = 2.0 / std::sqrt(4.0 / (m.crit_dt * m.crit_dt) + lam_springs);
+    // The stiffness-proportional damping, explicit: a mode of frequency w is damped at most as
+    // by beta_max K (its Rayleigh quotient is at most beta_max w^2), and central differences with
+    // the lagged velocity are stable for dt <= (2 / w)(sqrt(1 + xi^2) - xi), xi = beta w / 2.
+    if (beta_max > 0 && m.crit_dt > 0) {
+      const double xi = beta_max / m.crit_dt;  // w_max = 2 / crit_dt
+      m.crit_dt *= std::sqrt(1 + xi * xi) - xi;
+    }
+    if (m.visc.active()) {
+      m.visc.w.assign(2 * nn, 0.0);
+      m.visc.kw.assign(2 * nn, 0.0);
+      for (std::size_t r = 0; r < m.visc.node.size(); ++r) {
+        m.visc.rows.push_back(static_cast<std::uint32_t>(r));
+        m.visc.row_node.push_back(m.visc.node[r]);
+      }
+    }
     if (spec.share_rows) share_equal_rows(m);
     m.dash_of_node.assign(nn, -1);
     for (const auto& [node, c] : cblocks) {
@@ -969,6 +998,7 @@ std::vector<std::string> Solver::describe() const {
       case Boundary::Kind::Fixed: s += "fixed"; break;
       case Boundary::Kind::Damping:
         s += "damping layer " + fmt(bc.width) + " m thick, r0 = " + fmt(bc.r0) + ", power " + fmt(bc.power);
+        if (bc.beta > 0) s += ", beta " + fmt(bc.beta) + " s";
         break;
       case Boundary::Kind::Pml:
         s += "perfectly matched layer " + fmt(bc.width) + " m thick, r0 = " + fmt(bc.r0) +

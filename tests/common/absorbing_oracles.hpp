@@ -41,34 +41,36 @@ inline double kv_reflected_energy_fraction(const TimeFunction& fn, double durati
   });
 }
 
-// A graded mass-proportional damping layer of thickness L (alpha = alpha0 (x / L)^power, x from
-// its inner edge) ending in a fixed end (lk = false) or an LK dashpot (lk = true), in a medium
-// of wave speed c (section 9.2): U'' = -(w^2 - i w alpha(x)) / c^2 U integrated by RK4 from the
-// end back to x = 0, where U = A e^{-ikx} + B e^{ikx} gives R = B / A.
+// A graded damping layer of thickness L, mass-proportional alpha = alpha0 (x / L)^power and
+// stiffness-proportional beta = beta0 (x / L)^power (x from its inner edge), ending in a fixed end
+// (lk = false) or an LK dashpot (lk = true), in a medium of wave speed c (section 9.2): with
+// S = c^2 (1 + i w beta) U' (the stress over the density), U' = S / (c^2 (1 + i w beta)) and
+// S' = -(w^2 - i w alpha) U, integrated by RK4 from the end back to x = 0, where
+// U = A e^{-ikx} + B e^{ikx} gives R = B / A.
 inline double damping_layer_r2(double w, double L, double alpha0, double power, double c,
-                               bool lk) {
+                               bool lk, double beta0 = 0) {
   using C = std::complex<double>;
   const C I(0, 1);
-  auto k2 = [&](double x) {
-    const double a = alpha0 * std::pow(std::max(x, 0.0) / L, power);
-    return (w * w - I * w * a) / (c * c);
+  auto ramp = [&](double x) { return std::pow(std::max(x, 0.0) / L, power); };
+  auto f = [&](double x, C uu, C ss, C& fu, C& fs) {
+    fu = ss / (c * c * (1.0 + I * w * beta0 * ramp(x)));
+    fs = -(w * w - I * w * alpha0 * ramp(x)) * uu;
   };
-  C u = lk ? C(1) : C(0), du = lk ? -I * w / c : C(1);
+  C u = lk ? C(1) : C(0), s = lk ? -I * w * c : C(c * c);
   const int n = 1000;
   const double h = -L / n;
-  for (int s = 0; s < n; ++s) {
-    const double x = L + s * h;
-    auto f = [&](double xx, C uu, C dd, C& fu, C& fd) { fu = dd; fd = -k2(xx) * uu; };
+  for (int k = 0; k < n; ++k) {
+    const double x = L + k * h;
     C a1, b1, a2, b2, a3, b3, a4, b4;
-    f(x, u, du, a1, b1);
-    f(x + 0.5 * h, u + 0.5 * h * a1, du + 0.5 * h * b1, a2, b2);
-    f(x + 0.5 * h, u + 0.5 * h * a2, du + 0.5 * h * b2, a3, b3);
-    f(x + h, u + h * a3, du + h * b3, a4, b4);
+    f(x, u, s, a1, b1);
+    f(x + 0.5 * h, u + 0.5 * h * a1, s + 0.5 * h * b1, a2, b2);
+    f(x + 0.5 * h, u + 0.5 * h * a2, s + 0.5 * h * b2, a3, b3);
+    f(x + h, u + h * a3, s + h * b3, a4, b4);
     u += h / 6 * (a1 + 2. * a2 + 2. * a3 + a4);
-    du += h / 6 * (b1 + 2. * b2 + 2. * b3 + b4);
+    s += h / 6 * (b1 + 2. * b2 + 2. * b3 + b4);
   }
   const double k0 = w / c;
-  const C q = du / (I * k0);
+  const C q = s / (c * c) / (I * k0);  // U'(0) / (i k), beta(0) = 0
   return std::norm((u + q) / (u - q));
 }
 

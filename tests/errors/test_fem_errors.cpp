@@ -128,6 +128,14 @@ TEST(FemErrors, BadInputs) {
   c["fem"]["boundaries"][2]["alpha"] = -1;
   EXPECT_ERROR(error_of(c), "fem.boundaries[2].alpha", ">= 0");
   c["fem"]["boundaries"][2].erase("alpha");
+  c["fem"]["boundaries"][2]["beta"] = 1e-7;  // a damping layer's key
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].beta", "unknown key", "for a pml boundary");
+  c["fem"]["boundaries"][2]["type"] = "damping_layer";
+  EXPECT_EQ(error_of(c), "");
+  c["fem"]["boundaries"][2]["beta"] = -1e-7;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].beta", ">= 0");
+  c["fem"]["boundaries"][2].erase("beta");
+  c["fem"]["boundaries"][2]["type"] = "pml";
   c["fem"]["boundaries"][2]["a"] = 1;
   EXPECT_ERROR(error_of(c), "fem.boundaries[2].a", "unknown key", "for a pml boundary");
   c["fem"]["boundaries"][2].erase("a");

@@ -5,7 +5,8 @@
 //     is summed in the same order, so measured 0), Q1 and Q2; the ranks' own nodes cover the
 //     mesh once.
 //   * A square with every FE boundary (a traction pulse, PMLs on two sides meeting in a corner
-//     with dashpots behind them, a damping band in front of Kelvin-Voigt springs, gravity), 300
+//     with dashpots behind them, a damping band with a stiffness-proportional part in front of
+//     Kelvin-Voigt springs, gravity), 300
 //     steps: u and v on the own nodes as on one process (bound 1e-14 of their maxima; measured
 //     0), the probes within 1e-14 of their maxima, each energy term within 1e-14 of the largest
 //     and the balance kinetic + elastic + absorbed - work within 1e-13 of it.
@@ -53,6 +54,7 @@ fem::Spec square(int degree, bool boundaries) {
   fem::Boundary band = bc(fem::Boundary::Kind::Damping, 11, "band");
   band.width = 8 * h;
   band.r0 = 0.1;
+  band.beta = 0.2 * h / 5900;  // a stiffness-proportional part too
   s.boundaries.push_back(band);
   fem::Boundary kv = bc(fem::Boundary::Kind::Dashpot, 11, "kv");
   kv.delta = 40 * h;

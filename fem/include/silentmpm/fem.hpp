@@ -89,8 +89,11 @@ struct Boundary {
   // Damping: a graded mass-proportional damping layer of thickness `width` inside the curves,
   // alpha(s) = alpha0 s^power per unit mass, s = 1 - (distance to the curves) / width, alpha0 =
   // -(power + 1) c_d ln(r0) / width (c_d of the material next to the curves); nodal blocks
-  // C_i = alpha(x_i) m_i I beside the dashpots (docs/physics.md section 9.2).
-  double width = 0, r0 = 1e-3, power = 2;
+  // C_i = alpha(x_i) m_i I beside the dashpots (docs/physics.md section 9.2). With beta > 0 (s)
+  // also a stiffness-proportional part graded alike, beta_i = beta s_i^power at the nodes, whose
+  // force is -B^1/2 K B^1/2 v (B = diag beta_i, K the assembled stiffness), explicit with the
+  // last velocity; the critical time step shrinks to dt_c (sqrt(1 + xi^2) - xi), xi = beta / dt_c.
+  double width = 0, r0 = 1e-3, power = 2, beta = 0;
   // Pml: a perfectly matched layer of thickness `width` inside the curves, which must form one
   // straight edge parallel to the x or the y axis. Complex coordinate stretching normal to the
   // edge, s = 1 + d / (alpha + i omega), d = d0 s^power (s the depth into the layer over width,
