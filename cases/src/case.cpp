@@ -1063,7 +1063,7 @@ class Builder {
                "time", "anchor", "interval"},
               where);
     } else if (type == "damping_layer") {
-      o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power"}, where);
+      o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power", "beta"}, where);
     } else if (type == "pml") {
       o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power", "alpha"}, where);
     } else if (type == "silent") {
@@ -1189,11 +1189,15 @@ class Builder {
       if (!(dl.r0 > 0 && dl.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(dl.r0));
       dl.power = o.num("power", 2.0);
       o.ge("power", dl.power, 0);
+      dl.beta0 = o.num("beta", 0.0);
+      o.ge("beta", dl.beta0, 0);
       o.done();
       c.notes.push_back("damping_layer \"" + name + "\" on the " + what + " (" +
                         std::to_string(dl.layer.ids.size()) + " particles): alpha = alpha0 s^" +
                         fmt(dl.power) + ", alpha0 = -(" + fmt(dl.power) + " + 1) c_d ln(" +
-                        fmt(dl.r0) + ") / width");
+                        fmt(dl.r0) + ") / width" +
+                        (dl.beta0 > 0 ? ", beta = " + fmt(dl.beta0) + " s^" + fmt(dl.power) + " s"
+                                      : std::string()));
       s_->dampers.push_back(std::move(dl));
       return;
     }
@@ -1417,10 +1421,14 @@ class Builder {
       dt = dt_or_cfl_ * crit;
     } else {
       dt = dt_or_cfl_;
+      bool viscous = false;  // a damping layer's stiffness part lowers the limit
+      for (const auto& dl : s_->dampers) viscous = viscous || dl.beta0 > 0;
       if (dt > crit * (1 + 1e-12))
         ctx_.fail("time.dt", fmt(dt) + " s is above the stability limit " + fmt_down(crit) +
-                                 " s = h / max c_d (CFL " + fmt(dt / crit) +
-                                 " > 1); use dt <= " + fmt_down(crit) + " or set time.cfl");
+                                 (viscous ? " s (h / max c_d, lowered by a damping_layer's beta)"
+                                          : " s = h / max c_d") +
+                                 " (CFL " + fmt(dt / crit) + " > 1); use dt <= " +
+                                 fmt_down(crit) + " or set time.cfl");
     }
     const std::string e = detail::step_count_error(t_end_, dt);
     if (!e.empty()) ctx_.fail("time", e);

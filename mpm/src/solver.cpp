@@ -113,7 +113,17 @@ std::vector<uint32_t> Solver::nodes_in_box(double x0, double y0, double x1, doub
 double Solver::critical_dt() const {
   double cmax = 0;
   for (const auto& m : materials) cmax = std::max(cmax, m.cd);
-  return cmax > 0 ? grid.h / cmax : std::numeric_limits<double>::infinity();
+  if (!(cmax > 0)) return std::numeric_limits<double>::infinity();
+  double dt_c = grid.h / cmax, beta = 0;
+  // A damping layer's stiffness-proportional part, explicit: central differences with a lagged
+  // viscous force are stable for dt <= (2 / w)(sqrt(1 + xi^2) - xi), xi = beta w / 2, at the
+  // grid's highest frequency w = 2 / dt_c.
+  for (const auto& dl : dampers) beta = std::max(beta, dl.beta0);
+  if (beta > 0) {
+    const double xi = beta / dt_c;
+    dt_c *= std::sqrt(1 + xi * xi) - xi;
+  }
+  return dt_c;
 }
 
 long Solver::first_particle_outside() const {
@@ -168,6 +178,11 @@ void Solver::finalize() {
       const double sdep = std::clamp(1.0 - L.d[k] / L.depth, 0.0, 1.0);
       dl.alpha[k] = a0 * std::pow(sdep, dl.power);
     }
+    dl.beta.assign(L.idx.size(), 0.0);
+    dl.sv.assign(3 * L.idx.size(), 0.0);
+    if (dl.beta0 > 0)
+      for (std::size_t k = 0; k < L.idx.size(); ++k)
+        dl.beta[k] = dl.beta0 * std::pow(std::clamp(1.0 - L.d[k] / L.depth, 0.0, 1.0), dl.power);
   }
   // Perfectly matched layers: every particle of a band's body inside it, with d_x and d_y summed
   // over the bands (both at a corner) from its position at the start.
@@ -801,6 +816,19 @@ void Solver::apply_loads() {
         add_dashpot_node(dn[a]);
       }
     }
+    // The stiffness-proportional part: the last step's viscous stress, -V sigma_v grad N_i.
+    if (dl.beta0 > 0)
+      for (std::size_t q = 0; q < L.idx.size(); ++q) {
+        const double* sv = dl.sv.data() + 3 * q;
+        if (sv[0] == 0 && sv[1] == 0 && sv[2] == 0) continue;
+        long dn[K];
+        layer_shape(L, q, Anchor::Particle, sf, dn);
+        const double V = p.vol[L.idx[q]];
+        for (int a = 0; a < K; ++a) {
+          grid.fx[dn[a]] -= V * (sv[0] * sf.dNx[a] + sv[2] * sf.dNy[a]);
+          grid.fy[dn[a]] -= V * (sv[2] * sf.dNx[a] + sv[1] * sf.dNy[a]);
+        }
+      }
   }
   if (pml.active()) pml_loads<S>();
   // Split over ranks: every load is in; the shared nodes sum their forces.
@@ -967,7 +995,7 @@ void Solver::boundary_work(bool remapped) {
   }
   // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i, with the
   // weights the blocks were assembled with.
-  for (const auto& dl : dampers) {
+  for (auto& dl : dampers) {
     const auto& L = dl.layer;
     constexpr int K = S::kNodes;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
@@ -981,6 +1009,33 @@ void Solver::boundary_work(bool remapped) {
         wbar(dn[a], bx, by);
         energy.absorbed += dt * c * N[a] * (ax * bx + ay * by);
       }
+    }
+    if (!(dl.beta0 > 0)) continue;
+    // The stiffness-proportional part: the work of the viscous force this step applied (with
+    // the power's velocity), then the viscous stress beta C : D for the next, D the strain rate
+    // of the velocity that strains the particles (at the same positions).
+    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+      if (dl.beta[q] == 0) continue;
+      const std::uint32_t k = L.idx[q];
+      layer_shape(L, q, Anchor::Particle, sf, nodes);
+      double* sv = dl.sv.data() + 3 * q;
+      const double V = p.vol[k];
+      double lxx = 0, lxy = 0, lyx = 0, lyy = 0;  // du_x/dx, du_x/dy, du_y/dx, du_y/dy
+      for (int a = 0; a < K; ++a) {
+        double bx, by;
+        wbar(nodes[a], bx, by);
+        energy.absorbed += dt * V * ((sv[0] * sf.dNx[a] + sv[2] * sf.dNy[a]) * bx +
+                                     (sv[2] * sf.dNx[a] + sv[1] * sf.dNy[a]) * by);
+        lxx += ux[nodes[a]] * sf.dNx[a];
+        lxy += ux[nodes[a]] * sf.dNy[a];
+        lyx += uy[nodes[a]] * sf.dNx[a];
+        lyy += uy[nodes[a]] * sf.dNy[a];
+      }
+      const Material& m = materials[p.group[k]];
+      const double b = dl.beta[q], tr = lxx + lyy;
+      sv[0] = b * (m.lambda * tr + 2 * m.mu * lxx);
+      sv[1] = b * (m.lambda * tr + 2 * m.mu * lyy);
+      sv[2] = b * m.mu * (lxy + lyx);
     }
   }
 }

@@ -32,7 +32,8 @@ void Solver::for_each_layer(Fn&& fn) {
   }
   for (auto& dl : dampers) {
     BoundaryLayer& L = dl.layer;
-    fn(L, Arrays{{&L.nx, 1}, {&L.ny, 1}, {&L.d, 1}, {&L.w, 1}, {&dl.alpha, 1}});
+    fn(L, Arrays{{&L.nx, 1}, {&L.ny, 1}, {&L.d, 1}, {&L.w, 1}, {&dl.alpha, 1}, {&dl.beta, 1},
+                 {&dl.sv, 3}});
   }
   if (!pml_bands.empty()) {
     PmlLayer& P = pml;

@@ -71,6 +71,8 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
     w.put(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux);
     w.put(pre + "silent" + std::to_string(k) + ".uy", silents[k].uy);
   }
+  for (std::size_t k = 0; k < dampers.size(); ++k)  // a stiffness part's viscous stresses
+    if (dampers[k].beta0 > 0) w.put(pre + "damper" + std::to_string(k) + ".sv", dampers[k].sv);
   if (pml.active()) {  // a perfectly matched layer's particles: displacements and memories
     w.put(pre + "pml.H", pml.H);
     w.put(pre + "pml.u", pml.u);
@@ -96,9 +98,13 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
     if (silents[k].springs())
       for (std::size_t q = 0; q < silents[k].layer.idx.size(); ++q)
         entries[silents[k].layer.idx[q]].push_back({k, static_cast<int>(q)});
-  const std::size_t pml_tag = silents.size();
+  const std::size_t pml_tag = silents.size(), damper_tag = pml_tag + 1;  // damper k: + k
   for (std::size_t q = 0; q < pml.layer.idx.size(); ++q)
     entries[pml.layer.idx[q]].push_back({pml_tag, static_cast<int>(q)});
+  for (std::size_t k = 0; k < dampers.size(); ++k)
+    if (dampers[k].beta0 > 0)
+      for (std::size_t q = 0; q < dampers[k].layer.idx.size(); ++q)
+        entries[dampers[k].layer.idx[q]].push_back({damper_tag + k, static_cast<int>(q)});
   for (std::size_t k = 0; k < p.size(); ++k) {
     p.pack(k, mine);
     mine.push_back(static_cast<double>(entries[k].size()));
@@ -107,6 +113,9 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
       if (l < pml_tag) {
         mine.push_back(silents[l].ux[q]);
         mine.push_back(silents[l].uy[q]);
+      } else if (l >= damper_tag) {
+        const double* sv = dampers[l - damper_tag].sv.data() + 3 * q;
+        mine.insert(mine.end(), sv, sv + 3);
       } else {
         for (const auto* v : {&pml.H, &pml.xi, &pml.zeta}) mine.insert(mine.end(), v->begin() + 4 * q, v->begin() + 4 * q + 4);
         mine.insert(mine.end(), pml.u.begin() + 2 * q, pml.u.begin() + 2 * q + 2);
@@ -123,6 +132,8 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
   std::vector<std::vector<std::uint32_t>> sids(silents.size());
   std::vector<double> H, xi, zeta, u;
   std::vector<std::uint32_t> pids;
+  std::vector<std::vector<double>> dsv(dampers.size());
+  std::vector<std::vector<std::uint32_t>> dids(dampers.size());
   for (std::size_t r = 0; r < all.size();) {
     r += q.unpack(all.data() + r);
     const std::uint32_t id = q.id.back();
@@ -133,6 +144,10 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
         sids[l].push_back(id);
         ux[l].push_back(all[r++]);
         uy[l].push_back(all[r++]);
+      } else if (l >= damper_tag) {
+        dids[l - damper_tag].push_back(id);
+        dsv[l - damper_tag].insert(dsv[l - damper_tag].end(), all.begin() + r, all.begin() + r + 3);
+        r += 3;
       } else {
         pids.push_back(id);
         for (auto* v : {&H, &xi, &zeta}) v->insert(v->end(), all.begin() + r, all.begin() + r + 4), r += 4;
@@ -149,6 +164,11 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
     w.put(pre + "silent" + std::to_string(k) + ".ux", ux[k]);
     w.put(pre + "silent" + std::to_string(k) + ".uy", uy[k]);
   }
+  for (std::size_t k = 0; k < dampers.size(); ++k)
+    if (dampers[k].beta0 > 0) {
+      w.put(pre + "damper" + std::to_string(k) + ".ids", dids[k]);
+      w.put(pre + "damper" + std::to_string(k) + ".sv", dsv[k]);
+    }
   if (!pml_bands.empty()) {
     w.put(pre + "pml.ids", pids);
     w.put(pre + "pml.H", H);
@@ -175,6 +195,12 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
     r.get(name + ".uy", silents[k].uy, m);
     if (r.has(name + ".ids"))
       reorder_by_ids(r, name, silents[k].layer, n, {{&silents[k].ux, 1}, {&silents[k].uy, 1}});
+  }
+  for (std::size_t k = 0; k < dampers.size(); ++k) {
+    if (!(dampers[k].beta0 > 0)) continue;
+    const std::string name = pre + "damper" + std::to_string(k);
+    r.get(name + ".sv", dampers[k].sv, 3 * dampers[k].layer.ids.size());
+    if (r.has(name + ".ids")) reorder_by_ids(r, name, dampers[k].layer, n, {{&dampers[k].sv, 3}});
   }
   if (pml.active()) {
     const std::size_t m = pml.layer.ids.size();

@@ -38,6 +38,7 @@ struct ColumnSpec {
   double gravity = 0;       // body force along +x (m/s^2), towards the right end
   int damp_cells = 0;       // a damping layer this many cells thick at the right end (r0, power 2)
   double damp_r0 = 1e-3;
+  double damp_beta = 0;     // its stiffness-proportional part (s)
   int pml_cells = 0;        // a perfectly matched layer this many cells thick at the right end
   double pml_alpha = 0;
 };
@@ -75,6 +76,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
     dl.layer = s->select_layer("damping", 0, c.offset + L, 0, c.offset + L, top, 1, 0,
                                c.damp_cells * c.h);
     dl.r0 = c.damp_r0;
+    dl.beta0 = c.damp_beta;
     s->dampers.push_back(dl);
   }
   if (c.pml_cells > 0) {

@@ -224,6 +224,20 @@ std::vector<Bad> bad_cases() {
                       {"width", 0.002}, {"r0", 1.5}};
        },
        "boundaries[2].r0: must be in (0, 1), got 1.5"},
+      {"damping_layer_negative_beta",
+       [](ojson& j) {
+         bnd(j, 2) = {{"type", "damping_layer"}, {"body", "plate"}, {"side", "bottom"},
+                      {"width", 0.002}, {"beta", -1e-7}};
+       },
+       "boundaries[2].beta: must be >= 0"},
+      {"damping_layer_beta_lowers_the_limit",
+       [](ojson& j) {
+         bnd(j, 2) = {{"type", "damping_layer"}, {"body", "plate"}, {"side", "bottom"},
+                      {"width", 0.002}, {"beta", 1e-5}};
+         j["time"].erase("cfl");
+         j["time"]["dt"] = 1e-8;
+       },
+       "lowered by a damping_layer's beta"},
       {"damping_layer_thicker_than_body",
        [](ojson& j) {
          bnd(j, 2) = {{"type", "damping_layer"}, {"body", "plate"}, {"side", "bottom"}, {"width", 1.0}};

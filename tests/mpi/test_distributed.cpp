@@ -81,6 +81,7 @@ std::unique_ptr<Solver> make_plate(const PlateSpec& c) {
   if (c.other_layers) {
     DampingLayer dl;
     dl.layer = s->select_layer("band", 0, 0, H, 0, 0, -1, 0, 5 * h);
+    dl.beta0 = 0.3 * h / s->materials[0].cd;  // a stiffness-proportional part too
     s->dampers.push_back(dl);
     PmlBand band;
     band.name = "pml";

@@ -68,7 +68,7 @@ TEST(Restart, MpmSpringsAndDampingBandBitIdentical) {
   c["boundaries"][1]["type"] = "kelvin_voigt";
   c["boundaries"][1]["delta"] = 30 * h;
   c["boundaries"].push_back({{"type", "damping_layer"}, {"body", "plate"}, {"side", "top"},
-                             {"width", 5 * h}, {"r0", 0.3}});
+                             {"width", 5 * h}, {"r0", 0.3}, {"beta", 0.3 * h / 5000}});
   c["output"]["snapshots"] = 4;
   const long from = expect_restart_identical("mpm_kv", c, "checkpoint_every", 100);
   EXPECT_EQ(from, 200);

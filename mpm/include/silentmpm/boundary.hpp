@@ -78,10 +78,16 @@ struct SilentBoundary {
 // (0 at the layer's inner edge, 1 on the boundary), assembled each step into the nodal dashpot
 // blocks, C_i += alpha_q m_q N_i(x_q) I, and integrated with them (docs/physics.md section 9.2).
 // alpha0 = -(power + 1) c_d ln(R0) / width makes the normal-incidence round trip return R0.
+// With beta0 > 0 also a stiffness-proportional part graded alike, beta = beta0 s^power (s): a
+// viscous stress beta C : D at each layer particle, D the strain rate of the velocity that
+// strains the particles in one step, whose force acts in the next (explicit; the critical time
+// step shrinks, Solver::critical_dt).
 struct DampingLayer {
   BoundaryLayer layer;
-  double r0 = 1e-3, power = 2;
+  double r0 = 1e-3, power = 2, beta0 = 0;
   std::vector<double> alpha;         // alpha per layer particle (1/s), set by Solver::finalize
+  std::vector<double> beta;          // beta per layer particle (s), set by Solver::finalize
+  std::vector<double> sv;            // 3 per layer particle: the viscous stress xx, yy, xy (Pa)
   // This step's weights of each particle (kNodes per particle: node, N), from the assembly of
   // the blocks; the power of the damping force is booked with the same ones.
   std::vector<long> nodes;
