@@ -3,6 +3,7 @@
 // surface in a physical surface) and written back as ASCII MSH 4.1 text for deal.II's stream
 // reader, without Physical Points (which deal.II's readers do not handle well).
 #include <gmsh.h>
+#include <mpi.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -63,7 +64,8 @@ static int find_tag(const std::vector<PhysicalGroup>& gs, const std::string& s) 
 int Mesh::surface_tag(const std::string& s) const { return find_tag(surfaces, s); }
 int Mesh::curve_tag(const std::string& s) const { return find_tag(curves, s); }
 
-Mesh load_mesh(const std::string& file, double size, double max_cells,
+namespace {
+Mesh mesh_here(const std::string& file, double size, double max_cells,
                const std::vector<std::pair<std::string, double>>& parameters) {
   std::error_code ec;
   if (!fs::exists(file, ec)) throw FemError(file + ": mesh file not found");
@@ -190,6 +192,65 @@ Mesh load_mesh(const std::string& file, double size, double max_cells,
   m.msh = ss.str();
   fs::remove(tmp, ec);
   if (m.msh.empty()) fail("gmsh wrote an empty mesh");
+  return m;
+}
+
+
+// Several MPI ranks (docs/parallel.md, "The FE far field"): every rank asks for the mesh at
+// once; rank 0 alone reads or meshes the file and sends the result (or its error, which every
+// rank then throws) to the others.
+void broadcast(std::string& s) {
+  unsigned long long n = s.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  s.resize(n);
+  for (unsigned long long at = 0; at < n;) {  // in pieces a count of int holds
+    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1u << 30));
+    MPI_Bcast(s.data() + at, piece, MPI_CHAR, 0, MPI_COMM_WORLD);
+    at += static_cast<unsigned long long>(piece);
+  }
+}
+
+void broadcast(std::vector<PhysicalGroup>& groups) {
+  unsigned long long n = groups.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  groups.resize(n);
+  for (auto& g : groups) {
+    MPI_Bcast(&g.tag, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    broadcast(g.name);
+  }
+}
+}  // namespace
+
+Mesh load_mesh(const std::string& file, double size, double max_cells,
+               const std::vector<std::pair<std::string, double>>& parameters) {
+  int running = 0, finished = 0, ranks = 1, rank = 0;
+  MPI_Initialized(&running);
+  if (running) MPI_Finalized(&finished);
+  if (running && !finished) {
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  }
+  if (ranks == 1) return mesh_here(file, size, max_cells, parameters);
+  Mesh m;
+  std::string why;
+  if (rank == 0) {
+    try {
+      m = mesh_here(file, size, max_cells, parameters);
+    } catch (const std::exception& e) {  // any failure: the others must not wait for a mesh
+      why = e.what();
+      if (why.empty()) why = file + ": the mesh could not be read";
+    }
+  }
+  broadcast(why);
+  if (!why.empty()) throw FemError(why);
+  broadcast(m.file);
+  MPI_Bcast(&m.size, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  broadcast(m.msh);
+  broadcast(m.surfaces);
+  broadcast(m.curves);
+  unsigned long long quads = m.quads;
+  MPI_Bcast(&quads, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  m.quads = static_cast<std::size_t>(quads);
   return m;
 }
 

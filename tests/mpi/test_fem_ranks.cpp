@@ -62,6 +62,39 @@ fem::Spec square(int degree, bool boundaries) {
   return s;
 }
 
+// The mesh is read on rank 0 only: the other ranks ask for a file that does not exist and
+// receive rank 0's mesh, the same text on every rank; a file rank 0 cannot read is every rank's
+// error, with rank 0's message.
+TEST(FemRanks, MeshReadOnRankZeroOnly) {
+  const bool zero = mpi_testing::world_rank() == 0;
+  const std::string good = rectangle_geo("ranks_mesh_zero", 0.01, 0.005, 1e-3);
+  const std::string file = zero ? good : std::string("/nonexistent/elsewhere.geo");
+  const fem::Mesh m = fem::load_mesh(file, 1e-3);
+  std::vector<char> zeros_file(good.begin(), good.end());  // rank 0's path (each rank has its own)
+  int n = static_cast<int>(zeros_file.size());
+  MPI_Bcast(&n, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  zeros_file.resize(static_cast<std::size_t>(n));
+  MPI_Bcast(zeros_file.data(), n, MPI_CHAR, 0, MPI_COMM_WORLD);
+  EXPECT_EQ(m.file, std::string(zeros_file.begin(), zeros_file.end()));
+  EXPECT_EQ(m.quads, 50u);
+  EXPECT_FALSE(m.surfaces.empty());
+  EXPECT_EQ(m.curves.size(), 4u);
+  // The same text everywhere: its length and a checksum, largest and smallest over the ranks.
+  double sum = 0;
+  for (std::size_t k = 0; k < m.msh.size(); ++k) sum += static_cast<unsigned char>(m.msh[k]) * (k % 97 + 1);
+  const double len = static_cast<double>(m.msh.size());
+  EXPECT_EQ(max_over_ranks(sum), -max_over_ranks(-sum));
+  EXPECT_EQ(max_over_ranks(len), -max_over_ranks(-len));
+  // An error on rank 0 is every rank's.
+  std::string why;
+  try {
+    fem::load_mesh(zero ? std::string("/nonexistent/rank0.geo") : good, 1e-3);
+  } catch (const fem::FemError& e) {
+    why = e.what();
+  }
+  EXPECT_EQ(why, "/nonexistent/rank0.geo: mesh file not found");
+}
+
 TEST(FemRanks, InternalForceOnOwnRowsAsOneProcess) {
   for (const int degree : {1, 2}) {
     fem::Solver one(square(degree, false)), split(square(degree, false));

@@ -64,7 +64,9 @@ struct Mesh {
 
 // Reads or meshes `file` (".geo" or ".msh"); a .geo whose size would give more than max_cells
 // cells (estimated before meshing) is refused. `parameters` set other numbers of a .geo before it
-// is read (its DefineConstant keeps them). Throws FemError naming the file.
+// is read (its DefineConstant keeps them). Throws FemError naming the file. Under MPI with several
+// ranks every rank calls it at once: rank 0 alone reads or meshes its `file` and sends the mesh
+// to the others (their arguments are not read); rank 0's error is thrown on every rank.
 Mesh load_mesh(const std::string& file, double size, double max_cells = 1e7,
                const std::vector<std::pair<std::string, double>>& parameters = {});
 
