@@ -99,6 +99,19 @@ inline std::unique_ptr<fem::Solver> strip_fe(const Strip& c, double x0, bool loa
   return std::make_unique<fem::Solver>(s);
 }
 
+// A free strip (no rollers, no load) of 40 cells, the first 20 of particles on a 2 x 2 lattice,
+// `height` cells high: the momentum tests' (with v0 or gravity set).
+inline Strip free_strip(int height) {
+  Strip c;
+  c.cells = 40;
+  c.mpm_cells = 20;
+  c.height = height;
+  c.rollers = false;
+  c.load = false;
+  c.ppc_side = 2;
+  return c;
+}
+
 inline HybRun make_strip(const Strip& c) {
   HybRun m;
   const double h = c.h, L = c.cells * h, H = c.height * h, xi = c.mpm_cells * h;

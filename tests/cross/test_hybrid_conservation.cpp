@@ -89,14 +89,8 @@ TEST(HybridConservation, EnergyBalanceFreePlate) {
 // (particles + FE nodes) is conserved to round-off: at a shared node the update is
 // m v+ = p_MPM + m_FE v_FE + dt f with forces that sum to zero (Sum grad N = 0, K 1 = 0).
 TEST(HybridConservation, MomentumConserved) {
-  Strip c;
-  c.cells = 40;
-  c.mpm_cells = 20;
-  c.height = 6;
-  c.rollers = false;
-  c.load = false;
+  Strip c = free_strip(6);
   c.v0 = 5.0;
-  c.ppc_side = 2;
   for (Scheme sc : {Scheme::MUSL, Scheme::USL}) {
     c.scheme = sc;
     HybRun m = make_strip(c);
@@ -125,13 +119,7 @@ TEST(HybridConservation, MomentumConserved) {
 // at the shared nodes, as before, the momentum fell short by their share of the mass, 1.0 %,
 // and the balance by 1.2 % of the work.)
 TEST(HybridConservation, MomentumUnderGravity) {
-  Strip c;
-  c.cells = 40;
-  c.mpm_cells = 20;
-  c.height = 6;
-  c.rollers = false;
-  c.load = false;
-  c.ppc_side = 2;
+  Strip c = free_strip(6);
   c.gravity_x = -3000;
   c.gravity_y = -4000;
   for (Scheme sc : {Scheme::MUSL, Scheme::USL}) {

@@ -41,14 +41,8 @@ std::unique_ptr<Distributed> split(HybRun& m) {
 }
 
 TEST(HybridRanks, MomentumExactAcrossRankBorders) {
-  Strip c;
-  c.cells = 40;
-  c.mpm_cells = 20;
-  c.height = 16;
-  c.rollers = false;
-  c.load = false;
+  Strip c = free_strip(16);
   c.v0 = 5.0;
-  c.ppc_side = 2;
   for (Scheme sc : {Scheme::MUSL, Scheme::USL}) {
     c.scheme = sc;
     HybRun one = make_strip(c), m = make_strip(c);
@@ -132,11 +126,7 @@ TEST(HybridRanks, UniformStrainPatchAcrossRankBorders) {
 }
 
 TEST(HybridRanks, ParticleEnteringAnElementStopsEveryRankAtOneStep) {
-  Strip c;
-  c.cells = 40;
-  c.mpm_cells = 20;
-  c.height = 16;
-  c.load = false;
+  Strip c = free_strip(16);
   c.v0 = 2000;
   HybRun one = make_strip(c), m = make_strip(c);
   const auto d = split(m);

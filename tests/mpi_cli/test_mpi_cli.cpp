@@ -320,65 +320,53 @@ TEST(MpiCli, HybridOnOneToFourRanksAsOneProcess) {
   }
 }
 
+// A run on 2 ranks writing a checkpoint every `every` steps (args: the case and its settings), and
+// its restart on each of `restarts` rank counts (0: one plain process) in a copy of its folder:
+// each ends as the plain run does, every history column within `bound` of the largest of its
+// kind, each energy term within `bound` of the work; it restarts from the last checkpoint.
+void expect_checkpoint_restarts(const std::string& args, const std::string& tag, long every,
+                                std::initializer_list<int> restarts, double bound) {
+  const std::string ck =
+      args + " --set output.snapshots=0 --set output.checkpoint_every=" + std::to_string(every);
+  const fs::path a = out_dir(tag + "_plain"), b = out_dir(tag + "_np2");
+  ASSERT_EQ(run(0, ck + " --out " + a.string(), tag + "_plain").status, 0);
+  const Proc p = run(2, ck + " --out " + b.string(), tag + "_np2");
+  ASSERT_EQ(p.status, 0) << p.err;
+  ASSERT_TRUE(fs::exists(b / "checkpoint.smpm"));
+  const long steps = summary(a)["steps"].get<long>();
+  EXPECT_GT(steps, 2 * every) << tag;
+  for (int np : restarts) {
+    const std::string t = tag + "_restart" + std::to_string(np);
+    const fs::path r = out_dir(t);
+    fs::copy(b, r, fs::copy_options::recursive);
+    fs::remove(r / "summary.json");
+    const Proc q = run(np, ck + " --out " + r.string() + " --restart " +
+                               (r / "checkpoint.smpm").string(), t);
+    ASSERT_EQ(q.status, 0) << q.err;
+    EXPECT_EQ(summary(r)["restart"]["from_step"].get<long>(), (steps - 1) / every * every) << t;
+    for (const auto& [c, d] : differences(r, a)) EXPECT_LE(d, bound) << t << ", column " << c;
+    for (const char* e : {"kinetic", "elastic", "absorbed", "external_work"})
+      EXPECT_NEAR(summary(r)["energy"][e].get<double>(), summary(a)["energy"][e].get<double>(),
+                  bound * summary(a)["energy"]["external_work"].get<double>())
+          << t << " " << e;
+  }
+}
+
 // A hybrid checkpoint written on 2 ranks is one process's: a restart on 1 process and on 3
 // ranks ends as the plain run does (history within 1e-10 of the largest of a column's kind,
 // energies within 1e-10 of the work).
 TEST(MpiCli, HybridCheckpointOnTwoRanksRestartsOnAnyCount) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
-  const std::string args = source_file("studies/hybrid/cases/pulse_hybrid_dashpot.json") +
-                           " --set time.end=1e-5 --set output.snapshots=0 "
-                           "--set output.checkpoint_every=100 -q";
-  const fs::path a = out_dir("hybck_plain"), b = out_dir("hybck_np2");
-  ASSERT_EQ(run(0, args + " --out " + a.string(), "hybck_plain").status, 0);
-  const Proc p = run(2, args + " --out " + b.string(), "hybck_np2");
-  ASSERT_EQ(p.status, 0) << p.err;
-  ASSERT_TRUE(fs::exists(b / "checkpoint.smpm"));
-  for (int np : {0, 3}) {
-    const std::string tag = "hybck_restart" + std::to_string(np);
-    const fs::path r = out_dir(tag);
-    fs::copy(b, r, fs::copy_options::recursive);
-    fs::remove(r / "summary.json");
-    const Proc q = run(np, args + " --out " + r.string() + " --restart " +
-                               (r / "checkpoint.smpm").string(), tag);
-    ASSERT_EQ(q.status, 0) << q.err;
-    EXPECT_EQ(summary(r)["restart"]["from_step"], 200) << tag;
-    for (const auto& [c, d] : differences(r, a)) EXPECT_LE(d, 1e-10) << tag << ", column " << c;
-    for (const char* e : {"kinetic", "elastic", "absorbed", "external_work"})
-      EXPECT_NEAR(summary(r)["energy"][e].get<double>(), summary(a)["energy"][e].get<double>(),
-                  1e-10 * summary(a)["energy"]["external_work"].get<double>())
-          << tag << " " << e;
-  }
+  expect_checkpoint_restarts(source_file("studies/hybrid/cases/pulse_hybrid_dashpot.json") +
+                                 " --set time.end=1e-5 -q",
+                             "hybck", 100, {0, 3}, 1e-10);
 }
 
 // A far-field checkpoint written on 2 ranks holds the whole mesh's state: a restart on 1
-// process and on 4 ranks ends as the plain run does (history within 1e-13, the last snapshot's
-// fields to the bit).
+// process and on 4 ranks ends as the plain run does (history and energies within 1e-13).
 TEST(MpiCli, FarFieldCheckpointOnTwoRanksRestartsOnAnyCount) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
-  const std::string args = kFem + " --set output.snapshots=0 --set output.checkpoint_every=100";
-  const fs::path a = out_dir("femck_plain"), b = out_dir("femck_np2");
-  ASSERT_EQ(run(0, args + " --out " + a.string(), "femck_plain").status, 0);
-  const Proc p = run(2, args + " --out " + b.string(), "femck_np2");
-  ASSERT_EQ(p.status, 0) << p.err;
-  ASSERT_TRUE(fs::exists(b / "checkpoint.smpm"));
-  for (int np : {0, 4}) {
-    const std::string tag = "femck_restart" + std::to_string(np);
-    const fs::path r = out_dir(tag);
-    fs::copy(b, r, fs::copy_options::recursive);
-    fs::remove(r / "summary.json");
-    const Proc q = run(np, args + " --out " + r.string() + " --restart " +
-                               (r / "checkpoint.smpm").string(), tag);
-    ASSERT_EQ(q.status, 0) << q.err;
-    // The last checkpoint before the end (every 100 steps).
-    const long steps = summary(a)["steps"].get<long>();
-    EXPECT_EQ(summary(r)["restart"]["from_step"].get<long>(), (steps - 1) / 100 * 100) << tag;
-    EXPECT_GE(steps, 201) << tag;
-    for (const auto& [c, d] : differences(r, a)) EXPECT_LE(d, 1e-13) << tag << ", column " << c;
-    for (const char* e : {"kinetic", "elastic", "absorbed", "external_work"})
-      EXPECT_NEAR(summary(r)["energy"][e].get<double>(), summary(a)["energy"][e].get<double>(),
-                  1e-13 * summary(a)["energy"]["external_work"].get<double>())
-          << tag << " " << e;
-  }
+  expect_checkpoint_restarts(kFem, "femck", 100, {0, 4}, 1e-13);
 }
 
 // Snapshots on 2 ranks: rank 0 writes every rank's particles, in the order of their ids; every
@@ -460,23 +448,7 @@ TEST(MpiCli, SofteningFilmOnTwoAndFourRanks) {
 // on 4 ranks continues the run, every history column within 1e-10 of the plain run's.
 TEST(MpiCli, CheckpointOnTwoRanksRestartsOnAnyCount) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
-  const fs::path a = out_dir("ck_plain"), b = out_dir("ck_np2");
-  ASSERT_EQ(run(0, kCase + kShort + " --out " + a.string(), "ck_plain").status, 0);
-  const std::string ck = " --set output.checkpoint_every=300";
-  const Proc p = run(2, kCase + kShort + ck + " --out " + b.string(), "ck_np2");
-  ASSERT_EQ(p.status, 0) << p.err;
-  ASSERT_TRUE(fs::exists(b / "checkpoint.smpm"));
-  for (int np : {0, 2, 4}) {
-    const std::string tag = "ck_restart" + std::to_string(np);
-    const fs::path r = out_dir(tag);
-    fs::copy(b, r, fs::copy_options::recursive);
-    fs::remove(r / "summary.json");
-    const Proc q = run(np, kCase + kShort + ck + " --out " + r.string() + " --restart " +
-                               (r / "checkpoint.smpm").string(), tag);
-    ASSERT_EQ(q.status, 0) << q.err;
-    EXPECT_EQ(summary(r)["restart"]["from_step"], 900) << tag;
-    for (const auto& [c, d] : differences(r, a)) EXPECT_LE(d, 1e-10) << tag << ", column " << c;
-  }
+  expect_checkpoint_restarts(kCase + kShort, "ck", 300, {0, 2, 4}, 1e-10);
 }
 
 // The plate thrown upwards: its top rows leave the grid on the top rank only (20 steps); that
