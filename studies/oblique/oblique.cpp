@@ -4,6 +4,7 @@
 //
 //   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N] [--shape bilinear|gimp|bspline]
 //           [--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N]
+//           [--beta F] (damping: the band's stiffness part, F h / c_d seconds)
 //           (the right side of run A)
 #include <cstdlib>
 #include <fstream>
@@ -20,7 +21,7 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
                          "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
-                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N]\n");
+                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--beta F]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -66,6 +67,8 @@ int main(int argc, char** argv) {
       base.alpha = std::atof(argv[i + 1]);
     } else if (a == "--power") {
       base.power = std::atof(argv[i + 1]);
+    } else if (a == "--beta") {
+      base.beta = std::atof(argv[i + 1]);
     } else if (a == "--shape") {
       const std::string v = argv[i + 1];
       if (v == "bilinear") base.shape = ShapeKind::Bilinear;
@@ -96,6 +99,7 @@ int main(int argc, char** argv) {
       j["damping_band_cells"] = base.band;
       j["damping_r0"] = base.r0;
       j["damping_power"] = base.power;
+      j["damping_beta_h_over_cd"] = base.beta;
     }
     if (base.boundary == "pml") {
       j["pml_cells"] = base.band;

@@ -58,8 +58,9 @@ struct Setup {
   // "damping" (a graded damping band of `band` cells with r0 and power (default 2), then the dashpots),
   // "pml" (FEM: a perfectly matched layer of `band` cells with r0, power (default 2) and alpha, then the
   // dashpots).
+  // With "damping", beta > 0 adds the band's stiffness-proportional part, beta h / c_d seconds.
   std::string boundary = "lk";
-  double delta = 40, band = 10, r0 = 1e-3, alpha = 0, power = 2;
+  double delta = 40, band = 10, r0 = 1e-3, alpha = 0, power = 2, beta = 0;
   // Cells before the boundary where the initial data ends (a layer's thickness plus 2), or -1:
   // not cut (LK, Kelvin-Voigt).
   double clear() const { return boundary == "damping" || boundary == "pml" ? band + 2 : -1.0; }
@@ -237,6 +238,7 @@ inline Result measure(const Setup& su) {
         d.width = su.band * h;
         d.r0 = su.r0;
         d.power = su.power;
+        if (su.boundary == "damping") d.beta = su.beta * h / w.mat.cd;
         s.boundaries.push_back(d);
       }
     }

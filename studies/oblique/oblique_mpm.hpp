@@ -52,6 +52,7 @@ inline Result measure_mpm(const Setup& su) {
                                    su.band * h);
         dl.r0 = su.r0;
         dl.power = su.power;
+        dl.beta0 = su.beta * h / mat.cd;
         s->dampers.push_back(dl);
       }
     }
