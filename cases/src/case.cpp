@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -39,6 +40,85 @@
 
 namespace smpm {
 namespace {
+
+// A geometry as bytes and back (sent from rank 0 to the others under an MPI launcher).
+template <class T>
+void put_bytes(std::string& b, const std::vector<T>& v) {
+  const std::uint64_t n = v.size();
+  b.append(reinterpret_cast<const char*>(&n), sizeof n);
+  b.append(reinterpret_cast<const char*>(v.data()), n * sizeof(T));
+}
+void put_bytes(std::string& b, const std::string& s) { put_bytes(b, std::vector<char>(s.begin(), s.end())); }
+void put_bytes(std::string& b, int v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); }
+
+struct ByteReader {
+  const std::string& b;
+  std::size_t at = 0;
+  void raw(void* out, std::size_t n) {
+    if (at + n > b.size()) throw std::logic_error("a geometry's bytes ended early");
+    std::memcpy(out, b.data() + at, n);
+    at += n;
+  }
+  template <class T>
+  void get(std::vector<T>& v) {
+    std::uint64_t n = 0;
+    raw(&n, sizeof n);
+    v.resize(n);
+    raw(v.data(), n * sizeof(T));
+  }
+  void get(std::string& s) {
+    std::vector<char> v;
+    get(v);
+    s.assign(v.begin(), v.end());
+  }
+  void get(int& v) { raw(&v, sizeof v); }
+};
+
+std::string pack_geometry(const Geometry& g) {
+  std::string b;
+  put_bytes(b, g.file);
+  put_bytes(b, g.x);
+  put_bytes(b, g.y);
+  put_bytes(b, static_cast<int>(g.surfaces.size()));
+  for (const auto& s : g.surfaces) {
+    put_bytes(b, s.tag);
+    put_bytes(b, s.name);
+    put_bytes(b, s.elems);
+  }
+  put_bytes(b, static_cast<int>(g.curves.size()));
+  for (const auto& c : g.curves) {
+    put_bytes(b, c.tag);
+    put_bytes(b, c.name);
+    put_bytes(b, c.segs);
+    put_bytes(b, c.mid);
+  }
+  return b;
+}
+
+Geometry unpack_geometry(const std::string& b) {
+  Geometry g;
+  ByteReader r{b};
+  r.get(g.file);
+  r.get(g.x);
+  r.get(g.y);
+  int n = 0;
+  r.get(n);
+  g.surfaces.resize(static_cast<std::size_t>(n));
+  for (auto& s : g.surfaces) {
+    r.get(s.tag);
+    r.get(s.name);
+    r.get(s.elems);
+  }
+  r.get(n);
+  g.curves.resize(static_cast<std::size_t>(n));
+  for (auto& c : g.curves) {
+    r.get(c.tag);
+    r.get(c.name);
+    r.get(c.segs);
+    r.get(c.mid);
+  }
+  return g;
+}
 
 using detail::ojson;
 
@@ -1262,10 +1342,31 @@ class Builder {
     } catch (const std::runtime_error& e) {
       o.fail("file", std::string("the gmsh module: ") + e.what());
     }
+    auto load = [&] {
+      return checking_ ? gm->load_geometry_groups(file, size, params)
+                       : gm->load_geometry(file, size, params, load_limits().mesh_cells);
+    };
+    // Under an MPI launcher rank 0 alone reads (and meshes) the file and sends the geometry,
+    // or its error, to the others: every rank then fails with rank 0's message.
+    const detail::MpiModule* mpi = detail::mpi();
+    if (mpi && mpi->size() > 1) {
+      std::string bytes, why;
+      if (mpi->rank() == 0) {
+        try {
+          bytes = pack_geometry(load());
+        } catch (const std::exception& e) {
+          why = e.what();
+          if (why.empty()) why = file + ": the geometry could not be read";
+        }
+      }
+      mpi->broadcast(why);
+      if (!why.empty()) o.fail("file", why);
+      mpi->broadcast(bytes);
+      geo_ = std::make_unique<Geometry>(unpack_geometry(bytes));
+      return;
+    }
     try {
-      geo_ = std::make_unique<Geometry>(
-          checking_ ? gm->load_geometry_groups(file, size, params)
-                    : gm->load_geometry(file, size, params, load_limits().mesh_cells));
+      geo_ = std::make_unique<Geometry>(load());
     } catch (const GeometryError& e) {
       o.fail("file", e.what());
     }

@@ -44,7 +44,7 @@ struct FarFieldModule {
 };
 
 // Bumped whenever the table or a signature in it changes.
-inline constexpr int kMpiModuleApi = 1;
+inline constexpr int kMpiModuleApi = 2;
 
 // The MPI module (parallel/: MPI and PETSc), loaded only when an MPI launcher started the
 // program (processes.cpp).
@@ -60,6 +60,7 @@ struct MpiModule {
   std::unique_ptr<Decomposition> (*distribute)(Solver& s, int across);
   bool (*any)(bool b);                 // over every rank
   void (*abort)(int code);             // MPI_Abort: every rank stops
+  void (*broadcast)(std::string& bytes);  // rank 0's bytes to every rank (collective)
 };
 
 const GmshModule& gmsh_module();  // loads libsilentmpm_gmsh.so on first use

@@ -2,6 +2,9 @@
 // when an MPI launcher started it.
 #include <mpi.h>
 
+#include <algorithm>
+#include <string>
+
 #include "modules.hpp"
 #include "silentmpm/distributed.hpp"
 #include "silentmpm/solver.hpp"
@@ -30,8 +33,19 @@ bool any(bool b) {
   return v != 0;
 }
 void abort(int code) { MPI_Abort(MPI_COMM_WORLD, code); }
+void broadcast(std::string& bytes) {
+  unsigned long long n = bytes.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  bytes.resize(n);
+  for (unsigned long long at = 0; at < n;) {  // in pieces an int count holds
+    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
+    MPI_Bcast(bytes.data() + at, piece, MPI_CHAR, 0, MPI_COMM_WORLD);
+    at += static_cast<unsigned long long>(piece);
+  }
+}
 
-const MpiModule kTable = {kMpiModuleApi, start, stop, rank, size, distribute, any, abort};
+const MpiModule kTable = {kMpiModuleApi, start,  stop,  rank,     size,
+                          distribute,    any,    abort, broadcast};
 
 }  // namespace
 }  // namespace smpm::detail

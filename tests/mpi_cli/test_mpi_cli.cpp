@@ -209,6 +209,31 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
   }
 }
 
+// Rank 0 alone reads a case's gmsh geometry and FE mesh and sends them to the others (the
+// pulse plate above is a gmsh geometry, so its agreement with one process covers what is sent).
+// A file it cannot read is every rank's error: one line, rank 0's, the same as one process's,
+// exit 1, before the output folder.
+TEST(MpiCli, UnreadableGeometryOrMeshIsOneProcessError) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path o = out_dir("unreadable");
+  for (const std::string& args : {kCase + kShort + " --set geometry.file=nothere.geo",
+                                  kFem + " --set fem.mesh=nothere.geo"}) {
+    const Proc one = run(0, args + " --out " + o.string(), "unreadable1");
+    const Proc two = run(2, args + " --out " + o.string(), "unreadable2");
+    EXPECT_EQ(one.status, 1) << one.err;
+    EXPECT_EQ(two.status, 1) << two.err;
+    const std::string line = one.err.substr(0, one.err.find('\n'));
+    EXPECT_NE(line.find("nothere.geo"), std::string::npos) << line;
+    EXPECT_EQ(two.err.substr(0, two.err.find('\n')), line);
+    std::size_t n = 0;
+    for (std::size_t at = two.err.find("silentmpm: error"); at != std::string::npos;
+         at = two.err.find("silentmpm: error", at + 1))
+      ++n;
+    EXPECT_EQ(n, 1u) << two.err;
+    EXPECT_FALSE(fs::exists(o));
+  }
+}
+
 // The FE far field (fem_square.json: a traction pulse, PMLs on two sides meeting in a corner,
 // dashpots, a damping band (mass and stiffness parts) before Kelvin-Voigt springs, gravity; Q1
 // and Q2) on 1, 2, 3 and 4
