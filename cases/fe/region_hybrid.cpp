@@ -137,6 +137,7 @@ class HybridRegion final : public Region {
       j["mpi"]["interface_values_per_step"] = hy_.interface_values() / n;
     }
     put_mpm_scheme(j, s_);
+    j["grid"] = ranks_.grid_json();  // the whole grid (a rank's solver holds its window)
     j["fem"] = fem_json(fe_);
     j["hybrid"] = {{"shared_nodes", hy_.shared().size()},
                    {"interface_nodes", hy_.interface_nodes()}};

@@ -202,6 +202,19 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
     mpm_.grid.fix[n] |= mask[e];  // FE essential conditions hold on the shared node
   }
 
+  // A shared node's update is the grid's, which takes no PML or stiffness-damping force of the
+  // FE side: such layers must keep off the nodes the regions share.
+  {
+    const auto ex = fe_.explicit_force_nodes();
+    for (const auto& s : shared_)
+      if (std::binary_search(ex.begin(), ex.end(), s[0]))
+        throw HybridError("hybrid: the FE node at " + pt(X[s[0]], Y[s[0]]) +
+                          ", which the FEM region shares with the MPM grid, lies in a perfectly "
+                          "matched layer or in a damping layer with beta: keep those layers away "
+                          "from the nodes the regions share (the grid's update does not take "
+                          "their forces)");
+  }
+
   if (interface_count_ == 0)
     throw HybridError("hybrid: the FEM mesh does not touch the particles: no FE node coincides (within "
                       "h 1e-6) with a grid node of an MPM cell holding particles; the interface nodes "
@@ -354,6 +367,9 @@ void Hybrid::share(std::vector<double>& v) const {
 
 void Hybrid::distribute(Decomposition& d) {
   if (dist_) throw HybridError("hybrid: the coupling is already split over the MPI ranks");
+  if (fe_.ranks() != d.size())
+    throw HybridError("hybrid: split the FE far field over the same ranks first "
+                      "(fem::Solver::distribute)");
   dist_ = &d;
   const Grid& g = mpm_.grid;
   const auto org = d.window_origin();

@@ -62,8 +62,17 @@ std::size_t Solver::cells() const { return impl_->n_cells; }
 int Solver::degree() const { return impl_->degree; }
 int Solver::thread_count() const { return impl_->threads; }
 std::array<double, 4> Solver::bounds() const { return impl_->box; }
+std::vector<std::uint32_t> Solver::explicit_force_nodes() const {
+  const Impl& m = *impl_;
+  std::vector<std::uint32_t> out(m.pml.touched.begin(), m.pml.touched.end());
+  out.insert(out.end(), m.visc.node.begin(), m.visc.node.end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 std::array<double, 2> Solver::gravity() const {
-  return {impl_->spec.gravity_x, impl_->spec.gravity_y};
+  return {{impl_->spec.gravity_x, impl_->spec.gravity_y}};
 }
 double Solver::critical_dt() const { return impl_->crit_dt; }
 int Solver::snapshot_count() const { return impl_->snapshots; }

@@ -51,16 +51,21 @@ std::string first_logged_error() {
 GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threads()) {
   static char name[] = "silentmpm";
   char* argv[] = {name, nullptr};
-  gmsh::initialize(1, argv, /*readConfigFiles=*/false);
-  gmsh::option::setNumber("General.Terminal", 0);
-  gmsh::clear();
-  gmsh::onelab::clear();
-  gmsh::finalize();
-  gmsh::initialize(1, argv, /*readConfigFiles=*/false);
-  gmsh::option::setNumber("General.Terminal", 0);
-  gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);  // gmsh's defaults
-  gmsh::option::setNumber("Mesh.MeshSizeMin", 0);
-  gmsh::logger::start();
+  try {
+    gmsh::initialize(1, argv, /*readConfigFiles=*/false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::clear();
+    gmsh::onelab::clear();
+    gmsh::finalize();
+    gmsh::initialize(1, argv, /*readConfigFiles=*/false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);  // gmsh's defaults
+    gmsh::option::setNumber("Mesh.MeshSizeMin", 0);
+    gmsh::logger::start();
+  } catch (...) {  // no destructor runs: restore the thread count here
+    omp_set_num_threads(omp_threads_);
+    throw;
+  }
 }
 
 GmshSession::~GmshSession() {

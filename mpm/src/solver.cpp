@@ -110,15 +110,30 @@ std::vector<uint32_t> Solver::nodes_in_box(double x0, double y0, double x1, doub
   return out;
 }
 
+double Solver::viscous_beta() const {
+  bool any = false;
+  for (const auto& dl : dampers) any = any || dl.beta0 > 0;
+  if (!any) return 0;
+  std::vector<double> sum(p.size(), 0.0);
+  for (const auto& dl : dampers) {
+    if (!(dl.beta0 > 0)) continue;
+    const BoundaryLayer& L = dl.layer;
+    for (std::size_t q = 0; q < L.idx.size(); ++q)
+      sum[L.idx[q]] += dl.beta0 * std::pow(std::clamp(1.0 - L.d[q] / L.depth, 0.0, 1.0), dl.power);
+  }
+  return sum.empty() ? 0.0 : *std::max_element(sum.begin(), sum.end());
+}
+
 double Solver::critical_dt() const {
   double cmax = 0;
   for (const auto& m : materials) cmax = std::max(cmax, m.cd);
   if (!(cmax > 0)) return std::numeric_limits<double>::infinity();
-  double dt_c = grid.h / cmax, beta = 0;
+  double dt_c = grid.h / cmax;
   // A damping layer's stiffness-proportional part, explicit: central differences with a lagged
   // viscous force are stable for dt <= (2 / w)(sqrt(1 + xi^2) - xi), xi = beta w / 2, at the
-  // grid's highest frequency w = 2 / dt_c.
-  for (const auto& dl : dampers) beta = std::max(beta, dl.beta0);
+  // grid's highest frequency w = 2 / dt_c; beta at a particle in two layers (a corner) is the
+  // sum of theirs.
+  const double beta = viscous_beta_ >= 0 ? viscous_beta_ : viscous_beta();
   if (beta > 0) {
     const double xi = beta / dt_c;
     dt_c *= std::sqrt(1 + xi * xi) - xi;
@@ -184,6 +199,7 @@ void Solver::finalize() {
       for (std::size_t k = 0; k < L.idx.size(); ++k)
         dl.beta[k] = dl.beta0 * std::pow(std::clamp(1.0 - L.d[k] / L.depth, 0.0, 1.0), dl.power);
   }
+  viscous_beta_ = viscous_beta();  // the whole body's (a rank keeps it after the split)
   // Perfectly matched layers: every particle of a band's body inside it, with d_x and d_y summed
   // over the bands (both at a corner) from its position at the start.
   pml = PmlLayer{};

@@ -164,3 +164,27 @@ TEST(HybridErrors, GravityDiffersBetweenTheRegions) {
             std::string::npos)
       << e;
 }
+
+// A perfectly matched layer or a damping layer with beta on the nodes the regions share: the
+// grid's update would not take their forces.
+TEST(HybridErrors, LayerOnTheSharedNodes) {
+  for (const bool pml : {false, true}) {
+    auto s = particles();
+    const double h = 1e-3;
+    fem::Spec spec;
+    spec.mesh = fem::load_mesh(box_geo("err_layer", 20 * h, 0, 30 * h, 4 * h, h), h);
+    spec.materials = {smpm::testing::tungsten()};
+    spec.region_material = {{1, 0}};
+    spec.threads = 1;
+    auto b = fe_bc(pml ? fem::Boundary::Kind::Pml : fem::Boundary::Kind::Damping, 11, "band");
+    b.width = 3 * h;
+    if (!pml) b.beta = 1e-8;
+    spec.boundaries.push_back(b);
+    fem::Solver f(spec);
+    const std::string e = error_of([&] { Hybrid hy(*s, f); });
+    EXPECT_NE(e.find("which the FEM region shares with the MPM grid, lies in a perfectly matched "
+                     "layer or in a damping layer with beta"),
+              std::string::npos)
+        << e;
+  }
+}

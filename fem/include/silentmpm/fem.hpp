@@ -209,6 +209,10 @@ class Solver {
   // Nodes of each cell, (degree + 1)^2 per cell in deal.II's FE_Q order (vertices first:
   // (0,0), (1,0), (0,1), (1,1) in the cell's reference frame).
   const std::vector<std::uint32_t>& cell_nodes() const;
+  // The nodes whose update takes an explicit force besides f_int and f_ext: every node of a PML
+  // cell and the damping layers' stiffness-proportional nodes (ascending). The hybrid keeps its
+  // shared nodes off them (its grid update does not take those forces).
+  std::vector<std::uint32_t> explicit_force_nodes() const;
   // Constraint mask per node: bit 0 = x held, bit 1 = y held.
   const std::vector<std::uint8_t>& constraint_mask() const;
   // External nodal force f_ext(t) (2 per node) into f, written on the loaded nodes only: f must

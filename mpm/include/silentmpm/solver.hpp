@@ -108,7 +108,9 @@ class Solver {
   std::vector<uint32_t> nodes_in_box(double x0, double y0, double x1, double y1) const;
   // Call once after seeding and adding boundary conditions.
   void finalize();
-  double critical_dt() const;  // h / max c_d over materials present
+  // h / max c_d over materials present, lowered by the damping layers' stiffness parts (the
+  // largest sum of beta over the layers at one particle, taken at finalize() on the whole body).
+  double critical_dt() const;
 
   // --- run ---------------------------------------------------------------------------------
   // One time step (the sequence at the top of this file).
@@ -223,6 +225,8 @@ class Solver {
     dashpot_nodes_.push_back(i);
   }
   double mass_floor_ = 0;
+  double viscous_beta_ = -1;  // the largest beta at a particle (finalize()); -1: not yet
+  double viscous_beta() const;
   // ranges_[s * G + g] = [begin, end) of particles of strip s and group g.
   std::vector<std::array<uint32_t, 2>> ranges_;
   std::vector<int> strip_lo_, strip_hi_;  // cell-row range each strip touches
