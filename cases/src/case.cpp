@@ -46,7 +46,7 @@ template <class T>
 void put_bytes(std::string& b, const std::vector<T>& v) {
   const std::uint64_t n = v.size();
   b.append(reinterpret_cast<const char*>(&n), sizeof n);
-  b.append(reinterpret_cast<const char*>(v.data()), n * sizeof(T));
+  if (n > 0) b.append(reinterpret_cast<const char*>(v.data()), n * sizeof(T));
 }
 void put_bytes(std::string& b, const std::string& s) { put_bytes(b, std::vector<char>(s.begin(), s.end())); }
 void put_bytes(std::string& b, int v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); }
@@ -55,6 +55,7 @@ struct ByteReader {
   const std::string& b;
   std::size_t at = 0;
   void raw(void* out, std::size_t n) {
+    if (n == 0) return;  // an empty array's data() may be null
     if (at + n > b.size()) throw std::logic_error("a geometry's bytes ended early");
     std::memcpy(out, b.data() + at, n);
     at += n;
