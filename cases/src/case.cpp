@@ -75,49 +75,48 @@ struct ByteReader {
   void get(int& v) { raw(&v, sizeof v); }
 };
 
-std::string pack_geometry(const Geometry& g) {
+// A geometry's fields in one order for both directions: io(x) writes or reads x.
+template <class G, class Io>
+void geometry_fields(G& g, Io&& io) {
+  io(g.file);
+  io(g.x);
+  io(g.y);
+  io.count(g.surfaces);
+  for (auto& s : g.surfaces) io(s.tag), io(s.name), io(s.elems);
+  io.count(g.curves);
+  for (auto& c : g.curves) io(c.tag), io(c.name), io(c.segs), io(c.mid);
+}
+
+struct GeometryPut {
   std::string b;
-  put_bytes(b, g.file);
-  put_bytes(b, g.x);
-  put_bytes(b, g.y);
-  put_bytes(b, static_cast<int>(g.surfaces.size()));
-  for (const auto& s : g.surfaces) {
-    put_bytes(b, s.tag);
-    put_bytes(b, s.name);
-    put_bytes(b, s.elems);
+  template <class T>
+  void operator()(const T& v) { put_bytes(b, v); }
+  template <class T>
+  void count(const std::vector<T>& v) { put_bytes(b, static_cast<int>(v.size())); }
+};
+
+struct GeometryGet {
+  ByteReader r;
+  template <class T>
+  void operator()(T& v) { r.get(v); }
+  template <class T>
+  void count(std::vector<T>& v) {
+    int n = 0;
+    r.get(n);
+    v.resize(static_cast<std::size_t>(n));
   }
-  put_bytes(b, static_cast<int>(g.curves.size()));
-  for (const auto& c : g.curves) {
-    put_bytes(b, c.tag);
-    put_bytes(b, c.name);
-    put_bytes(b, c.segs);
-    put_bytes(b, c.mid);
-  }
-  return b;
+};
+
+std::string pack_geometry(const Geometry& g) {
+  GeometryPut put;
+  geometry_fields(g, put);
+  return std::move(put.b);
 }
 
 Geometry unpack_geometry(const std::string& b) {
+  GeometryGet get{ByteReader{b}};
   Geometry g;
-  ByteReader r{b};
-  r.get(g.file);
-  r.get(g.x);
-  r.get(g.y);
-  int n = 0;
-  r.get(n);
-  g.surfaces.resize(static_cast<std::size_t>(n));
-  for (auto& s : g.surfaces) {
-    r.get(s.tag);
-    r.get(s.name);
-    r.get(s.elems);
-  }
-  r.get(n);
-  g.curves.resize(static_cast<std::size_t>(n));
-  for (auto& c : g.curves) {
-    r.get(c.tag);
-    r.get(c.name);
-    r.get(c.segs);
-    r.get(c.mid);
-  }
+  geometry_fields(g, get);
   return g;
 }
 
