@@ -80,7 +80,7 @@ void SnapshotList::open(SnapshotWriter& w, const std::string& out_dir) const {
     w.open(out_dir, "particles");
     return;
   }
-  if (w.resume(out_dir, "particles", steps, times, sizes) == 0)
+  if (w.resume(out_dir, "particles", steps, times, sizes) == 0 && w.rank() == 0)
     std::fprintf(stderr, "note: %s/particles.h5 does not hold the %zu snapshot(s) written before "
                          "the checkpoint; particles.xdmf lists the snapshots from the restart on\n",
                  out_dir.c_str(), steps.size());
@@ -153,23 +153,26 @@ void MpmSnapshots::write(const Solver& s) {
 }
 
 void MpmSnapshots::open(const OutputSpec& out, const std::string& out_dir, double x0, double y0,
-                        double h, int nx, int ny) {
+                        double h, int nx, int ny, const void* comm, const void* info,
+                        int rank) {
+  snap_.set_ranks(comm, info, rank);
   snap_.set_fields(out.fields);
   snap_.set_compression(out.compression);
   earlier_.open(snap_, out_dir);
-  grid_on_ = out.grid;
+  grid_on_ = out.grid && rank == 0;
   if (grid_on_) grid_.open(x0, y0, h, nx, ny, out_dir, out.compression, earlier_.times);
 }
 
 void MpmSnapshots::write(const Particles& p, long step, double time,
-                         const std::vector<std::uint8_t>& layer, const Solver::NodalProjection* P) {
-  snap_.write(p, step, time, &layer);
+                         const std::vector<std::uint8_t>& layer, std::size_t offset,
+                         std::size_t total, const Solver::NodalProjection* P) {
+  snap_.write(p, step, time, &layer, offset, total);
   if (grid_on_ && P) grid_.write(time, *P);
 }
 
 void MpmSnapshots::close() {
   snap_.close();
-  grid_.close();
+  if (grid_on_) grid_.close();
 }
 
 void save_snapshot_list(StateWriter& w, const SnapshotWriter& snap) {

@@ -72,12 +72,14 @@ class MpmSnapshots {
   void restore(const StateReader& r) { earlier_ = SnapshotList::read(r); }
   void open(const Solver& s, const OutputSpec& out, const std::string& out_dir);
   void write(const Solver& s);
-  // Several ranks: rank 0 opens with the whole grid's geometry, and writes the particles and the
-  // grid's projection gathered from every rank (P: null without output.grid).
+  // Several ranks (comm: SnapshotWriter::set_ranks'): every rank opens and writes particles.h5
+  // together, each its particles as rows [offset, offset + p.size()) of `total`; rank 0 alone
+  // writes the grid's projection (the whole grid's geometry; P gathered from every rank, null
+  // without output.grid or on the other ranks).
   void open(const OutputSpec& out, const std::string& out_dir, double x0, double y0, double h,
-            int nx, int ny);
+            int nx, int ny, const void* comm, const void* info, int rank);
   void write(const Particles& p, long step, double time, const std::vector<std::uint8_t>& layer,
-             const Solver::NodalProjection* P);
+             std::size_t offset, std::size_t total, const Solver::NodalProjection* P);
   void close();
   int count() const { return snap_.count(); }
 
@@ -89,8 +91,8 @@ class MpmSnapshots {
 };
 
 // An MPM solver under an MPI launcher (the MPM and the hybrid regions): every rank built the
-// whole case; each keeps its block once split() has cut it (docs/parallel.md). Its snapshots
-// are gathered on rank 0, its counts and energies summed over the ranks. On one process
+// whole case; each keeps its block once split() has cut it (docs/parallel.md). Every rank writes
+// its particles into the one snapshot file; counts and energies are summed over the ranks. On one process
 // nothing is cut and every call is the solver's own.
 class MpmRanks {
  public:
@@ -104,7 +106,8 @@ class MpmRanks {
   // particles'.
   void keep_account_on_root(const Energies& whole);
   void open_snapshots(MpmSnapshots& snaps, const OutputSpec& out, const std::string& out_dir);
-  // Every rank calls it; rank 0 writes the particles (by id) and the grid's projection gathered.
+  // Every rank calls it: each writes its particles into particles.h5 (rank by rank, in the
+  // ranks' order), rank 0 the grid's projection gathered.
   void write_snapshot(MpmSnapshots& snaps, bool grid);
   void close_snapshots(MpmSnapshots& snaps);
   double total(double v) const;  // summed over the ranks (itself on one process)

@@ -44,7 +44,7 @@ struct FarFieldModule {
 };
 
 // Bumped whenever the table or a signature in it changes.
-inline constexpr int kMpiModuleApi = 2;
+inline constexpr int kMpiModuleApi = 3;
 
 // The MPI module (parallel/: MPI and PETSc), loaded only when an MPI launcher started the
 // program (processes.cpp).
@@ -61,6 +61,10 @@ struct MpiModule {
   bool (*any)(bool b);                 // over every rank
   void (*abort)(int code);             // MPI_Abort: every rank stops
   void (*broadcast)(std::string& bytes);  // rank 0's bytes to every rank (collective)
+  // The ranks' communicator and MPI_INFO_NULL, as pointers to an MPI_Comm and an MPI_Info (for
+  // writers that open one file from every rank, SnapshotWriter::set_ranks).
+  const void* (*world)();
+  const void* (*no_info)();
 };
 
 const GmshModule& gmsh_module();  // loads libsilentmpm_gmsh.so on first use

@@ -38,25 +38,28 @@ void MpmRanks::keep_account_on_root(const Energies& e) {
 
 void MpmRanks::open_snapshots(MpmSnapshots& snaps, const OutputSpec& out,
                               const std::string& out_dir) {
-  if (!several()) snaps.open(s_, out, out_dir);
-  else if (dist_->rank() == 0)
-    snaps.open(out, out_dir, whole_.x0, whole_.y0, whole_.h, whole_.nx, whole_.ny);
+  if (!several()) return snaps.open(s_, out, out_dir);
+  mpi()->any(false);  // every rank waits for rank 0 to have made the output folder
+  snaps.open(out, out_dir, whole_.x0, whole_.y0, whole_.h, whole_.nx, whole_.ny, mpi()->world(),
+             mpi()->no_info(), dist_->rank());
 }
 
 void MpmRanks::write_snapshot(MpmSnapshots& snaps, bool grid) {
   if (!several()) return snaps.write(s_);
-  std::vector<double> mine, all;
-  const auto layer = s_.layer_flags();
-  for (std::size_t k = 0; k < s_.p.size(); ++k) {
-    s_.p.pack(k, mine);
-    mine.push_back(layer[k]);
+  // This rank's rows of the snapshot: after those of the ranks before it.
+  std::vector<double> counts(static_cast<std::size_t>(dist_->size()), 0.0);
+  counts[static_cast<std::size_t>(dist_->rank())] = static_cast<double>(s_.p.size());
+  dist_->sum(counts.data(), static_cast<int>(counts.size()));
+  std::size_t offset = 0, total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    if (static_cast<int>(r) == dist_->rank()) offset = total;
+    total += static_cast<std::size_t>(counts[r]);
   }
-  dist_->gather(mine, all);
   // The grid's projection (output.grid): each rank's own nodes, by their index in the whole
-  // grid.
-  std::vector<double> nodes_mine, nodes_all;
+  // grid, gathered on rank 0.
   Solver::NodalProjection P;
   if (grid) {
+    std::vector<double> nodes_mine, nodes_all;
     P = s_.nodal_projection();
     const auto own = dist_->own_nodes();
     const auto org = dist_->window_origin();
@@ -69,33 +72,22 @@ void MpmRanks::write_snapshot(MpmSnapshots& snaps, bool grid) {
           nodes_mine.push_back((*v)[k]);
       }
     dist_->gather(nodes_mine, nodes_all);
-  }
-  if (dist_->rank() != 0) return;
-  if (grid) {
-    const std::size_t n = static_cast<std::size_t>(whole_.nx + 1) * (whole_.ny + 1);
-    for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) v->assign(n, 0.0);
-    for (std::size_t r = 0; r + 7 < nodes_all.size(); r += 8) {
-      const auto k = static_cast<std::size_t>(nodes_all[r]);
-      int q = 1;
-      for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) (*v)[k] = nodes_all[r + q++];
+    if (dist_->rank() == 0) {
+      const std::size_t n = static_cast<std::size_t>(whole_.nx + 1) * (whole_.ny + 1);
+      for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) v->assign(n, 0.0);
+      for (std::size_t r = 0; r + 7 < nodes_all.size(); r += 8) {
+        const auto k = static_cast<std::size_t>(nodes_all[r]);
+        int q = 1;
+        for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy})
+          (*v)[k] = nodes_all[r + q++];
+      }
     }
   }
-  Particles p;
-  if (s_.p.has_film()) p.enable_film();
-  std::vector<std::uint8_t> flags;
-  for (std::size_t r = 0; r < all.size();) {
-    r += p.unpack(all.data() + r);
-    flags.push_back(static_cast<std::uint8_t>(all[r++]));
-  }
-  const std::vector<uint32_t> by_id = p.sort_by_id();
-  std::vector<std::uint8_t> f(flags.size());
-  for (std::size_t k = 0; k < f.size(); ++k) f[k] = flags[by_id[k]];
-  snaps.write(p, s_.steps, s_.t, f, grid ? &P : nullptr);
+  snaps.write(s_.p, s_.steps, s_.t, s_.layer_flags(), offset, total,
+              grid && dist_->rank() == 0 ? &P : nullptr);
 }
 
-void MpmRanks::close_snapshots(MpmSnapshots& snaps) {
-  if (!several() || dist_->rank() == 0) snaps.close();
-}
+void MpmRanks::close_snapshots(MpmSnapshots& snaps) { snaps.close(); }
 
 double MpmRanks::total(double v) const {
   if (dist_) dist_->sum(&v, 1);
@@ -197,8 +189,7 @@ class MpmRegion final : public Region {
     return false;  // the particles were re-cut into blocks and re-sorted
   }
 
-  // Several ranks: rank 0 writes the snapshots of every rank's particles, gathered (in the
-  // order of their ids).
+  // Several ranks: every rank writes its particles into the one file (MpmRanks).
   void open_snapshots(const std::string& out_dir) override {
     split();
     ranks_.open_snapshots(snaps_, c_.output, out_dir);

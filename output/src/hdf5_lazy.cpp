@@ -28,13 +28,21 @@
   X(H5Gopen2) X(H5Gclose) X(H5Lexists) X(H5Ldelete) X(H5Literate) X(H5Screate)                  \
   X(H5Screate_simple) X(H5Sget_simple_extent_dims) X(H5Sclose) X(H5Dcreate2) X(H5Dopen2)        \
   X(H5Dwrite) X(H5Dget_space) X(H5Dclose) X(H5Acreate2) X(H5Aopen) X(H5Aexists) X(H5Awrite)     \
-  X(H5Aread) X(H5Aget_type) X(H5Aclose) X(H5Tcopy) X(H5Tset_size) X(H5Tget_size) X(H5Tclose)
+  X(H5Aread) X(H5Aget_type) X(H5Aclose) X(H5Tcopy) X(H5Tset_size) X(H5Tget_size) X(H5Tclose)   \
+  X(H5Sselect_hyperslab) X(H5Sselect_none) X(H5Pset_alloc_time) SMPM_H5_MPI_FUNCTIONS(X)
+
+// Writing one file from several processes (MPI-IO), in HDF5's MPI flavour.
+#ifdef H5_HAVE_PARALLEL
+#define SMPM_H5_MPI_FUNCTIONS(X) X(H5Pset_fapl_mpio) X(H5Pset_dxpl_mpio)
+#else
+#define SMPM_H5_MPI_FUNCTIONS(X)
+#endif
 
 // The type and property-class globals those macros read.
 #define SMPM_H5_GLOBALS(X)                                                                         \
   X(H5T_NATIVE_DOUBLE_g) X(H5T_IEEE_F64LE_g) X(H5T_STD_I64LE_g) X(H5T_NATIVE_INT64_g)              \
   X(H5T_STD_I32LE_g) X(H5T_NATIVE_INT32_g) X(H5T_STD_U32LE_g) X(H5T_NATIVE_UINT32_g) X(H5T_C_S1_g) \
-  X(H5P_CLS_FILE_ACCESS_ID_g) X(H5P_CLS_DATASET_CREATE_ID_g)
+  X(H5P_CLS_FILE_ACCESS_ID_g) X(H5P_CLS_DATASET_CREATE_ID_g) X(H5P_CLS_DATASET_XFER_ID_g)
 
 namespace {
 
@@ -121,6 +129,9 @@ herr_t H5Pset_chunk(hid_t plist_id, int ndims, const hsize_t dim[]) {
 }
 herr_t H5Pset_deflate(hid_t plist_id, unsigned level) { return lib().H5Pset_deflate(plist_id, level); }
 herr_t H5Pset_shuffle(hid_t plist_id) { return lib().H5Pset_shuffle(plist_id); }
+herr_t H5Pset_alloc_time(hid_t plist_id, H5D_alloc_time_t alloc_time) {
+  return lib().H5Pset_alloc_time(plist_id, alloc_time);
+}
 hid_t H5Gcreate2(hid_t loc_id, const char* name, hid_t lcpl_id, hid_t gcpl_id, hid_t gapl_id) {
   return lib().H5Gcreate2(loc_id, name, lcpl_id, gcpl_id, gapl_id);
 }
@@ -146,6 +157,19 @@ int H5Sget_simple_extent_dims(hid_t space_id, hsize_t dims[], hsize_t maxdims[])
   return lib().H5Sget_simple_extent_dims(space_id, dims, maxdims);
 }
 herr_t H5Sclose(hid_t space_id) { return lib().H5Sclose(space_id); }
+herr_t H5Sselect_hyperslab(hid_t space_id, H5S_seloper_t op, const hsize_t start[],
+                           const hsize_t stride[], const hsize_t count[], const hsize_t block[]) {
+  return lib().H5Sselect_hyperslab(space_id, op, start, stride, count, block);
+}
+herr_t H5Sselect_none(hid_t space_id) { return lib().H5Sselect_none(space_id); }
+#ifdef H5_HAVE_PARALLEL
+herr_t H5Pset_fapl_mpio(hid_t fapl_id, MPI_Comm comm, MPI_Info info) {
+  return lib().H5Pset_fapl_mpio(fapl_id, comm, info);
+}
+herr_t H5Pset_dxpl_mpio(hid_t dxpl_id, H5FD_mpio_xfer_t xfer_mode) {
+  return lib().H5Pset_dxpl_mpio(dxpl_id, xfer_mode);
+}
+#endif
 hid_t H5Dcreate2(hid_t loc_id, const char* name, hid_t type_id, hid_t space_id, hid_t lcpl_id,
                  hid_t dcpl_id, hid_t dapl_id) {
   return lib().H5Dcreate2(loc_id, name, type_id, space_id, lcpl_id, dcpl_id, dapl_id);

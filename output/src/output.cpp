@@ -140,18 +140,33 @@ herr_t innermost_error(unsigned n, const H5E_error2_t* e, void* out) {
                            (detail.empty() ? std::string() : " (" + detail + ")"));
 }
 
+// One rank's share of a dataset written by several processes at once: its rows [offset, offset
+// + n) of `total`, written through the collective transfer list `xfer`.
+struct Rows {
+  std::size_t offset, total;
+  hid_t xfer;
+};
+
 // compression: the deflate level (0: stored as is, contiguous; 1-9: chunks of up to 65 536 rows,
-// byte-shuffled and deflated, which every HDF5 reader undoes).
+// byte-shuffled and deflated, which every HDF5 reader undoes). part: this rank's rows when
+// several processes write the dataset together (null: all n rows are here).
 void write_dataset(hid_t group, const char* name, hid_t file_type, hid_t mem_type,
                    const void* data, std::size_t n, std::size_t ncomp, const std::string& file,
                    const std::string& group_name, const char* units = nullptr,
-                   int compression = 0) {
+                   int compression = 0, const Rows* part = nullptr) {
   const int rank = ncomp > 1 ? 2 : 1;
-  hsize_t dims[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(ncomp)};
+  const std::size_t rows = part ? part->total : n;
+  hsize_t dims[2] = {static_cast<hsize_t>(rows), static_cast<hsize_t>(ncomp)};
   H5Handle space(H5Screate_simple(rank, dims, nullptr), H5Sclose);
   if (space.id < 0) h5_fail("cannot create dataspace for '" + group_name + "/" + name + "'", file);
-  const bool deflate = compression > 0 && n > 0;
-  H5Handle dcpl(deflate ? H5Pcreate(H5P_DATASET_CREATE) : H5P_DEFAULT, deflate ? H5Pclose : nullptr);
+  const bool deflate = compression > 0 && rows > 0;
+  // Several processes: the file space is allocated when the dataset is made, on every rank
+  // alike (a rank with no rows to write would otherwise not allocate it, and the ranks' views
+  // of the file would part).
+  const bool own_dcpl = deflate || part;
+  H5Handle dcpl(own_dcpl ? H5Pcreate(H5P_DATASET_CREATE) : H5P_DEFAULT, own_dcpl ? H5Pclose : nullptr);
+  if (part && (dcpl.id < 0 || H5Pset_alloc_time(dcpl.id, H5D_ALLOC_TIME_EARLY) < 0))
+    h5_fail("cannot set the allocation of '" + group_name + "/" + name + "'", file);
   if (deflate) {
     const hsize_t chunk[2] = {std::min<hsize_t>(dims[0], 65536), dims[1]};
     if (dcpl.id < 0 || H5Pset_chunk(dcpl.id, rank, chunk) < 0 || H5Pset_shuffle(dcpl.id) < 0 ||
@@ -161,8 +176,27 @@ void write_dataset(hid_t group, const char* name, hid_t file_type, hid_t mem_typ
   H5Handle ds(H5Dcreate2(group, name, file_type, space.id, H5P_DEFAULT, dcpl.id, H5P_DEFAULT),
               H5Dclose);
   if (ds.id < 0) h5_fail("cannot create dataset '" + group_name + "/" + name + "'", file);
-  if (n > 0 && H5Dwrite(ds.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+  if (part && rows > 0) {
+    // Every rank takes part in the collective write, one with no rows selecting none.
+    const hsize_t start[2] = {static_cast<hsize_t>(part->offset), 0};
+    hsize_t count[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(ncomp)};
+    const hsize_t one[2] = {1, static_cast<hsize_t>(ncomp)};
+    H5Handle mem(H5Screate_simple(rank, n > 0 ? count : one, nullptr), H5Sclose);
+    bool selected = mem.id >= 0;
+    if (selected && n > 0)
+      selected = H5Sselect_hyperslab(space.id, H5S_SELECT_SET, start, nullptr, count, nullptr) >= 0;
+    else if (selected)
+      selected = H5Sselect_none(space.id) >= 0 && H5Sselect_none(mem.id) >= 0;
+    const double none = 0;
+    if (!selected || H5Dwrite(ds.id, mem_type, mem.id, space.id, part->xfer,
+                              n > 0 ? data : &none) < 0)
+      h5_fail("cannot write dataset '" + group_name + "/" + name + "' (rows " +
+                  std::to_string(part->offset) + " to " + std::to_string(part->offset + n) +
+                  " of " + std::to_string(rows) + ")",
+              file);
+  } else if (n > 0 && H5Dwrite(ds.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     h5_fail("cannot write dataset '" + group_name + "/" + name + "'", file);
+  }
   if (!units) return;
   H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
   H5Handle aspace(H5Screate(H5S_SCALAR), H5Sclose);
@@ -185,11 +219,20 @@ void write_scalar_attribute(hid_t obj, const char* name, hid_t file_type, hid_t 
 
 // A snapshot file created (truncating) or opened for writing without a file lock, so that h5py
 // or ParaView can look at a running simulation's snapshots (each is flushed); readers still
-// lock as usual. Returns the file, or a negative id.
-hid_t open_unlocked(const std::string& path, bool create) {
+// lock as usual. comm: the ranks that open it together over MPI-IO (null: this process alone).
+// Returns the file, or a negative id.
+hid_t open_unlocked(const std::string& path, bool create, const void* comm = nullptr,
+                    const void* info = nullptr) {
   H5Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
 #if H5_VERSION_GE(1, 10, 7)
   H5Pset_file_locking(fapl.id, 0, 1);
+#endif
+#ifdef H5_HAVE_PARALLEL
+  if (comm && H5Pset_fapl_mpio(fapl.id, *static_cast<const MPI_Comm*>(comm),
+                               *static_cast<const MPI_Info*>(info)) < 0)
+    return -1;
+#else
+  if (comm) return -1;
 #endif
   return create ? H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id)
                 : H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
@@ -273,6 +316,17 @@ SnapshotWriter::~SnapshotWriter() {
   }
 }
 
+void SnapshotWriter::set_ranks(const void* comm, const void* info, int rank) {
+#ifndef H5_HAVE_PARALLEL
+  if (comm)
+    throw std::runtime_error("this HDF5 library was built without MPI: particle snapshots of "
+                             "several processes need HDF5's MPI flavour");
+#endif
+  comm_ = comm;
+  info_ = info;
+  rank_ = comm ? rank : 0;
+}
+
 void SnapshotWriter::open(const std::string& dir, const std::string& base) {
   close();
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
@@ -283,7 +337,7 @@ void SnapshotWriter::open(const std::string& dir, const std::string& base) {
   sizes_.clear();
   const std::string path = dir_ + "/" + base_ + ".h5";
 
-  const hid_t f = open_unlocked(path, true);
+  const hid_t f = open_unlocked(path, true, comm_, info_);
   if (f < 0)
     h5_fail("cannot create the snapshot file (does the output directory exist and is it "
             "writable?)",
@@ -306,7 +360,7 @@ int SnapshotWriter::resume(const std::string& dir, const std::string& base,
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   const std::string path = (dir.empty() ? std::string(".") : dir) + "/" + base + ".h5";
   hid_t f = -1;
-  if (!steps.empty()) f = open_unlocked(path, false);  // a missing or unreadable file: f < 0
+  if (!steps.empty()) f = open_unlocked(path, false, comm_, info_);  // missing or unreadable: f < 0
   bool whole = f >= 0;
   for (std::size_t k = 0; whole && k < steps.size(); ++k)
     whole = H5Lexists(f, step_name(steps[k]).c_str(), H5P_DEFAULT) > 0;
@@ -338,16 +392,36 @@ int SnapshotWriter::resume(const std::string& dir, const std::string& base,
   steps_ = steps;
   times_ = times;
   sizes_ = sizes;
-  write_xdmf();
+  if (rank_ == 0) write_xdmf();
   return static_cast<int>(steps.size());
 }
 
 void SnapshotWriter::write(const Particles& p, long step, double time,
                            const std::vector<std::uint8_t>* layer) {
+  if (comm_)
+    throw std::runtime_error("SnapshotWriter::write: several processes write with an offset");
+  write(p, step, time, layer, 0, p.size());
+}
+
+void SnapshotWriter::write(const Particles& p, long step, double time,
+                           const std::vector<std::uint8_t>* layer, std::size_t offset,
+                           std::size_t total) {
   const std::string path = dir_ + "/" + base_ + ".h5";
   if (file_ < 0) throw std::runtime_error("SnapshotWriter::write called before open()");
   const hid_t file = static_cast<hid_t>(file_);
   const std::size_t n = p.size();
+  if (offset + n > total)
+    throw std::runtime_error("SnapshotWriter: rows " + std::to_string(offset) + " to " +
+                             std::to_string(offset + n) + " of a snapshot of " +
+                             std::to_string(total));
+  // Several processes: the datasets are written collectively, each rank its rows.
+  H5Handle xfer(comm_ ? H5Pcreate(H5P_DATASET_XFER) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
+#ifdef H5_HAVE_PARALLEL
+  if (comm_ && (xfer.id < 0 || H5Pset_dxpl_mpio(xfer.id, H5FD_MPIO_COLLECTIVE) < 0))
+    h5_fail("cannot set up the collective write", path);
+#endif
+  const Rows rows{offset, total, xfer.id};
+  const Rows* part = comm_ ? &rows : nullptr;
   {
     const std::size_t sizes[] = {p.y.size(),   p.x0.size(),  p.y0.size(),  p.vx.size(),
                                  p.vy.size(),  p.mass.size(), p.vol.size(), p.sxx.size(),
@@ -393,7 +467,7 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
     return columns(3, [&](std::size_t i, int q) { return q == 0 ? a[i] : q == 1 ? b[i] : 0.0; });
   };
   write_dataset(group.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, vec3(p.x, p.y), n, 3, path,
-                gname, "m", compression_);
+                gname, "m", compression_, part);
   std::vector<int32_t> ibuf(n);
   for (const FieldInfo& f : kFields) {
     if (!(fields_ & f.bit) || (f.bit == kFieldFilm && !film_)) continue;
@@ -424,14 +498,14 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
       const std::vector<double>& v = name == "jump_n" ? p.jump_n : name == "jump_t" ? p.jump_t : p.ubar;
       d = film_ && p.has_film() ? v.data() : columns(1, [](std::size_t, int) { return 0.0; });
     }
-    if (d) {
+    if (std::strcmp(f.number_type, "Float") == 0) {  // d: null when this rank has no rows
       write_dataset(group.id, f.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, d, n,
-                    static_cast<std::size_t>(f.components), path, gname, f.units, compression_);
+                    static_cast<std::size_t>(f.components), path, gname, f.units, compression_, part);
       continue;
     }
     if (name == "id") {
       write_dataset(group.id, f.name, H5T_STD_U32LE, H5T_NATIVE_UINT32, p.id.data(), n, 1, path,
-                    gname, f.units, compression_);
+                    gname, f.units, compression_, part);
       continue;
     }
     for (std::size_t i = 0; i < n; ++i)
@@ -439,30 +513,30 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
                 : name == "state" ? (i < p.state.size() ? p.state[i] : 0)
                                   : (layer ? (*layer)[i] : 0);
     write_dataset(group.id, f.name, H5T_STD_I32LE, H5T_NATIVE_INT32, ibuf.data(), n, 1, path,
-                  gname, f.units, compression_);
+                  gname, f.units, compression_, part);
   }
 
   // The vertex connectivity 0 .. N-1 of the Polyvertex topology (XDMF 3 readers and meshio need
   // it): one dataset per particle count, shared by the snapshots of that count.
-  const std::string vname = vertices_name(n);
+  const std::string vname = vertices_name(total);
   if (H5Lexists(file, vname.c_str(), H5P_DEFAULT) <= 0) {
     std::vector<int64_t> v(n);
-    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<int64_t>(i);
+    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<int64_t>(offset + i);
     write_dataset(file, vname.c_str(), H5T_STD_I64LE, H5T_NATIVE_INT64, v.data(), n, 1, path, "",
-                  nullptr, compression_);
+                  nullptr, compression_, part);
   }
 
   if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
 
   if (slot < steps_.size()) {
     times_[slot] = time;
-    sizes_[slot] = n;
-    write_xdmf();
+    sizes_[slot] = total;
+    if (rank_ == 0) write_xdmf();
   } else {
     steps_.push_back(step);
     times_.push_back(time);
-    sizes_.push_back(n);
-    append_xdmf();
+    sizes_.push_back(total);
+    if (rank_ == 0) append_xdmf();
   }
 }
 

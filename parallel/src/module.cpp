@@ -44,8 +44,17 @@ void broadcast(std::string& bytes) {
   }
 }
 
-const MpiModule kTable = {kMpiModuleApi, start,  stop,  rank,     size,
-                          distribute,    any,    abort, broadcast};
+const void* world() {
+  static const MPI_Comm w = MPI_COMM_WORLD;
+  return &w;
+}
+const void* no_info() {
+  static const MPI_Info i = MPI_INFO_NULL;
+  return &i;
+}
+
+const MpiModule kTable = {kMpiModuleApi, start, stop,  rank,      size,
+                          distribute,    any,   abort, broadcast, world, no_info};
 
 }  // namespace
 }  // namespace smpm::detail

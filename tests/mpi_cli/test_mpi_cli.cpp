@@ -394,7 +394,7 @@ TEST(MpiCli, FarFieldCheckpointOnTwoRanksRestartsOnAnyCount) {
   expect_checkpoint_restarts(kFem, "femck", 100, {0, 4}, 1e-13);
 }
 
-// Snapshots on 2 ranks: rank 0 writes every rank's particles, in the order of their ids; every
+// Snapshots on 2 ranks: every rank writes its particles into the one file, rank by rank; every
 // dataset of every snapshot against the plain run's, row by row through the ids, within 1e-10
 // of its largest value. The grid's projection (output.grid) node by node within 1e-10, its
 // XDMF byte-identical.

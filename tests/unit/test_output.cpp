@@ -394,6 +394,38 @@ TEST(OutputSnapshot, ChosenFieldsOnly) {
   EXPECT_EQ(snapshot_field_names().size(), 12u);
 }
 
+// A snapshot with no particles (every one has left the grid) keeps each dataset's type and
+// columns: the float fields stay 64-bit floats with 0 rows (they came out as 32-bit integers
+// once, an empty array's null data taken for a field that is not a float).
+TEST(OutputSnapshot, EmptySnapshotKeepsEveryDatasetsType) {
+  TempDir dir("snap0");
+  {
+    SnapshotWriter w;
+    w.open(dir.path.string());
+    w.write(Particles{}, 7, 1e-6);
+  }
+  const hid_t f = H5Fopen(dir.str("particles.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  const std::vector<std::pair<std::string, int>> floats = {
+      {"xyz", 3}, {"velocity", 3}, {"displacement", 3}, {"stress", 9}, {"J2", 1},
+      {"eps_p", 1}, {"mass", 1}, {"volume", 1}};
+  for (const auto& [name, columns] : floats) {
+    const hid_t ds = H5Dopen2(f, ("/step_000000007/" + name).c_str(), H5P_DEFAULT);
+    ASSERT_GE(ds, 0) << name;
+    const hid_t type = H5Dget_type(ds), space = H5Dget_space(ds);
+    EXPECT_EQ(H5Tget_class(type), H5T_FLOAT) << name;
+    EXPECT_EQ(H5Tget_size(type), 8u) << name;
+    hsize_t dims[2] = {1, 1};
+    const int rank = H5Sget_simple_extent_dims(space, dims, nullptr);
+    EXPECT_EQ(dims[0], 0u) << name;
+    EXPECT_EQ(rank == 2 ? static_cast<int>(dims[1]) : 1, columns) << name;
+    H5Sclose(space);
+    H5Tclose(type);
+    H5Dclose(ds);
+  }
+  H5Fclose(f);
+}
+
 TEST(OutputSnapshot, XdmfIsRewrittenAfterEverySnapshot) {
   TempDir dir("snapx");
   SnapshotWriter w;

@@ -71,11 +71,23 @@ class SnapshotWriter {
   // Deflate level of the datasets written from now on: 0 (default) stores them as they are,
   // 1-9 in byte-shuffled, deflated chunks (OutputSpec::compression).
   void set_compression(int level) { compression_ = level; }
+  // Several processes writing one file together (HDF5 over MPI-IO): comm points to the MPI
+  // communicator (an MPI_Comm) of the ranks that open, write, resume and close together, info
+  // to the MPI_Info for opening it (MPI_INFO_NULL); rank 0 alone writes the XDMF. Before open()
+  // or resume(); null: one process (the default). Throws std::runtime_error when this HDF5 was
+  // built without MPI.
+  void set_ranks(const void* comm, const void* info, int rank);
   // layer: per particle (in p's order) its SnapshotLayer bits, or null (all 0).
   void write(const Particles& p, long step, double time,
              const std::vector<std::uint8_t>* layer = nullptr);
+  // Several processes (set_ranks): every rank calls it at once with its particles, which fill
+  // rows [offset, offset + p.size()) of the snapshot's `total` rows (the ranks' rows must not
+  // overlap and must cover them all).
+  void write(const Particles& p, long step, double time, const std::vector<std::uint8_t>* layer,
+             std::size_t offset, std::size_t total);
   void close();
   int count() const { return static_cast<int>(times_.size()); }
+  int rank() const { return rank_; }  // set_ranks' (0 on one process)
   // Restart: reopens DIR/<base>.h5 of an earlier run that wrote the snapshots listed (their
   // steps, times and particle counts), removes any later snapshot group it holds, and lists them
   // again in the XDMF. Returns how many were kept: all of them, or 0 when the file or one of the
@@ -88,6 +100,9 @@ class SnapshotWriter {
 
  private:
   long long file_ = -1;  // hid_t
+  const void* comm_ = nullptr;  // set_ranks
+  const void* info_ = nullptr;
+  int rank_ = 0;
   std::string dir_, base_;
   std::vector<double> times_;
   std::vector<long> steps_;
