@@ -128,11 +128,11 @@ class HybridRegion final : public Region {
     j["threads"] = s_.thread_count();
     if (ranks_.dist()) {  // the grid's halo sums and migrations, the far field's ghost updates,
                           // the interface's sums (the slowest rank's seconds)
-      ranks_.put_traffic(j, r.steps);
+      ranks_.put_traffic(j, r.steps_run);
       j["mpi"]["fem"] = fem_traffic_json(fe_);
       double slow = hy_.interface_seconds();
       ranks_.dist()->max(&slow, 1);
-      const double n = std::max(1.0, static_cast<double>(r.steps));
+      const double n = std::max(1.0, static_cast<double>(r.steps_run));
       j["mpi"]["interface_seconds_per_step"] = slow / n;
       j["mpi"]["interface_values_per_step"] = hy_.interface_values() / n;
     }

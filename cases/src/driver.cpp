@@ -283,6 +283,7 @@ RunResult run_region(const Case& c, detail::Region& region, const std::string& o
 
     RunResult r;
     r.steps = nsteps;
+    r.steps_run = nsteps - first;
     r.wall_seconds = seconds_since(t_start);
     region.rates(r, nsteps - first, step_seconds);
 

@@ -112,7 +112,7 @@ class MpmRanks {
   void close_snapshots(MpmSnapshots& snaps);
   double total(double v) const;  // summed over the ranks (itself on one process)
   // summary.json: "mpi_ranks", "mpi_ranks_across" and "mpi" (the halo sums' and migrations'
-  // time and bytes per step of `steps`), when split; every rank calls it.
+  // time and bytes per step, over the `steps` this run made), when split; every rank calls it.
   void put_traffic(nlohmann::ordered_json& j, long steps) const;
   // The whole grid's geometry: "origin", "cells", "cell".
   nlohmann::ordered_json grid_json() const;

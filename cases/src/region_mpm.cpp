@@ -216,7 +216,7 @@ class MpmRegion final : public Region {
     j["particles"] = r.particles;
     j["particle_updates_per_second"] = r.particle_updates_per_second;
     j["threads"] = s_.thread_count();
-    ranks_.put_traffic(j, r.steps);
+    ranks_.put_traffic(j, r.steps_run);
     put_mpm_scheme(j, s_);
     j["grid"] = ranks_.grid_json();
     j["energy"] = energy_json(s_.total_energy());

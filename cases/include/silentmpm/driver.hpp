@@ -10,6 +10,7 @@ namespace smpm {
 
 struct RunResult {
   long steps = 0;
+  long steps_run = 0;  // the steps this run made (steps less a restart's first)
   double wall_seconds = 0;
   double particle_updates_per_second = 0;
   std::size_t particles = 0;            // MPM region, over every rank
