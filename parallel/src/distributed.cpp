@@ -403,23 +403,30 @@ void Distributed::gather(const std::vector<double>& mine, std::vector<double>& o
   const long long n = static_cast<long long>(mine.size());
   std::vector<long long> counts(d.size);
   MPI_Gather(&n, 1, MPI_LONG_LONG, counts.data(), 1, MPI_LONG_LONG, 0, d.comm);
+  // Rank by rank, in messages of at most gather_piece() values (an MPI count is an int), so
+  // the whole may hold more than 2^31 - 1 values.
+  const long long piece = static_cast<long long>(gather_piece());
+  constexpr int kTag = 7302;
+  if (d.rank != 0) {
+    for (long long at = 0; at < n; at += piece)
+      MPI_Send(mine.data() + at, static_cast<int>(std::min(piece, n - at)), MPI_DOUBLE, 0, kTag,
+               d.comm);
+    return;
+  }
   long long total = 0;
   for (long long c : counts) total += c;
-  int too_large = d.rank == 0 && total > 2147483647LL;
-  MPI_Bcast(&too_large, 1, MPI_INT, 0, d.comm);
-  if (too_large)
-    throw std::runtime_error("gathering " + std::to_string(total) + " values on rank 0 needs more "
-                             "than one message can carry (2^31 - 1)");
-  std::vector<int> rc(d.size), disp(d.size);
-  for (int r = 0, at = 0; r < d.size; ++r) {
-    rc[r] = static_cast<int>(counts[r]);
-    disp[r] = at;
-    at += rc[r];
+  on_root.resize(static_cast<std::size_t>(total));
+  std::copy(mine.begin(), mine.end(), on_root.begin());
+  long long from = n;
+  for (int r = 1; r < d.size; ++r) {
+    for (long long at = 0; at < counts[r]; at += piece)
+      MPI_Recv(on_root.data() + from + at, static_cast<int>(std::min(piece, counts[r] - at)),
+               MPI_DOUBLE, r, kTag, d.comm, MPI_STATUS_IGNORE);
+    from += counts[r];
   }
-  if (d.rank == 0) on_root.resize(static_cast<std::size_t>(total));
-  MPI_Gatherv(mine.data(), static_cast<int>(n), MPI_DOUBLE, on_root.data(), rc.data(), disp.data(),
-              MPI_DOUBLE, 0, d.comm);
 }
+
+std::size_t Distributed::gather_piece_ = std::size_t{1} << 30;
 
 void Distributed::sum(double* v, int n) {
   if (d_->size > 1) MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, d_->comm);

@@ -3,7 +3,7 @@ boundary and method, with the LK closed form (docs/physics.md section 4.1) besid
 
     /usr/bin/python3 studies/absorbing/metrics.py OUTDIR
 
-Reads OUTDIR/<fem|mpm>_<lk|kv|damping|pml>/metrics[_mpm].json (written by `oblique`), writes
+Reads OUTDIR/<fem|mpm>_<lk|kv|damping|rayleigh|pml>/metrics[_mpm].json (written by `oblique`), writes
 OUTDIR/metrics.json and OUTDIR/reflection_vs_angle.png and prints the table.
 """
 import json
@@ -15,8 +15,9 @@ import style  # noqa: E402
 
 import matplotlib.pyplot as plt  # noqa: E402
 
-BOUNDARIES = ["lk", "kv", "damping", "pml"]
-NAMES = {"lk": "LK dashpots", "kv": "Kelvin–Voigt", "damping": "damping band", "pml": "PML"}
+BOUNDARIES = ["lk", "kv", "damping", "rayleigh", "pml"]
+NAMES = {"lk": "LK dashpots", "kv": "Kelvin–Voigt", "damping": "damping band",
+         "rayleigh": "Rayleigh band", "pml": "PML"}
 METHODS = {"fem": "FEM far field", "mpm": "MPM"}
 
 
