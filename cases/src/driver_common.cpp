@@ -94,30 +94,38 @@ void GridSnapshots::open(const Solver& s, const std::string& out_dir, int compre
 
 void GridSnapshots::open(double x0, double y0, double h, int nx, int ny,
                          const std::string& out_dir, int compression,
-                         const std::vector<double>& earlier) {
+                         const std::vector<double>& earlier, const void* comm, const void* info,
+                         int rank, std::array<int, 4> own) {
+  const int nnx = nx + 1, nny = ny + 1;
+  // The nodes and cells this process writes: all of them, or a rank's own block.
+  const std::array<int, 4> nodes = comm ? own : std::array<int, 4>{0, nx, 0, ny};
+  const std::array<int, 4> cbox = {nodes[0], std::min(nodes[1], nx - 1), nodes[2],
+                                   std::min(nodes[3], ny - 1)};
+  auto block = [](const std::array<int, 4>& b, int width) {
+    return RowBlock{static_cast<std::size_t>(b[2]) * width + b[0],
+                    static_cast<std::size_t>(std::max(0, b[1] - b[0] + 1)),
+                    static_cast<std::size_t>(std::max(0, b[3] - b[2] + 1)),
+                    static_cast<std::size_t>(width)};
+  };
   w_.set_compression(compression);
+  w_.set_ranks(comm, info, rank, static_cast<std::size_t>(nnx) * nny,
+               static_cast<std::size_t>(nx) * ny, block(nodes, nnx), block(cbox, nx));
   if (!earlier.empty() && w_.resume(out_dir, "grid", earlier) == static_cast<int>(earlier.size()))
     return;
-  if (!earlier.empty())
+  if (!earlier.empty() && rank == 0)
     std::fprintf(stderr, "note: %s/grid.h5 does not hold the %zu snapshot(s) written before the "
                          "checkpoint; grid.xdmf lists the snapshots from the restart on\n",
                  out_dir.c_str(), earlier.size());
-  const int nnx = nx + 1, nny = ny + 1;
-  std::vector<double> xyz(3 * static_cast<std::size_t>(nnx) * nny);
-  for (int j = 0; j < nny; ++j)
-    for (int i = 0; i < nnx; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * nnx + i;
-      xyz[3 * k] = x0 + i * h;
-      xyz[3 * k + 1] = y0 + j * h;
-    }
+  std::vector<double> xyz;
+  for (int j = nodes[2]; j <= nodes[3]; ++j)
+    for (int i = nodes[0]; i <= nodes[1]; ++i) xyz.insert(xyz.end(), {x0 + i * h, y0 + j * h, 0.0});
   std::vector<std::int64_t> cells;
-  cells.reserve(4 * static_cast<std::size_t>(nx) * ny);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
+  for (int j = cbox[2]; j <= cbox[3]; ++j)
+    for (int i = cbox[0]; i <= cbox[1]; ++i) {
       const std::int64_t n0 = static_cast<std::int64_t>(j) * nnx + i;
       cells.insert(cells.end(), {n0, n0 + 1, n0 + 1 + nnx, n0 + nnx});  // counter-clockwise
     }
-  w_.open(out_dir, "grid", xyz, cells, std::vector<std::int32_t>(static_cast<std::size_t>(nx) * ny, 0));
+  w_.open(out_dir, "grid", xyz, cells, std::vector<std::int32_t>(cells.size() / 4, 0));
 }
 
 void GridSnapshots::write(const Solver& s) { write(s.t, s.nodal_projection()); }
@@ -154,25 +162,26 @@ void MpmSnapshots::write(const Solver& s) {
 
 void MpmSnapshots::open(const OutputSpec& out, const std::string& out_dir, double x0, double y0,
                         double h, int nx, int ny, const void* comm, const void* info,
-                        int rank) {
+                        int rank, std::array<int, 4> own) {
   snap_.set_ranks(comm, info, rank);
   snap_.set_fields(out.fields);
   snap_.set_compression(out.compression);
   earlier_.open(snap_, out_dir);
-  grid_on_ = out.grid && rank == 0;
-  if (grid_on_) grid_.open(x0, y0, h, nx, ny, out_dir, out.compression, earlier_.times);
+  grid_on_ = out.grid;
+  if (grid_on_)
+    grid_.open(x0, y0, h, nx, ny, out_dir, out.compression, earlier_.times, comm, info, rank, own);
 }
 
 void MpmSnapshots::write(const Particles& p, long step, double time,
                          const std::vector<std::uint8_t>& layer, std::size_t offset,
                          std::size_t total, const Solver::NodalProjection* P) {
   snap_.write(p, step, time, &layer, offset, total);
-  if (grid_on_ && P) grid_.write(time, *P);
+  if (grid_on_) grid_.write(time, *P);
 }
 
 void MpmSnapshots::close() {
   snap_.close();
-  if (grid_on_) grid_.close();
+  grid_.close();
 }
 
 void save_snapshot_list(StateWriter& w, const SnapshotWriter& snap) {

@@ -2,6 +2,7 @@
 // Internal: the pieces the run loop (driver.cpp) and its three regions (region_mpm.cpp,
 // region_fem.cpp, region_hybrid.cpp) share — output folder, history.csv columns and energy terms,
 // probe fields, the progress line, and the blocks and writing of summary.json.
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -51,9 +52,13 @@ class GridSnapshots {
   // `earlier`: the times of the snapshots before a restart (empty: a new file).
   void open(const Solver& s, const std::string& out_dir, int compression,
             const std::vector<double>& earlier);
-  // The same for a grid of nx x ny cells of h from (x0, y0) (several ranks: the whole grid).
+  // The same for a grid of nx x ny cells of h from (x0, y0). Several ranks (comm: as
+  // SnapshotWriter::set_ranks'): the whole grid's, every rank writing grid.h5 together, each
+  // its own nodes {i0, i1, j0, j1} (inclusive, the whole grid's numbering) and their cells;
+  // write() then takes those nodes' values, row by row.
   void open(double x0, double y0, double h, int nx, int ny, const std::string& out_dir,
-            int compression, const std::vector<double>& earlier);
+            int compression, const std::vector<double>& earlier, const void* comm = nullptr,
+            const void* info = nullptr, int rank = 0, std::array<int, 4> own = {});
   void write(const Solver& s);
   void write(double t, const Solver::NodalProjection& P);
   void close() { w_.close(); }
@@ -73,11 +78,11 @@ class MpmSnapshots {
   void open(const Solver& s, const OutputSpec& out, const std::string& out_dir);
   void write(const Solver& s);
   // Several ranks (comm: SnapshotWriter::set_ranks'): every rank opens and writes particles.h5
-  // together, each its particles as rows [offset, offset + p.size()) of `total`; rank 0 alone
-  // writes the grid's projection (the whole grid's geometry; P gathered from every rank, null
-  // without output.grid or on the other ranks).
+  // together, each its particles as rows [offset, offset + p.size()) of `total`, and grid.h5
+  // (output.grid; the whole grid's geometry), each the projection P on its own nodes `own`
+  // (GridSnapshots::open; P may be null without output.grid).
   void open(const OutputSpec& out, const std::string& out_dir, double x0, double y0, double h,
-            int nx, int ny, const void* comm, const void* info, int rank);
+            int nx, int ny, const void* comm, const void* info, int rank, std::array<int, 4> own);
   void write(const Particles& p, long step, double time, const std::vector<std::uint8_t>& layer,
              std::size_t offset, std::size_t total, const Solver::NodalProjection* P);
   void close();
@@ -107,7 +112,7 @@ class MpmRanks {
   void keep_account_on_root(const Energies& whole);
   void open_snapshots(MpmSnapshots& snaps, const OutputSpec& out, const std::string& out_dir);
   // Every rank calls it: each writes its particles into particles.h5 (rank by rank, in the
-  // ranks' order), rank 0 the grid's projection gathered.
+  // ranks' order) and the grid's projection on its own nodes into grid.h5.
   void write_snapshot(MpmSnapshots& snaps, bool grid);
   void close_snapshots(MpmSnapshots& snaps);
   double total(double v) const;  // summed over the ranks (itself on one process)

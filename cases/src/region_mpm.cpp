@@ -41,7 +41,7 @@ void MpmRanks::open_snapshots(MpmSnapshots& snaps, const OutputSpec& out,
   if (!several()) return snaps.open(s_, out, out_dir);
   mpi()->any(false);  // every rank waits for rank 0 to have made the output folder
   snaps.open(out, out_dir, whole_.x0, whole_.y0, whole_.h, whole_.nx, whole_.ny, mpi()->world(),
-             mpi()->no_info(), dist_->rank());
+             mpi()->no_info(), dist_->rank(), dist_->own_nodes());
 }
 
 void MpmRanks::write_snapshot(MpmSnapshots& snaps, bool grid) {
@@ -55,36 +55,22 @@ void MpmRanks::write_snapshot(MpmSnapshots& snaps, bool grid) {
     if (static_cast<int>(r) == dist_->rank()) offset = total;
     total += static_cast<std::size_t>(counts[r]);
   }
-  // The grid's projection (output.grid): each rank's own nodes, by their index in the whole
-  // grid, gathered on rank 0.
+  // The grid's projection (output.grid) on this rank's own nodes, row by row.
   Solver::NodalProjection P;
   if (grid) {
-    std::vector<double> nodes_mine, nodes_all;
-    P = s_.nodal_projection();
+    const Solver::NodalProjection W = s_.nodal_projection();  // over the window
     const auto own = dist_->own_nodes();
     const auto org = dist_->window_origin();
-    const long wnnx = whole_.nx + 1;
     for (int j = own[2]; j <= own[3]; ++j)
       for (int i = own[0]; i <= own[1]; ++i) {
         const long k = static_cast<long>(j - org[1]) * s_.grid.nnx + (i - org[0]);
-        nodes_mine.push_back(static_cast<double>(static_cast<long>(j) * wnnx + i));
-        for (const auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy})
-          nodes_mine.push_back((*v)[k]);
+        for (auto [to, from] : {std::pair{&P.mass, &W.mass}, {&P.vx, &W.vx}, {&P.vy, &W.vy},
+                                {&P.sxx, &W.sxx}, {&P.syy, &W.syy}, {&P.szz, &W.szz},
+                                {&P.sxy, &W.sxy}})
+          to->push_back((*from)[k]);
       }
-    dist_->gather(nodes_mine, nodes_all);
-    if (dist_->rank() == 0) {
-      const std::size_t n = static_cast<std::size_t>(whole_.nx + 1) * (whole_.ny + 1);
-      for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy}) v->assign(n, 0.0);
-      for (std::size_t r = 0; r + 7 < nodes_all.size(); r += 8) {
-        const auto k = static_cast<std::size_t>(nodes_all[r]);
-        int q = 1;
-        for (auto* v : {&P.mass, &P.vx, &P.vy, &P.sxx, &P.syy, &P.szz, &P.sxy})
-          (*v)[k] = nodes_all[r + q++];
-      }
-    }
   }
-  snaps.write(s_.p, s_.steps, s_.t, s_.layer_flags(), offset, total,
-              grid && dist_->rank() == 0 ? &P : nullptr);
+  snaps.write(s_.p, s_.steps, s_.t, s_.layer_flags(), offset, total, grid ? &P : nullptr);
 }
 
 void MpmRanks::close_snapshots(MpmSnapshots& snaps) { snaps.close(); }

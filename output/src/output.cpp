@@ -140,10 +140,11 @@ herr_t innermost_error(unsigned n, const H5E_error2_t* e, void* out) {
                            (detail.empty() ? std::string() : " (" + detail + ")"));
 }
 
-// One rank's share of a dataset written by several processes at once: its rows [offset, offset
-// + n) of `total`, written through the collective transfer list `xfer`.
+// One rank's share of a dataset written by several processes at once: its rows (RowBlock) of
+// `total`, written through the collective transfer list `xfer`.
 struct Rows {
-  std::size_t offset, total;
+  RowBlock block;
+  std::size_t total;
   hid_t xfer;
 };
 
@@ -178,21 +179,28 @@ void write_dataset(hid_t group, const char* name, hid_t file_type, hid_t mem_typ
   if (ds.id < 0) h5_fail("cannot create dataset '" + group_name + "/" + name + "'", file);
   if (part && rows > 0) {
     // Every rank takes part in the collective write, one with no rows selecting none.
-    const hsize_t start[2] = {static_cast<hsize_t>(part->offset), 0};
-    hsize_t count[2] = {static_cast<hsize_t>(n), static_cast<hsize_t>(ncomp)};
-    const hsize_t one[2] = {1, static_cast<hsize_t>(ncomp)};
-    H5Handle mem(H5Screate_simple(rank, n > 0 ? count : one, nullptr), H5Sclose);
+    const RowBlock& b = part->block;
+    if (b.rows() != n)
+      throw std::runtime_error("HDF5 writer: " + std::to_string(n) + " rows for a block of " +
+                               std::to_string(b.rows()) + " in '" + file + "'");
+    const hsize_t start[2] = {static_cast<hsize_t>(b.first), 0};
+    const hsize_t stride[2] = {static_cast<hsize_t>(std::max(b.stride, b.length)), 1};
+    const hsize_t count[2] = {static_cast<hsize_t>(b.count), 1};
+    const hsize_t block[2] = {static_cast<hsize_t>(b.length), static_cast<hsize_t>(ncomp)};
+    const hsize_t mdims[2] = {static_cast<hsize_t>(std::max<std::size_t>(n, 1)),
+                              static_cast<hsize_t>(ncomp)};
+    H5Handle mem(H5Screate_simple(rank, mdims, nullptr), H5Sclose);
     bool selected = mem.id >= 0;
     if (selected && n > 0)
-      selected = H5Sselect_hyperslab(space.id, H5S_SELECT_SET, start, nullptr, count, nullptr) >= 0;
+      selected = H5Sselect_hyperslab(space.id, H5S_SELECT_SET, start, stride, count, block) >= 0;
     else if (selected)
       selected = H5Sselect_none(space.id) >= 0 && H5Sselect_none(mem.id) >= 0;
     const double none = 0;
     if (!selected || H5Dwrite(ds.id, mem_type, mem.id, space.id, part->xfer,
                               n > 0 ? data : &none) < 0)
-      h5_fail("cannot write dataset '" + group_name + "/" + name + "' (rows " +
-                  std::to_string(part->offset) + " to " + std::to_string(part->offset + n) +
-                  " of " + std::to_string(rows) + ")",
+      h5_fail("cannot write dataset '" + group_name + "/" + name + "' (" + std::to_string(n) +
+                  " rows from row " + std::to_string(b.first) + " of " + std::to_string(rows) +
+                  ")",
               file);
   } else if (n > 0 && H5Dwrite(ds.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     h5_fail("cannot write dataset '" + group_name + "/" + name + "'", file);
@@ -236,6 +244,16 @@ hid_t open_unlocked(const std::string& path, bool create, const void* comm = nul
 #endif
   return create ? H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id)
                 : H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
+}
+
+// A transfer property list for collective writes (several processes). Throws on failure.
+hid_t collective_transfer(const std::string& path) {
+  const hid_t x = H5Pcreate(H5P_DATASET_XFER);
+#ifdef H5_HAVE_PARALLEL
+  if (x >= 0 && H5Pset_dxpl_mpio(x, H5FD_MPIO_COLLECTIVE) >= 0) return x;
+#endif
+  if (x >= 0) H5Pclose(x);
+  h5_fail("cannot set up the collective write", path);
 }
 
 std::string step_name(long step) {
@@ -415,12 +433,8 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
                              std::to_string(offset + n) + " of a snapshot of " +
                              std::to_string(total));
   // Several processes: the datasets are written collectively, each rank its rows.
-  H5Handle xfer(comm_ ? H5Pcreate(H5P_DATASET_XFER) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
-#ifdef H5_HAVE_PARALLEL
-  if (comm_ && (xfer.id < 0 || H5Pset_dxpl_mpio(xfer.id, H5FD_MPIO_COLLECTIVE) < 0))
-    h5_fail("cannot set up the collective write", path);
-#endif
-  const Rows rows{offset, total, xfer.id};
+  H5Handle xfer(comm_ ? collective_transfer(path) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
+  const Rows rows{RowBlock{offset, n, 1, n}, total, xfer.id};
   const Rows* part = comm_ ? &rows : nullptr;
   {
     const std::size_t sizes[] = {p.y.size(),   p.x0.size(),  p.y0.size(),  p.vx.size(),
@@ -715,6 +729,23 @@ MeshSnapshotWriter::~MeshSnapshotWriter() {
   }
 }
 
+void MeshSnapshotWriter::set_ranks(const void* comm, const void* info, int rank,
+                                   std::size_t nodes, std::size_t cells,
+                                   const RowBlock& own_nodes, const RowBlock& own_cells) {
+#ifndef H5_HAVE_PARALLEL
+  if (comm)
+    throw std::runtime_error("this HDF5 library was built without MPI: mesh snapshots of "
+                             "several processes need HDF5's MPI flavour");
+#endif
+  comm_ = comm;
+  info_ = info;
+  rank_ = comm ? rank : 0;
+  nodes_ = nodes;
+  cells_ = cells;
+  own_nodes_ = own_nodes;
+  own_cells_ = own_cells;
+}
+
 void MeshSnapshotWriter::open(const std::string& dir, const std::string& base,
                               const std::vector<double>& xyz, const std::vector<std::int64_t>& cells,
                               const std::vector<std::int32_t>& material) {
@@ -726,27 +757,32 @@ void MeshSnapshotWriter::open(const std::string& dir, const std::string& base,
   names_.clear();
   units_.clear();
   components_.clear();
-  nodes_ = xyz.size() / 3;
-  cells_ = cells.size() / 4;
-  if (material.size() != cells_)
+  const std::size_t my_nodes = xyz.size() / 3, my_cells = cells.size() / 4;
+  if (!comm_) {
+    nodes_ = my_nodes;
+    cells_ = my_cells;
+  }
+  if (material.size() != my_cells)
     throw std::runtime_error("MeshSnapshotWriter: " + std::to_string(material.size()) +
-                             " materials for " + std::to_string(cells_) + " cells");
+                             " materials for " + std::to_string(my_cells) + " cells");
   const std::string path = dir_ + "/" + base_ + ".h5";
-  const hid_t f = open_unlocked(path, true);
+  const hid_t f = open_unlocked(path, true, comm_, info_);
   if (f < 0) h5_fail("cannot create the snapshot file (does the output directory exist?)", path);
   try {  // the writer counts as open only with the mesh written
+    H5Handle xfer(comm_ ? collective_transfer(path) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
+    const Rows node_rows{own_nodes_, nodes_, xfer.id}, cell_rows{own_cells_, cells_, xfer.id};
     H5Handle mesh(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     if (mesh.id < 0) h5_fail("cannot create group '/mesh'", path);
-    write_dataset(mesh.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), nodes_, 3, path,
-                  "mesh", "m", compression_);
-    write_dataset(mesh.id, "cells", H5T_STD_I64LE, H5T_NATIVE_INT64, cells.data(), cells_, 4,
-                  path, "mesh", "1", compression_);
-    write_dataset(mesh.id, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, material.data(), cells_,
-                  1, path, "mesh", "1", compression_);
+    write_dataset(mesh.id, "xyz", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, xyz.data(), my_nodes, 3,
+                  path, "mesh", "m", compression_, comm_ ? &node_rows : nullptr);
+    write_dataset(mesh.id, "cells", H5T_STD_I64LE, H5T_NATIVE_INT64, cells.data(), my_cells, 4,
+                  path, "mesh", "1", compression_, comm_ ? &cell_rows : nullptr);
+    write_dataset(mesh.id, "material", H5T_STD_I32LE, H5T_NATIVE_INT32, material.data(),
+                  my_cells, 1, path, "mesh", "1", compression_, comm_ ? &cell_rows : nullptr);
     if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
   } catch (...) {
     H5Fclose(f);
-    std::remove(path.c_str());
+    if (rank_ == 0) std::remove(path.c_str());
     throw;
   }
   file_ = f;
@@ -759,7 +795,7 @@ int MeshSnapshotWriter::resume(const std::string& dir, const std::string& base,
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   const std::string path = (dir.empty() ? std::string(".") : dir) + "/" + base + ".h5";
   if (times.empty()) return 0;
-  hid_t f = open_unlocked(path, false);
+  hid_t f = open_unlocked(path, false, comm_, info_);
   hsize_t rows = 0, cols = 0, crow = 0;
   bool whole = f >= 0 && dataset_shape(f, "/mesh/xyz", rows, cols) &&
                dataset_shape(f, "/mesh/cells", crow, cols);
@@ -807,7 +843,8 @@ int MeshSnapshotWriter::resume(const std::string& dir, const std::string& base,
   }
   if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
   times_ = times;
-  xdmf_end_ = write_xdmf_whole(dir_ + "/" + base_ + ".xdmf", xdmf_text(), std::strlen(kXdmfTail));
+  if (rank_ == 0)
+    xdmf_end_ = write_xdmf_whole(dir_ + "/" + base_ + ".xdmf", xdmf_text(), std::strlen(kXdmfTail));
   return static_cast<int>(times.size());
 }
 
@@ -830,11 +867,15 @@ void MeshSnapshotWriter::write(double time, const std::vector<Field>& fields) {
   H5Handle grp(H5Gcreate2(f, g.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
   if (grp.id < 0) h5_fail("cannot create group '/" + g + "'", path);
   write_scalar_attribute(grp.id, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, time, path, g);
+  H5Handle xfer(comm_ ? collective_transfer(path) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
+  const Rows node_rows{own_nodes_, nodes_, xfer.id};
   for (const Field& fd : fields)
-    write_dataset(grp.id, fd.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fd.data, nodes_,
-                  static_cast<std::size_t>(fd.components), path, g, fd.units, compression_);
+    write_dataset(grp.id, fd.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fd.data,
+                  comm_ ? own_nodes_.rows() : nodes_, static_cast<std::size_t>(fd.components),
+                  path, g, fd.units, compression_, comm_ ? &node_rows : nullptr);
   if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) h5_fail("cannot flush", path);
   times_.push_back(time);
+  if (rank_ != 0) return;
   const std::string xpath = dir_ + "/" + base_ + ".xdmf";
   if (xdmf_end_ < 0 || !append_xdmf_grid(xpath, xdmf_end_, xdmf_grid(times_.size() - 1))) {
     xdmf_end_ = -1;

@@ -400,10 +400,11 @@ TEST(MpiCli, FarFieldCheckpointOnTwoRanksRestartsOnAnyCount) {
   expect_checkpoint_restarts(kFem, "femck", 100, {0, 4}, 1e-13);
 }
 
-// Snapshots on 2 ranks: every rank writes its particles into the one file, rank by rank; every
-// dataset of every snapshot against the plain run's, row by row through the ids, within 1e-10
-// of its largest value. The grid's projection (output.grid) node by node within 1e-10, its
-// XDMF byte-identical.
+// Snapshots on 2 ranks, and on 4 as 2 x 2 blocks with deflated datasets: every rank writes its
+// particles into the one file, rank by rank, and its own nodes' projection into grid.h5 (a
+// block of rows of the whole grid's); every dataset of every snapshot against the plain run's,
+// row by row through the ids, within 1e-10 of its largest value. The grid's projection
+// (output.grid) node by node within 1e-10, its XDMF byte-identical.
 TEST(MpiCli, SnapshotsOnTwoRanksHoldEveryParticle) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path a = out_dir("snap_plain"), b = out_dir("snap_np2");
@@ -421,6 +422,18 @@ TEST(MpiCli, SnapshotsOnTwoRanksHoldEveryParticle) {
   EXPECT_EQ(g.status, 0) << g.out << g.err;
   EXPECT_EQ(case_testing::read_file(a / "grid.xdmf"), case_testing::read_file(b / "grid.xdmf"));
   std::printf("grid snapshots on 2 ranks: %s", g.out.c_str());
+  const fs::path c = out_dir("snap_np4");
+  const Proc q = run(4, args + c.string() + " --ranks-across 2 --set output.compression=3",
+                     "snap_np4");
+  ASSERT_EQ(q.status, 0) << q.err;
+  const Proc h4 = compare_h5(a / "particles.h5", c / "particles.h5", true, 1e-10, "snap4_h5");
+  EXPECT_EQ(h4.status, 0) << h4.out << h4.err;
+  const Proc g4 = compare_h5(a / "grid.h5", c / "grid.h5", false, 1e-10, "snap4_grid");
+  EXPECT_EQ(g4.status, 0) << g4.out << g4.err;
+  EXPECT_EQ(case_testing::read_file(a / "grid.xdmf"), case_testing::read_file(c / "grid.xdmf"));
+  EXPECT_EQ(case_testing::read_file(a / "particles.xdmf"),
+            case_testing::read_file(c / "particles.xdmf"));
+  std::printf("on 2 x 2 ranks, deflated: particles %sgrid %s", h4.out.c_str(), g4.out.c_str());
 }
 
 // The impact study with multi-field contact and friction on 2 ranks: every history column

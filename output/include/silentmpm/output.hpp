@@ -121,6 +121,14 @@ class SnapshotWriter {
   std::string xdmf_text() const;
 };
 
+// The rows of a dataset that one of several processes writes: `count` runs of `length` rows,
+// the first from row `first`, each `stride` rows after the one before (a block of nodes or cells
+// of a row-major grid: its rows' runs).
+struct RowBlock {
+  std::size_t first = 0, length = 0, count = 1, stride = 0;
+  std::size_t rows() const { return length * count; }
+};
+
 // Snapshots of a fixed mesh of quadrilaterals (the FE far field): DIR/<base>.h5 holds the mesh
 // once (/mesh/xyz N x 3, /mesh/cells M x 4 int64 counter-clockwise, /mesh/material M int32) and a
 // group /snapshot_NNNNN per snapshot (attribute "time") with node fields of N rows; DIR/<base>.xdmf
@@ -147,12 +155,22 @@ class MeshSnapshotWriter {
   int resume(const std::string& dir, const std::string& base, const std::vector<double>& times);
   bool is_open() const { return file_ >= 0; }
   void set_compression(int level) { compression_ = level; }  // as SnapshotWriter's
+  // Several processes writing one file together (as SnapshotWriter::set_ranks): the mesh has
+  // `nodes` nodes and `cells` cells in all, of which this rank writes the rows `own_nodes` and
+  // `own_cells`; open()'s arrays and write()'s fields then hold those rows only, in order.
+  // Before open() or resume().
+  void set_ranks(const void* comm, const void* info, int rank, std::size_t nodes,
+                 std::size_t cells, const RowBlock& own_nodes, const RowBlock& own_cells);
   void write(double time, const std::vector<Field>& fields);
   void close();
   int count() const { return static_cast<int>(times_.size()); }
 
  private:
   long long file_ = -1;  // hid_t
+  const void* comm_ = nullptr;  // set_ranks
+  const void* info_ = nullptr;
+  int rank_ = 0;
+  RowBlock own_nodes_, own_cells_;
   std::string dir_, base_;
   std::size_t nodes_ = 0, cells_ = 0;
   std::vector<double> times_;
