@@ -334,12 +334,19 @@ SnapshotWriter::~SnapshotWriter() {
   }
 }
 
-void SnapshotWriter::set_ranks(const void* comm, const void* info, int rank) {
+namespace {
+// Several processes (comm) need HDF5's MPI flavour: throws naming `what` without it.
+void need_mpi_flavour([[maybe_unused]] const void* comm, [[maybe_unused]] const char* what) {
 #ifndef H5_HAVE_PARALLEL
   if (comm)
-    throw std::runtime_error("this HDF5 library was built without MPI: particle snapshots of "
-                             "several processes need HDF5's MPI flavour");
+    throw std::runtime_error(std::string("this HDF5 library was built without MPI: ") + what +
+                             " of several processes need HDF5's MPI flavour");
 #endif
+}
+}  // namespace
+
+void SnapshotWriter::set_ranks(const void* comm, const void* info, int rank) {
+  need_mpi_flavour(comm, "particle snapshots");
   comm_ = comm;
   info_ = info;
   rank_ = comm ? rank : 0;
@@ -732,11 +739,7 @@ MeshSnapshotWriter::~MeshSnapshotWriter() {
 void MeshSnapshotWriter::set_ranks(const void* comm, const void* info, int rank,
                                    std::size_t nodes, std::size_t cells,
                                    const RowBlock& own_nodes, const RowBlock& own_cells) {
-#ifndef H5_HAVE_PARALLEL
-  if (comm)
-    throw std::runtime_error("this HDF5 library was built without MPI: mesh snapshots of "
-                             "several processes need HDF5's MPI flavour");
-#endif
+  need_mpi_flavour(comm, "mesh snapshots");
   comm_ = comm;
   info_ = info;
   rank_ = comm ? rank : 0;
