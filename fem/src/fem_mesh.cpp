@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "silentmpm/mpi_bytes.hpp"
 #include "silentmpm/fem.hpp"
 #include "silentmpm/gmsh_session.hpp"
 
@@ -199,16 +200,7 @@ Mesh mesh_here(const std::string& file, double size, double max_cells,
 // Several MPI ranks (docs/parallel.md, "The FE far field"): every rank asks for the mesh at
 // once; rank 0 alone reads or meshes the file and sends the result (or its error, which every
 // rank then throws) to the others.
-void broadcast(std::string& s) {
-  unsigned long long n = s.size();
-  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
-  s.resize(n);
-  for (unsigned long long at = 0; at < n;) {  // in pieces a count of int holds
-    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1u << 30));
-    MPI_Bcast(s.data() + at, piece, MPI_CHAR, 0, MPI_COMM_WORLD);
-    at += static_cast<unsigned long long>(piece);
-  }
-}
+void broadcast(std::string& s) { broadcast_bytes(s, MPI_COMM_WORLD); }
 
 void broadcast(std::vector<PhysicalGroup>& groups) {
   unsigned long long n = groups.size();

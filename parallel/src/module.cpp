@@ -2,11 +2,11 @@
 // when an MPI launcher started it.
 #include <mpi.h>
 
-#include <algorithm>
 #include <string>
 
 #include "modules.hpp"
 #include "silentmpm/distributed.hpp"
+#include "silentmpm/mpi_bytes.hpp"
 #include "silentmpm/solver.hpp"
 
 namespace smpm::detail {
@@ -33,16 +33,7 @@ bool any(bool b) {
   return v != 0;
 }
 void abort(int code) { MPI_Abort(MPI_COMM_WORLD, code); }
-void broadcast(std::string& bytes) {
-  unsigned long long n = bytes.size();
-  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
-  bytes.resize(n);
-  for (unsigned long long at = 0; at < n;) {  // in pieces an int count holds
-    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
-    MPI_Bcast(bytes.data() + at, piece, MPI_CHAR, 0, MPI_COMM_WORLD);
-    at += static_cast<unsigned long long>(piece);
-  }
-}
+void broadcast(std::string& bytes) { broadcast_bytes(bytes, MPI_COMM_WORLD); }
 
 const void* world() {
   static const MPI_Comm w = MPI_COMM_WORLD;
