@@ -61,14 +61,16 @@ void MpmRanks::write_snapshot(MpmSnapshots& snaps, bool grid) {
     const Solver::NodalProjection W = s_.nodal_projection();  // over the window
     const auto own = dist_->own_nodes();
     const auto org = dist_->window_origin();
-    for (int j = own[2]; j <= own[3]; ++j)
-      for (int i = own[0]; i <= own[1]; ++i) {
-        const long k = static_cast<long>(j - org[1]) * s_.grid.nnx + (i - org[0]);
-        for (auto [to, from] : {std::pair{&P.mass, &W.mass}, {&P.vx, &W.vx}, {&P.vy, &W.vy},
-                                {&P.sxx, &W.sxx}, {&P.syy, &W.syy}, {&P.szz, &W.szz},
-                                {&P.sxy, &W.sxy}})
-          to->push_back((*from)[k]);
+    const long run = own[1] - own[0] + 1;  // each row of the block is a run of window nodes
+    for (auto [to, from] : {std::pair{&P.mass, &W.mass}, {&P.vx, &W.vx}, {&P.vy, &W.vy},
+                            {&P.sxx, &W.sxx}, {&P.syy, &W.syy}, {&P.szz, &W.szz},
+                            {&P.sxy, &W.sxy}}) {
+      to->reserve(static_cast<std::size_t>(run) * (own[3] - own[2] + 1));
+      for (int j = own[2]; j <= own[3]; ++j) {
+        const auto k = from->begin() + static_cast<long>(j - org[1]) * s_.grid.nnx + (own[0] - org[0]);
+        to->insert(to->end(), k, k + run);
       }
+    }
   }
   snaps.write(s_.p, s_.steps, s_.t, s_.layer_flags(), offset, total, grid ? &P : nullptr);
 }

@@ -246,11 +246,13 @@ hid_t open_unlocked(const std::string& path, bool create, const void* comm = nul
                 : H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.id);
 }
 
-// A transfer property list for collective writes (several processes). Throws on failure.
-hid_t collective_transfer(const std::string& path) {
+// The transfer property list of a writer's datasets: collective writes when several processes
+// (comm) write the file together, else the default. Throws on failure.
+H5Handle transfer_list(const void* comm, const std::string& path) {
+  if (!comm) return H5Handle(H5P_DEFAULT, nullptr);
   const hid_t x = H5Pcreate(H5P_DATASET_XFER);
 #ifdef H5_HAVE_PARALLEL
-  if (x >= 0 && H5Pset_dxpl_mpio(x, H5FD_MPIO_COLLECTIVE) >= 0) return x;
+  if (x >= 0 && H5Pset_dxpl_mpio(x, H5FD_MPIO_COLLECTIVE) >= 0) return H5Handle(x, H5Pclose);
 #endif
   if (x >= 0) H5Pclose(x);
   h5_fail("cannot set up the collective write", path);
@@ -440,7 +442,7 @@ void SnapshotWriter::write(const Particles& p, long step, double time,
                              std::to_string(offset + n) + " of a snapshot of " +
                              std::to_string(total));
   // Several processes: the datasets are written collectively, each rank its rows.
-  H5Handle xfer(comm_ ? collective_transfer(path) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
+  const H5Handle xfer = transfer_list(comm_, path);
   const Rows rows{RowBlock{offset, n, 1, n}, total, xfer.id};
   const Rows* part = comm_ ? &rows : nullptr;
   {
@@ -772,7 +774,7 @@ void MeshSnapshotWriter::open(const std::string& dir, const std::string& base,
   const hid_t f = open_unlocked(path, true, comm_, info_);
   if (f < 0) h5_fail("cannot create the snapshot file (does the output directory exist?)", path);
   try {  // the writer counts as open only with the mesh written
-    H5Handle xfer(comm_ ? collective_transfer(path) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
+    const H5Handle xfer = transfer_list(comm_, path);
     const Rows node_rows{own_nodes_, nodes_, xfer.id}, cell_rows{own_cells_, cells_, xfer.id};
     H5Handle mesh(H5Gcreate2(f, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     if (mesh.id < 0) h5_fail("cannot create group '/mesh'", path);
@@ -870,7 +872,7 @@ void MeshSnapshotWriter::write(double time, const std::vector<Field>& fields) {
   H5Handle grp(H5Gcreate2(f, g.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
   if (grp.id < 0) h5_fail("cannot create group '/" + g + "'", path);
   write_scalar_attribute(grp.id, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, time, path, g);
-  H5Handle xfer(comm_ ? collective_transfer(path) : H5P_DEFAULT, comm_ ? H5Pclose : nullptr);
+  const H5Handle xfer = transfer_list(comm_, path);
   const Rows node_rows{own_nodes_, nodes_, xfer.id};
   for (const Field& fd : fields)
     write_dataset(grp.id, fd.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fd.data,
