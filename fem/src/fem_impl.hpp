@@ -60,17 +60,20 @@ struct Solver::Impl {
     std::vector<std::uint32_t> cell_nodes;   // nb per cell
     std::vector<std::uint32_t> shape;        // per cell: its table in grad
     std::vector<double> grad;                // per shape, point, node: dN/dx, dN/dy
-    // Per cell and point: (d_y - d_x) JxW (lambda + 2 mu), (d_y - d_x) JxW mu, d_x, d_y.
+    // The distinct kinds of point, each (d_y - d_x) JxW (lambda + 2 mu), (d_y - d_x) JxW mu,
+    // d_x, d_y (a structured layer has a few dozen), and per cell and point its kind.
     std::vector<double> kl, km, dx, dy;
+    std::vector<std::uint32_t> kind;
     std::vector<double> xi;                  // 4 per cell and point
     std::vector<std::uint32_t> node;         // nodes with d_x + d_y > 0
     std::vector<double> m_sum, m_prod;       // m_i (d_x + d_y), m_i d_x d_y
     std::vector<double> zeta;                // 4 per node: the memories I1, I2 of u_x, then of u_y
     std::vector<std::uint32_t> touched;      // every node of a layer cell
-    // Recursive-convolution coefficients (e, ca, cb) for dt_coef: per cell and point for
-    // alpha + d_x and alpha + d_y, and for alpha.
+    // Recursive-convolution coefficients (e, ca, cb) for dt_coef: per kind of point for
+    // alpha + d_x and alpha + d_y (cx, cy), and for alpha; and per kind of point, packed for the
+    // step, kl, km, cx, cy.
     double dt_coef = 0;
-    std::vector<double> cx, cy;
+    std::vector<double> cx, cy, packed;
     double e_a = 1, ca_a = 0, cb_a = 0;
     bool active() const { return !touched.empty(); }
   };

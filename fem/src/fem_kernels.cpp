@@ -179,64 +179,92 @@ namespace {
 // term m (s_x s_y)(i omega)^2 u less its damping part m (d_x + d_y) v (in the dashpot block):
 // -m [(d_x + d_y)(-alpha u + alpha^2 I1) + d_x d_y (u - 2 alpha I1 + alpha^2 I2)], with I1 the
 // convolution of u and I2 that of I1 with exp(-alpha t).
-void pml_forces(Solver::Impl& m, double dt) {
-  Solver::Impl::Pml& P = m.pml;
-  if (P.dt_coef != dt) {
-    convolution_tables(P.alpha, P.dx, P.dy, dt, P.cx, P.cy, P.e_a, P.ca_a, P.cb_a);
-    P.dt_coef = dt;
+// One layer cell's forces at u into f (through the dashpot blocks), advancing its points'
+// memories; NB, NQ its nodes and quadrature points (0: P.nb and P.nq at run time).
+template <int NB, int NQ>
+inline void pml_cell(Solver::Impl::Pml& P, std::int64_t c, const double* __restrict u,
+                     const std::int32_t* __restrict dn, double* __restrict f) {
+  const int nb = NB ? NB : P.nb, nq = NQ ? NQ : P.nq;
+  const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
+  const double* gs = P.grad.data() + static_cast<std::size_t>(P.shape[c]) * nq * nb * 2;
+  double ux[9], uy[9], fx[9] = {0}, fy[9] = {0};
+  for (int a = 0; a < nb; ++a) {
+    ux[a] = u[2 * cn[a]];
+    uy[a] = u[2 * cn[a] + 1];
   }
+  for (int q = 0; q < nq; ++q) {
+    const std::size_t k = c * nq + q;
+    const double* g = gs + 2 * q * nb;
+    double gxx = 0, gxy = 0, gyx = 0, gyy = 0;  // du_x/dx, du_y/dx, du_x/dy, du_y/dy
+    for (int a = 0; a < nb; ++a) {
+      gxx += g[2 * a] * ux[a];
+      gxy += g[2 * a] * uy[a];
+      gyx += g[2 * a + 1] * ux[a];
+      gyy += g[2 * a + 1] * uy[a];
+    }
+    double* xi = P.xi.data() + 4 * k;
+    const double* t = P.packed.data() + 8 * P.kind[k];  // kl, km, cx, cy
+    const double kl = t[0], km = t[1], *cx = t + 2, *cy = t + 5;
+    const double pxx = xi[0] + cx[2] * gxx, pxy = xi[1] + cx[2] * gxy;
+    const double pyx = xi[2] + cy[2] * gyx, pyy = xi[3] + cy[2] * gyy;
+    xi[0] = cx[0] * pxx + cx[1] * gxx;
+    xi[1] = cx[0] * pxy + cx[1] * gxy;
+    xi[2] = cy[0] * pyx + cy[1] * gyx;
+    xi[3] = cy[0] * pyy + cy[1] * gyy;
+    // The x part carries d_y - d_x, the y part d_x - d_y.
+    const double sxx = kl * pxx, sxy = km * pxy, syx = -km * pyx, syy = -kl * pyy;
+    for (int a = 0; a < nb; ++a) {
+      fx[a] -= sxx * g[2 * a] + syx * g[2 * a + 1];
+      fy[a] -= sxy * g[2 * a] + syy * g[2 * a + 1];
+    }
+  }
+  for (int a = 0; a < nb; ++a) {
+    f[2 * dn[cn[a]]] += fx[a];
+    f[2 * dn[cn[a]] + 1] += fy[a];
+  }
+}
+
+template <int NB, int NQ>
+void pml_cells(Solver::Impl& m) {
+  Solver::Impl::Pml& P = m.pml;
   double* __restrict f = m.dash_force.data();
   const std::int32_t* __restrict dn = m.dash_of_node.data();
   const double* __restrict u = m.u.data();
-  for (const std::uint32_t nd : P.touched) f[2 * dn[nd]] = f[2 * dn[nd] + 1] = 0.0;
-  const int nb = P.nb, nq = P.nq;
   // Several ranks: the layer cells around this rank's nodes (Part::pml_cells), by colour.
   const Solver::Impl::Part* part = m.part.get();
   const std::vector<std::uint32_t>& starts = part ? part->pml_colour_start : P.colour_start;
   for (std::size_t colour = 0; colour + 1 < starts.size(); ++colour) {
     const std::int64_t c0 = starts[colour], c1 = starts[colour + 1];
 #pragma omp parallel for schedule(static) num_threads(m.threads) if (c1 - c0 >= 256)
-    for (std::int64_t cc = c0; cc < c1; ++cc) {
-      const std::int64_t c = part ? part->pml_cells[cc] : cc;
-      const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
-      const double* gs = P.grad.data() + static_cast<std::size_t>(P.shape[c]) * nq * nb * 2;
-      double ux[9], uy[9], fx[9] = {0}, fy[9] = {0};
-      for (int a = 0; a < nb; ++a) {
-        ux[a] = u[2 * cn[a]];
-        uy[a] = u[2 * cn[a] + 1];
-      }
-      for (int q = 0; q < nq; ++q) {
-        const std::size_t k = c * nq + q;
-        const double* g = gs + 2 * q * nb;
-        double gxx = 0, gxy = 0, gyx = 0, gyy = 0;  // du_x/dx, du_y/dx, du_x/dy, du_y/dy
-        for (int a = 0; a < nb; ++a) {
-          gxx += g[2 * a] * ux[a];
-          gxy += g[2 * a] * uy[a];
-          gyx += g[2 * a + 1] * ux[a];
-          gyy += g[2 * a + 1] * uy[a];
-        }
-        double* xi = P.xi.data() + 4 * k;
-        const double* cx = P.cx.data() + 3 * k;
-        const double* cy = P.cy.data() + 3 * k;
-        const double pxx = xi[0] + cx[2] * gxx, pxy = xi[1] + cx[2] * gxy;
-        const double pyx = xi[2] + cy[2] * gyx, pyy = xi[3] + cy[2] * gyy;
-        xi[0] = cx[0] * pxx + cx[1] * gxx;
-        xi[1] = cx[0] * pxy + cx[1] * gxy;
-        xi[2] = cy[0] * pyx + cy[1] * gyx;
-        xi[3] = cy[0] * pyy + cy[1] * gyy;
-        // The x part carries d_y - d_x, the y part d_x - d_y.
-        const double sxx = P.kl[k] * pxx, sxy = P.km[k] * pxy, syx = -P.km[k] * pyx, syy = -P.kl[k] * pyy;
-        for (int a = 0; a < nb; ++a) {
-          fx[a] -= sxx * g[2 * a] + syx * g[2 * a + 1];
-          fy[a] -= sxy * g[2 * a] + syy * g[2 * a + 1];
-        }
-      }
-      for (int a = 0; a < nb; ++a) {
-        f[2 * dn[cn[a]]] += fx[a];
-        f[2 * dn[cn[a]] + 1] += fy[a];
+    for (std::int64_t cc = c0; cc < c1; ++cc)
+      pml_cell<NB, NQ>(P, part ? part->pml_cells[cc] : cc, u, dn, f);
+  }
+}
+
+void pml_forces(Solver::Impl& m, double dt) {
+  Solver::Impl::Pml& P = m.pml;
+  if (P.dt_coef != dt) {
+    convolution_tables(P.alpha, P.dx, P.dy, dt, P.cx, P.cy, P.e_a, P.ca_a, P.cb_a);
+    P.packed.resize(8 * P.kl.size());
+    for (std::size_t j = 0; j < P.kl.size(); ++j) {
+      double* t = P.packed.data() + 8 * j;
+      t[0] = P.kl[j];
+      t[1] = P.km[j];
+      for (int i = 0; i < 3; ++i) {
+        t[2 + i] = P.cx[3 * j + i];
+        t[5 + i] = P.cy[3 * j + i];
       }
     }
+    P.dt_coef = dt;
   }
+  double* __restrict f = m.dash_force.data();
+  const std::int32_t* __restrict dn = m.dash_of_node.data();
+  const double* __restrict u = m.u.data();
+  for (const std::uint32_t nd : P.touched) f[2 * dn[nd]] = f[2 * dn[nd] + 1] = 0.0;
+  if (P.nb == 4 && P.nq == 4) pml_cells<4, 4>(m);
+  else if (P.nb == 9 && P.nq == 9) pml_cells<9, 9>(m);
+  else pml_cells<0, 0>(m);
+  const Solver::Impl::Part* part = m.part.get();
   const std::size_t nodes = part ? part->pml_nodes.size() : P.node.size();
   for (std::size_t jj = 0; jj < nodes; ++jj) {
     const std::size_t j = part ? part->pml_nodes[jj] : jj;

@@ -1,6 +1,7 @@
 // FEM far-field setup with deal.II: mesh in, dofs numbered by node, lumped mass, stiffness in a
 // node-block CSR, LK dashpot blocks, traction load vectors, the element bound on the time step,
 // probes and snapshots. The time stepping itself is in fem_kernels.cpp (no deal.II).
+#include <array>
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/dofs/dof_handler.h>
@@ -258,6 +259,7 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
     for (const auto n : cells[c].nodes) used[n] |= std::uint64_t{1} << k;
   }
   P.colour_start.assign(1, 0);
+  std::map<std::array<double, 4>, std::uint32_t> kinds;  // the distinct kinds of point
   for (int k = 0; k < ncolours; ++k) {
     for (std::size_t c = 0; c < cells.size(); ++c) {
       if (colour[c] != k) continue;
@@ -265,14 +267,22 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
       P.cell.push_back(e.index);
       P.cell_nodes.insert(P.cell_nodes.end(), e.nodes.begin(), e.nodes.end());
       P.shape.push_back(e.shape);
-      P.kl.insert(P.kl.end(), e.kl.begin(), e.kl.end());
-      P.km.insert(P.km.end(), e.km.begin(), e.km.end());
-      P.dx.insert(P.dx.end(), e.dx.begin(), e.dx.end());
-      P.dy.insert(P.dy.end(), e.dy.begin(), e.dy.end());
+      for (std::size_t q = 0; q < e.kl.size(); ++q) {
+        const std::array<double, 4> key{{e.kl[q], e.km[q], e.dx[q], e.dy[q]}};
+        auto it = kinds.find(key);
+        if (it == kinds.end()) {
+          it = kinds.emplace(key, static_cast<std::uint32_t>(P.kl.size())).first;
+          P.kl.push_back(e.kl[q]);
+          P.km.push_back(e.km[q]);
+          P.dx.push_back(e.dx[q]);
+          P.dy.push_back(e.dy[q]);
+        }
+        P.kind.push_back(it->second);
+      }
     }
     P.colour_start.push_back(static_cast<std::uint32_t>(P.shape.size()));
   }
-  P.xi.assign(4 * P.kl.size(), 0.0);
+  P.xi.assign(4 * P.kind.size(), 0.0);
   double lam = 0;
   for (const std::uint32_t node : touched) {
     P.touched.push_back(node);
