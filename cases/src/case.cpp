@@ -1147,11 +1147,12 @@ class Builder {
     } else if (type == "pml") {
       o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power", "alpha"}, where);
     } else if (type == "silent") {
-      o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor"},
+      o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor",
+               "edge_velocity"},
               where);
     } else {
       o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor",
-               "delta", "alpha_n", "alpha_t"},
+               "edge_velocity", "delta", "alpha_n", "alpha_t"},
               where);
     }
     const std::string name = o.str("name", type + std::to_string(i));
@@ -1312,13 +1313,29 @@ class Builder {
     sb.anchor = o.choice("anchor", {"boundary", "particle"}, anchor_default.c_str()) == "boundary"
                     ? Anchor::Boundary
                     : Anchor::Particle;
+    // Which velocity MUSL strains the particles with at the dashpots' nodes (docs/physics.md
+    // section 4): the re-mapped one (default) or the updated one, for edges off the grid lines.
+    if (o.choice("edge_velocity", {"remapped", "updated"}, "remapped") == "updated") {
+      if (s_->opt.scheme != Scheme::MUSL)
+        o.fail("edge_velocity", "\"updated\" applies under scheme.update \"MUSL\" only (USL "
+                                "strains the particles with the updated velocity everywhere, USF "
+                                "with the start-of-step one)");
+      if (sb.form != SilentForm::Nodal)
+        o.fail("edge_velocity", "\"updated\" needs the nodal form (the particle form puts no "
+                                "dashpot on the nodes)");
+      if (s_->contact.multi())
+        o.fail("edge_velocity", "\"updated\" is not available with multi-field contact (each "
+                                "body's field keeps its re-mapped velocity)");
+      sb.updated_velocity = true;
+    }
     o.done();
     if (type == "silent")
       c.notes.push_back("silent \"" + name + "\" on the " + what + " (" +
                         std::to_string(sb.layer.ids.size()) + " particles): LK dashpots a " +
                         fmt(sb.a) + " rho c_d, b " + fmt(sb.b) + " rho c_s, " +
                         (sb.form == SilentForm::Nodal ? "nodal" : "particle") + " form, at the " +
-                        (sb.anchor == Anchor::Boundary ? "boundary" : "particles"));
+                        (sb.anchor == Anchor::Boundary ? "boundary" : "particles") +
+                        (sb.updated_velocity ? ", strained with the updated velocity" : ""));
     // The impedances a rho c_d and b rho c_s of each particle's material are set by
     // Solver::finalize().
     s_->silents.push_back(std::move(sb));

@@ -183,6 +183,11 @@ void Solver::finalize() {
       s.kt[k] = s.alpha_t * m.rho * m.cs * m.cs / s.delta;
     }
   }
+  updated_weight_.clear();
+  for (const auto& s : silents)
+    if (opt.scheme == Scheme::MUSL && body_of_group_.empty() && s.form == SilentForm::Nodal &&
+        s.updated_velocity)
+      updated_weight_.assign(grid.nodes(), 0.0);
   // Damping of each layer particle from its depth and its material's c_d.
   for (auto& dl : dampers) {
     const BoundaryLayer& L = dl.layer;
@@ -526,10 +531,25 @@ void Solver::start_velocities() {
 }
 
 // MUSL: every field's re-mapped momentum q becomes the velocity q / m, with the constraints.
+// At the dashpot nodes of layers strained with the updated velocity (their weight > 0), v+
+// instead: the velocity the dashpots acted on (docs/physics.md section 4) -- where the node
+// holds at least dt/2 times the full LK impedance rho c_d of its share of the edge, the mass
+// of a matched edge node times the CFL number. A lighter node (of a nearly empty cell) keeps
+// the re-mapped value: there v+ = v + dt f / m amplifies the internal force, and a strong
+// dashpot makes the trapezoidal update ring. The boundary work, the springs and the stress
+// update then all take the velocity chosen here.
 void Solver::remapped_velocities() {
   for (const VelocityField& F : fields_)
     kernels::nodal_velocity(grid, F.box, F.f.m, grid.fix.data(), F.f.qx, F.f.qy, F.f.qx, F.f.qy,
                             mass_floor_, nthreads_);
+  if (updated_weight_.empty()) return;
+  for (const long i : dashpot_nodes_) {
+    if (updated_weight_[i] > 0 && grid.m[i] > mass_floor_ &&
+        0.5 * dt * updated_weight_[i] <= grid.m[i]) {
+      grid.qx[i] = grid.vnx[i];
+      grid.qy[i] = grid.vny[i];
+    }
+  }
 }
 
 // Shape functions of boundary particle q of layer L at its anchor point; fills nodes[].
@@ -775,6 +795,8 @@ void Solver::apply_loads() {
     grid.cxx[i] = grid.cxy[i] = grid.cyy[i] = 0;
     dashpot_mark_[i] = 0;
   }
+  if (!updated_weight_.empty())
+    for (long i : dashpot_nodes_) updated_weight_[i] = 0;
   dashpot_nodes_.clear();
   has_nodal_dashpot_ = false;
   for (auto& sl : silents) {
@@ -804,11 +826,14 @@ void Solver::apply_loads() {
       has_nodal_dashpot_ = true;
       double bxx, bxy, byy;
       lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], bxx, bxy, byy);
+      const bool updated = !updated_weight_.empty() && sl.updated_velocity;
+      const Material& mq = materials[p.group[L.idx[q]]];
       for (int a = 0; a < S::kNodes; ++a) {
         const double wn = L.w[q] * sf.N[a];
         grid.cxx[nodes[a]] += wn * bxx;
         grid.cxy[nodes[a]] += wn * bxy;
         grid.cyy[nodes[a]] += wn * byy;
+        if (updated) updated_weight_[nodes[a]] += wn * mq.rho * mq.cd;
         add_dashpot_node(nodes[a]);
       }
     }

@@ -85,8 +85,10 @@ void Solver::sum_halo(bool momentum, bool force) {
     for (auto* v : {&grid.m, &grid.px, &grid.py}) f.push_back(v->data());
   if (force) {
     for (auto* v : {&grid.fx, &grid.fy}) f.push_back(v->data());
-    if (halo_dashpots_)
+    if (halo_dashpots_) {
       for (auto* v : {&grid.cxx, &grid.cxy, &grid.cyy}) f.push_back(v->data());
+      if (!updated_weight_.empty()) f.push_back(updated_weight_.data());
+    }
   }
   const bool bodies = !body_of_group_.empty();
   if (bodies)

@@ -41,6 +41,7 @@ struct ColumnSpec {
   double damp_beta = 0;     // its stiffness-proportional part (s)
   int pml_cells = 0;        // a perfectly matched layer this many cells thick at the right end
   double pml_alpha = 0;
+  bool updated_edge = false;  // MUSL: strain with the updated velocity at the end's dashpot nodes
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -66,6 +67,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
     sb.layer = s->select_layer("right", 0, c.offset + L, 0, c.offset + L, top, 1, 0, c.h);
     sb.form = c.form;
     sb.anchor = c.anchor;
+    sb.updated_velocity = c.updated_edge;
     s->silents.push_back(sb);
   } else if (c.end == End::Fixed) {
     const double xr = c.offset + L;

@@ -295,6 +295,21 @@ std::vector<Bad> bad_cases() {
        "boundaries[2].alpha_n: must be >= 0"},
       {"silent_with_delta", [](ojson& j) { bnd(j, 2)["delta"] = 0.01; },
        "boundaries[2].delta: unknown key for a silent boundary"},
+      {"edge_velocity_unknown", [](ojson& j) { bnd(j, 2)["edge_velocity"] = "update"; },
+       "boundaries[2].edge_velocity: must be one of \"remapped\", \"updated\", got \"update\""},
+      {"edge_velocity_under_usl",
+       [](ojson& j) { j["scheme"]["update"] = "USL"; bnd(j, 2)["edge_velocity"] = "updated"; },
+       "boundaries[2].edge_velocity: \"updated\" applies under scheme.update \"MUSL\" only"},
+      {"edge_velocity_particle_form",
+       [](ojson& j) { bnd(j, 2)["form"] = "particle"; bnd(j, 2)["edge_velocity"] = "updated"; },
+       "boundaries[2].edge_velocity: \"updated\" needs the nodal form"},
+      {"edge_velocity_multi_contact",
+       [](ojson& j) {
+         j["contact"] = {{"type", "multi"}};
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["edge_velocity"] = "updated";
+       },
+       "boundaries[2].edge_velocity: \"updated\" is not available with multi-field contact"},
       {"traction_both_forms", [](ojson& j) { bnd(j, 1)["vector"] = {0, 1}; },
        "boundaries[1].vector: give either normal/tangential or vector"},
       {"unknown_boundary_body", [](ojson& j) { bnd(j, 2)["body"] = "plat"; },

@@ -70,6 +70,11 @@ struct SilentBoundary {
   double delta = 0, alpha_n = 1, alpha_t = 1;
   std::vector<double> kn, kt;        // alpha_n rho c_d^2 / delta and alpha_t rho c_s^2 / delta
   std::vector<double> ux, uy;        // displacement of each particle's anchor since the start
+  // MUSL, nodal form, one velocity field: strain the particles with the updated grid velocity
+  // v+ (the one the dashpots acted on) at this layer's dashpot nodes, where they are heavy
+  // enough, instead of the re-mapped one (docs/physics.md section 4; the case key
+  // "edge_velocity": "updated").
+  bool updated_velocity = false;
   bool springs() const { return delta > 0; }
 };
 

@@ -224,6 +224,11 @@ class Solver {
     dashpot_mark_[i] = 1;
     dashpot_nodes_.push_back(i);
   }
+  // MUSL, one velocity field: per grid node, the full LK impedance (rho c_d times the edge
+  // length) the dashpots of layers strained with the updated velocity put on it this step
+  // (SilentBoundary::updated_velocity; summed over the halo with the blocks); empty when no
+  // layer is.
+  std::vector<double> updated_weight_;
   double mass_floor_ = 0;
   double viscous_beta_ = -1;  // the largest beta at a particle (finalize()); -1: not yet
   double viscous_beta() const;
