@@ -44,6 +44,7 @@ struct InclinedSpec {
   int threads = 0;
   double a = 1, b = 1;      // LK coefficients (0, 0: a free edge)
   std::string form, anchor; // silent layer options (empty: the defaults)
+  std::string edge_velocity;  // MUSL: "updated" or "remapped" (empty: the default)
   double width = 0;         // silent layer depth, cells (0: the default, one cell)
   // Measure div/curl of the displacement (docs/physics.md §4.1: R are displacement-amplitude
   // ratios) or, if false, of the velocity (weights the high frequencies one order more).
@@ -93,6 +94,7 @@ inline json inclined_case(const std::string& source_dir, const InclinedSpec& s, 
     json silent = {{"type", "silent"}, {"body", "plate"}, {"curve", 12}, {"a", s.a}, {"b", s.b}};
     if (!s.form.empty()) silent["form"] = s.form;
     if (!s.anchor.empty()) silent["anchor"] = s.anchor;
+    if (!s.edge_velocity.empty()) silent["edge_velocity"] = s.edge_velocity;
     if (s.width > 0) silent["width"] = s.width * h;
     j["boundaries"].push_back(silent);
   }

@@ -24,6 +24,7 @@ InclinedResult run(InclinedSpec s) {
   if (const char* e = std::getenv("SMPM_INCLINED_HF")) s.height_factor = std::atof(e);
   if (const char* e = std::getenv("SMPM_INCLINED_D0")) s.depth0 = std::atof(e);
   if (const char* e = std::getenv("SMPM_INCLINED_D1")) s.depth1 = std::atof(e);
+  if (const char* e = std::getenv("SMPM_INCLINED_EDGE_VELOCITY")) s.edge_velocity = e;  // "updated"
   const InclinedResult r = smpm::inclined::measure_inclined(SMPM_SOURCE_DIR, s);
   std::printf("[ inclined ] theta %.0f deg, a = b = %g, %d ppc, FWHM %.0f cells: |R_PP| %.4f "
               "(closed form %.4f), |R_PS| %.4f (closed form %.4f); %ld + %ld particles, %ld steps, "
