@@ -241,6 +241,9 @@ int run_main(int argc, char** argv) {
       for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
       return 0;
     }
+    if (root())  // what check calls a note, run says on stderr before it starts
+      for (const auto& n : c.notes)
+        if (n.rfind("note: ", 0) == 0) std::fprintf(stderr, "%s\n", n.c_str());
     const auto r = smpm::run_case(c, out_dir, ropt);
     if (!quiet && root())
       std::printf("%s: %ld steps, %zu particles, %.2f s, %.3g particle-updates/s -> %s\n",

@@ -692,6 +692,7 @@ class Builder {
         parse_boundary(Obj(ctx_, (*bnd)[i], index_path("boundaries", i)), i, c);
     if (checking_) return c;  // no solver: the keys are read
 
+    note_particles_on_grid_lines(c);
     s_->finalize();
     // A point probe must see particles (of its body, when it names one): else it would record
     // zeros all run. (Points along a curve are checked against their bodies when placed.)
@@ -979,6 +980,29 @@ class Builder {
       out.push_back(std::move(p));
     }
     return out;
+  }
+
+  // With bilinear shapes a particle exactly on a grid line takes its gradients from whichever
+  // cell round-off puts it in, and a node beside it can get stiffness without mass: a
+  // degenerate MPM (docs/physics.md section 4). Such bodies run, with a note saying so.
+  void note_particles_on_grid_lines(Case& c) const {
+    if (s_->opt.shape != ShapeKind::Bilinear) return;
+    const Particles& p = s_->p;
+    const Grid& g = s_->grid;
+    std::vector<std::size_t> count(bodies_.size(), 0);
+    auto on_line = [&](double x, double x0) {
+      const double r = (x - x0) * g.inv_h;
+      return std::abs(r - std::round(r)) < 1e-9;
+    };
+    for (std::size_t k = 0; k < p.size(); ++k)
+      if (p.body[k] < count.size() && (on_line(p.x[k], g.x0) || on_line(p.y[k], g.y0)))
+        ++count[p.body[k]];
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+      if (count[b] > 0)
+        c.notes.push_back("note: body \"" + bodies_[b].name + "\": " + std::to_string(count[b]) +
+                          " particles lie on grid lines, where bilinear shape functions are "
+                          "degenerate (docs/physics.md section 4): shift the body by a fraction "
+                          "of a cell, or use scheme.shape \"gimp\" or \"bspline\"");
   }
 
   void seed() {

@@ -261,6 +261,34 @@ TEST(CaseLoad, MinimalCaseUsesDefaults) {
   EXPECT_TRUE(c.solver->constraints.empty());
 }
 
+// A body whose particles lie on grid lines (1 ppc in a box shifted by half a cell, 4 ppc by a
+// quarter) gets one note naming it and the count; aligned bodies, other shifts and wider
+// shapes none.
+TEST(CaseLoad, ParticlesOnGridLinesGetANote) {
+  auto build = [](double shift, int ppc, const char* shape) {
+    nlohmann::json j = {
+        {"grid", {{"size", {0.008, 0.004}}, {"cell", 0.001}}},
+        {"time", {{"end", 1e-6}, {"dt", 1e-8}}},
+        {"scheme", {{"shape", shape}}},
+        {"materials", {{"m", {{"model", "elastic"}, {"young", 1e9}, {"poisson", 0.25},
+                              {"density", 1000}}}}},
+        {"bodies", {{{"name", "b"}, {"material", "m"}, {"particles_per_cell", ppc},
+                     {"box", {shift, 0, 0.004 + shift, 0.002}}}}}};
+    const smpm::Case c = smpm::build_case(j, "inline");
+    std::string note;
+    for (const auto& n : c.notes)
+      if (n.find("grid lines") != std::string::npos) note += n;
+    return note;
+  };
+  const std::string half = build(0.0005, 1, "bilinear");
+  EXPECT_NE(half.find("body \"b\": 8 particles lie on grid lines"), std::string::npos) << half;
+  EXPECT_NE(build(0.00025, 4, "bilinear").find("body \"b\": 16 particles lie on grid lines"),
+            std::string::npos);  // every other column of the 2 x 2 lattice
+  EXPECT_EQ(build(0, 1, "bilinear"), "");
+  EXPECT_EQ(build(0.00025, 1, "bilinear"), "");
+  EXPECT_EQ(build(0.0005, 1, "bspline"), "");
+}
+
 // The complete example of docs/case-reference.md is a valid case (the reference stays honest).
 TEST(CaseLoad, ReferenceExampleBuilds) {
   const std::string doc = read_file(fs::path(SMPM_SOURCE_DIR) / "docs" / "case-reference.md");
