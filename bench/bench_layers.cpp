@@ -5,8 +5,11 @@
 // `dashpot`), Kelvin-Voigt springs, a graded damping band of L cells in front of the dashpots,
 // a perfectly matched layer of L cells in front of them. Each variant runs a short sin^2 pulse
 // from the top for a few steps to warm up, then is timed over S steps; the variants alternate,
-// and each figure is the best of R rounds (one thread by default, timed by the process's CPU
-// clock; with more threads by the wall clock, since idle OpenMP threads spin and count as CPU).
+// R rounds (one thread by default, timed by the process's CPU clock; with more threads by the
+// wall clock, since idle OpenMP threads spin and count as CPU). The time per step is the best
+// round's; the ratio to the free square is the median over the rounds of the ratio within each
+// round, which cancels the host's slow drifts (the edge-only boundaries amplify the ratio's
+// noise by N / N_layer, about 70 at 200 cells).
 //
 // Per variant it prints the time per step, the ratio to the free square's, and the cost of one
 // cell of the layer against a free cell:
@@ -120,7 +123,14 @@ struct Variant {
   Case c;
   int layer_cells = 0;               // thickness of the layer in cells (0: none)
   double best = 1e300;               // seconds per step
+  std::vector<double> rounds;        // seconds per step, each round
 };
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
 
 void step(Variant& v) {
   if (v.c.solver) v.c.solver->step();
@@ -174,19 +184,19 @@ int main(int argc, char** argv) {
   try {
     if (o.only != "fem") {
       for (const char* k : {"free", "lk", "kv", "damping"}) {
-        Variant v{"MPM", k, "MUSL", {}, 0};
+        Variant v{"MPM", k, "MUSL", {}, 0, 1e300, {}};
         v.c = load_case_text(mpm_case(o, k, "MUSL"), (dir / "mpm.json").string());
         vs.push_back(std::move(v));
       }
       for (const char* k : {"free", "pml"}) {
-        Variant v{"MPM", k, "USL", {}, 0};
+        Variant v{"MPM", k, "USL", {}, 0, 1e300, {}};
         v.c = load_case_text(mpm_case(o, k, "USL"), (dir / "mpm.json").string());
         vs.push_back(std::move(v));
       }
     }
     if (o.only != "mpm")
       for (const char* k : {"free", "lk", "kv", "damping", "pml"}) {
-        Variant v{"FEM", k, "", {}, 0};
+        Variant v{"FEM", k, "", {}, 0, 1e300, {}};
         v.c = load_case_text(fem_case(o, k, geo), (dir / "fem.json").string());
         vs.push_back(std::move(v));
       }
@@ -217,7 +227,8 @@ int main(int argc, char** argv) {
     for (Variant& v : vs) {
       const double t0 = seconds(o.threads);
       for (int s = 0; s < o.steps; ++s) step(v);
-      v.best = std::min(v.best, (seconds(o.threads) - t0) / o.steps);
+      v.rounds.push_back((seconds(o.threads) - t0) / o.steps);
+      v.best = std::min(v.best, v.rounds.back());
     }
   std::printf("%-6s %-8s %-6s %12s %10s %14s\n", "method", "boundary", "scheme", "us/step",
               "vs free", "cost/cell");
@@ -226,7 +237,9 @@ int main(int argc, char** argv) {
     const Variant* f = nullptr;
     for (const Variant& w : vs)
       if (w.method == v.method && w.kind == "free" && w.scheme == v.scheme) f = &w;
-    const double ratio = v.best / f->best;
+    std::vector<double> r(v.rounds.size());
+    for (std::size_t k = 0; k < r.size(); ++k) r[k] = v.rounds[k] / f->rounds[k];
+    const double ratio = median(r);
     std::printf("%-6s %-8s %-6s %12.1f %10.3f", v.method.c_str(), v.kind.c_str(),
                 v.scheme.empty() ? "-" : v.scheme.c_str(), 1e6 * v.best, ratio);
     if (v.layer_cells > 0)
