@@ -4,12 +4,12 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <climits>
 #include <cstdio>
 #include <limits>
 #include <string>
 
 #include "fem_impl.hpp"
+#include "silentmpm/mpi_bytes.hpp"
 
 namespace smpm::fem {
 
@@ -227,6 +227,12 @@ void sum_over_ranks(const Solver::Impl& m, double* v, int n) {
   if (m.part) MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
 }
 
+namespace {
+std::size_t gather_piece_ = std::size_t{1} << 30;
+}  // namespace
+
+void Solver::set_gather_piece(std::size_t n) { gather_piece_ = n > 0 ? n : 1; }
+
 void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& owner,
                     const std::vector<const std::vector<double>*>& fields, int width,
                     std::vector<std::vector<double>>& out) {
@@ -239,25 +245,12 @@ void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& own
     for (const auto* f : fields) mine.insert(mine.end(), f->begin() + w * i, f->begin() + w * (i + 1));
   }
   out.clear();
-  // Every rank's count first; the whole must fit one message's count.
-  const long long n = static_cast<long long>(mine.size());
-  std::vector<long long> counts(static_cast<std::size_t>(P.size), 0);
-  MPI_Gather(&n, 1, MPI_LONG_LONG, counts.data(), 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
-  long long total = 0;
-  for (const auto c : counts) total += c;
-  int fits = total <= INT_MAX ? 1 : 0;
-  MPI_Bcast(&fits, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!fits)
-    throw FemError("FEM: gathering the whole mesh on rank 0 needs " + std::to_string(total) +
-                   " values, more than one MPI message holds (2^31 - 1)");
-  std::vector<int> cnt(counts.size()), displs(counts.size(), 0);
-  for (std::size_t q = 0; q < counts.size(); ++q) {
-    cnt[q] = static_cast<int>(counts[q]);
-    if (q > 0) displs[q] = displs[q - 1] + cnt[q - 1];
-  }
-  std::vector<double> all(P.rank == 0 ? static_cast<std::size_t>(total) : 0);
-  MPI_Gatherv(mine.data(), static_cast<int>(n), MPI_DOUBLE, all.data(), cnt.data(), displs.data(),
-              MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  std::vector<long long> counts;
+  std::vector<double> all;
+  gather_doubles(mine, all, counts, MPI_COMM_WORLD, static_cast<long long>(gather_piece_));
+  std::vector<std::size_t> displs(counts.size(), 0);
+  for (std::size_t q = 1; q < counts.size(); ++q)
+    displs[q] = displs[q - 1] + static_cast<std::size_t>(counts[q - 1]);
   if (P.rank != 0) return;
   out.assign(fields.size(), std::vector<double>(w * items, 0.0));
   std::vector<std::size_t> pos(displs.begin(), displs.end());

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "silentmpm/mpi_bytes.hpp"
 #include "silentmpm/solver.hpp"
 
 namespace smpm {
@@ -398,32 +399,11 @@ std::array<int, 4> Distributed::own_nodes() const {
 }
 std::array<int, 2> Distributed::window_origin() const { return {d_->gx0, d_->gy0}; }
 
+// Rank by rank, in messages of at most gather_piece() values (an MPI count is an int), so the
+// whole may hold more than 2^31 - 1 values.
 void Distributed::gather(const std::vector<double>& mine, std::vector<double>& on_root) {
-  Impl& d = *d_;
-  const long long n = static_cast<long long>(mine.size());
-  std::vector<long long> counts(d.size);
-  MPI_Gather(&n, 1, MPI_LONG_LONG, counts.data(), 1, MPI_LONG_LONG, 0, d.comm);
-  // Rank by rank, in messages of at most gather_piece() values (an MPI count is an int), so
-  // the whole may hold more than 2^31 - 1 values.
-  const long long piece = static_cast<long long>(gather_piece());
-  constexpr int kTag = 7302;
-  if (d.rank != 0) {
-    for (long long at = 0; at < n; at += piece)
-      MPI_Send(mine.data() + at, static_cast<int>(std::min(piece, n - at)), MPI_DOUBLE, 0, kTag,
-               d.comm);
-    return;
-  }
-  long long total = 0;
-  for (long long c : counts) total += c;
-  on_root.resize(static_cast<std::size_t>(total));
-  std::copy(mine.begin(), mine.end(), on_root.begin());
-  long long from = n;
-  for (int r = 1; r < d.size; ++r) {
-    for (long long at = 0; at < counts[r]; at += piece)
-      MPI_Recv(on_root.data() + from + at, static_cast<int>(std::min(piece, counts[r] - at)),
-               MPI_DOUBLE, r, kTag, d.comm, MPI_STATUS_IGNORE);
-    from += counts[r];
-  }
+  std::vector<long long> counts;
+  gather_doubles(mine, on_root, counts, d_->comm, static_cast<long long>(gather_piece()));
 }
 
 std::size_t Distributed::gather_piece_ = std::size_t{1} << 30;

@@ -162,6 +162,21 @@ TEST(FemRanks, SquareWithEveryBoundaryAsOneProcess) {
     }
   worst = max_over_ranks(worst);
   scale = max_over_ranks(scale);
+  // The displacement gathered on rank 0 in messages of 7 values (a gather in pieces, so that a
+  // whole of more than 2^31 - 1 values goes too): the same bits as in one message, and each
+  // node where one process has it.
+  const std::vector<double> whole = split.gathered(split.displacement());
+  fem::Solver::set_gather_piece(7);
+  const std::vector<double> pieces = split.gathered(split.displacement());
+  fem::Solver::set_gather_piece(std::size_t{1} << 30);
+  if (root()) {
+    EXPECT_EQ(pieces, whole);
+    ASSERT_EQ(pieces.size(), one.displacement().size());
+    double off = 0;
+    for (std::size_t k = 0; k < pieces.size(); ++k)
+      off = std::max(off, std::fabs(pieces[k] - one.displacement()[k]));
+    EXPECT_LE(off, 1e-14 * scale) << "gathered in pieces";
+  }
   one.update_energies();
   split.update_energies();
   const Energies& e1 = one.energy;

@@ -255,6 +255,10 @@ class Solver {
   // A per-node array (2 values a node, the whole mesh's size) as each node's owner holds it,
   // on rank 0 (collective: the other ranks get an empty vector); on one process a copy.
   std::vector<double> gathered(const std::vector<double>& per_node) const;
+  // Gathers on rank 0 (gathered(), checkpoints) go rank by rank in messages of at most this
+  // many values (default 2^30; an MPI count is an int), so the whole has no count limit. A
+  // test sets it small.
+  static void set_gather_piece(std::size_t n);
   // The ghost updates so far over all ranks (every rank calls it): the slowest rank's seconds,
   // the bytes all ranks sent, and the largest rank's counts.
   struct Traffic {

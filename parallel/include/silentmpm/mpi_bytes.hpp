@@ -1,14 +1,16 @@
 #pragma once
-// Rank 0's bytes to every rank of comm (collective), in pieces an MPI count (an int) holds: the
-// MSH text of a mesh and a packed geometry, which may exceed 2^31 - 1 bytes. Header-only, so
-// that the far-field module and the MPI module share it without linking each other.
+// Messages larger than an MPI count (an int) holds, in pieces. Header-only, so that the
+// far-field module and the MPI module share them without linking each other.
 #include <mpi.h>
 
 #include <algorithm>
 #include <string>
+#include <vector>
 
 namespace smpm {
 
+// Rank 0's bytes to every rank of comm (collective): the MSH text of a mesh and a packed
+// geometry, which may exceed 2^31 - 1 bytes.
 inline void broadcast_bytes(std::string& bytes, MPI_Comm comm) {
   unsigned long long n = bytes.size();
   MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
@@ -17,6 +19,37 @@ inline void broadcast_bytes(std::string& bytes, MPI_Comm comm) {
     const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
     MPI_Bcast(bytes.data() + at, piece, MPI_CHAR, 0, comm);
     at += static_cast<unsigned long long>(piece);
+  }
+}
+
+// Every rank's values to rank 0 (collective), joined in rank order, rank by rank in messages of
+// at most `piece` values, so that the whole may hold more than 2^31 - 1 of them. On rank 0
+// counts[r] is rank r's count.
+inline void gather_doubles(const std::vector<double>& mine, std::vector<double>& on_root,
+                           std::vector<long long>& counts, MPI_Comm comm, long long piece) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  const long long n = static_cast<long long>(mine.size());
+  counts.assign(static_cast<std::size_t>(size), 0);
+  MPI_Gather(&n, 1, MPI_LONG_LONG, counts.data(), 1, MPI_LONG_LONG, 0, comm);
+  constexpr int kTag = 7302;
+  if (rank != 0) {
+    for (long long at = 0; at < n; at += piece)
+      MPI_Send(mine.data() + at, static_cast<int>(std::min(piece, n - at)), MPI_DOUBLE, 0, kTag,
+               comm);
+    return;
+  }
+  long long total = 0;
+  for (const long long c : counts) total += c;
+  on_root.resize(static_cast<std::size_t>(total));
+  std::copy(mine.begin(), mine.end(), on_root.begin());
+  long long from = n;
+  for (int r = 1; r < size; ++r) {
+    for (long long at = 0; at < counts[r]; at += piece)
+      MPI_Recv(on_root.data() + from + at, static_cast<int>(std::min(piece, counts[r] - at)),
+               MPI_DOUBLE, r, kTag, comm, MPI_STATUS_IGNORE);
+    from += counts[r];
   }
 }
 
