@@ -9,7 +9,8 @@
 // wall clock, since idle OpenMP threads spin and count as CPU). The time per step is the best
 // round's; the ratio to the free square is the median over the rounds of the ratio within each
 // round, which cancels the host's slow drifts (the edge-only boundaries amplify the ratio's
-// noise by N / N_layer, about 70 at 200 cells).
+// noise by N / N_layer, about 70 at 200 cells: measure them on a smaller square, e.g.
+// `--cells 50 --steps 3200 --kind lk`, where it is about 17).
 //
 // Per variant it prints the time per step, the ratio to the free square's, and the cost of one
 // cell of the layer against a free cell:
