@@ -620,14 +620,14 @@ static inline void spring_of(const SilentBoundary& sl, std::size_t q, double ux,
 // A Kelvin-Voigt spring's displacement advances with the grid velocity (vx, vy) at its anchor,
 // through the weights that map its force: the velocity the scheme strains the particles with,
 // so the spring and the body's stresses see one displacement history.
-template <class S>
-static inline void advance_spring(SilentBoundary& sl, std::size_t q, const S& sf,
+template <int K>
+static inline void advance_spring(SilentBoundary& sl, std::size_t q, const double* N,
                                   const long* nodes, const std::vector<double>& vx,
                                   const std::vector<double>& vy, double dt) {
   double dx = 0, dy = 0;
-  for (int a = 0; a < S::kNodes; ++a) {
-    dx += sf.N[a] * vx[nodes[a]];
-    dy += sf.N[a] * vy[nodes[a]];
+  for (int a = 0; a < K; ++a) {
+    dx += N[a] * vx[nodes[a]];
+    dy += N[a] * vy[nodes[a]];
   }
   sl.ux[q] += dt * dx;
   sl.uy[q] += dt * dy;
@@ -774,15 +774,28 @@ void Solver::pml_shapes() {
 template <class S>
 void Solver::apply_loads() {
   S sf;
-  long nodes[S::kNodes];
-  for (const auto& tl : tractions) {
+  constexpr int K = S::kNodes;
+  // Each entry's weights, kept for boundary_work: the work of this step's forces is taken with
+  // the weights they were mapped with (under MUSL the particles have moved by then).
+  auto weights = [&](const BoundaryLayer& L, std::size_t q, Anchor anchor, std::vector<long>& wn,
+                     std::vector<double>& wN) -> long* {
+    if (q == 0) {
+      wn.resize(K * L.idx.size());
+      wN.resize(K * L.idx.size());
+    }
+    long* nodes = wn.data() + K * q;
+    load_weights(L, q, anchor, sf, nodes);
+    std::copy(sf.N, sf.N + K, wN.data() + K * q);
+    return nodes;
+  };
+  for (auto& tl : tractions) {
     const double f = tl.fn(t);
     if (f == 0.0) continue;
     for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
       double tx, ty;
       traction_of(tl, q, f, tx, ty);
-      load_weights(tl.layer, q, tl.anchor, sf, nodes);
-      for (int a = 0; a < S::kNodes; ++a) {
+      const long* nodes = weights(tl.layer, q, tl.anchor, tl.nodes, tl.N);
+      for (int a = 0; a < K; ++a) {
         grid.fx[nodes[a]] += tx * tl.layer.w[q] * sf.N[a];
         grid.fy[nodes[a]] += ty * tl.layer.w[q] * sf.N[a];
       }
@@ -802,11 +815,12 @@ void Solver::apply_loads() {
   for (auto& sl : silents) {
     const auto& L = sl.layer;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
-      load_weights(L, q, sl.anchor, sf, nodes);
+      const long* nodes = weights(L, q, sl.anchor, sl.nodes, sl.N);
       if (sl.springs()) {  // explicit: the displacement at the start of the step
         // USF strains the particles with the start-of-step velocity before the forces: the
         // springs do the same.
-        if (opt.scheme == Scheme::USF) advance_spring(sl, q, sf, nodes, grid.vx, grid.vy, dt);
+        if (opt.scheme == Scheme::USF)
+          advance_spring<K>(sl, q, sf.N, nodes, grid.vx, grid.vy, dt);
         double tx, ty;
         spring_of(sl, q, sl.ux[q], sl.uy[q], tx, ty);
         for (int a = 0; a < S::kNodes; ++a) {
@@ -841,7 +855,6 @@ void Solver::apply_loads() {
   // Damping layers: C_i += alpha_q m_q N_i(x_q) I, at the particle (a volume term).
   for (auto& dl : dampers) {
     const auto& L = dl.layer;
-    constexpr int K = S::kNodes;
     dl.nodes.resize(K * L.idx.size());
     dl.N.resize(K * L.idx.size());
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
@@ -945,7 +958,8 @@ void Solver::grid_update() {
 template <class S>
 void Solver::boundary_work(bool remapped) {
   S sf;
-  long nodes[S::kNodes];
+  constexpr int K = S::kNodes;
+  long nodes[K];
   const std::vector<double>& ux = remapped ? grid.qx : grid.vnx;
   const std::vector<double>& uy = remapped ? grid.qy : grid.vny;
   auto vbar = [&](long i, double& ax, double& ay) {  // the forces' velocity
@@ -962,10 +976,11 @@ void Solver::boundary_work(bool remapped) {
     for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
       double tx, ty, ax, ay;
       traction_of(tl, q, f, tx, ty);
-      load_weights(tl.layer, q, tl.anchor, sf, nodes);
-      for (int a = 0; a < S::kNodes; ++a) {
-        wbar(nodes[a], ax, ay);
-        energy.external_work += dt * tl.layer.w[q] * sf.N[a] * (tx * ax + ty * ay);
+      const long* tn = tl.nodes.data() + K * q;  // the weights apply_loads mapped with
+      const double* N = tl.N.data() + K * q;
+      for (int a = 0; a < K; ++a) {
+        wbar(tn[a], ax, ay);
+        energy.external_work += dt * tl.layer.w[q] * N[a] * (tx * ax + ty * ay);
       }
     }
   }
@@ -999,23 +1014,23 @@ void Solver::boundary_work(bool remapped) {
   for (auto& sl : silents) {
     const auto& L = sl.layer;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
-      load_weights(L, q, sl.anchor, sf, nodes);
-      if (sl.springs() && opt.scheme != Scheme::USF) advance_spring(sl, q, sf, nodes, ux, uy, dt);
-      for (int a = 0; a < S::kNodes; ++a) {
+      const long* sn = sl.nodes.data() + K * q;  // the weights apply_loads mapped with
+      const double* N = sl.N.data() + K * q;
+      if (sl.springs() && opt.scheme != Scheme::USF) advance_spring<K>(sl, q, N, sn, ux, uy, dt);
+      for (int a = 0; a < K; ++a) {
         double ax, ay, tx, ty, bx, by;
-        vbar(nodes[a], ax, ay);
-        wbar(nodes[a], bx, by);
+        vbar(sn[a], ax, ay);
+        wbar(sn[a], bx, by);
         // The dashpot acts on the particle velocity (paper form) or on each node's mid-step one.
         if (sl.form == SilentForm::Particle) dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
         else dashpot_of(sl, q, ax, ay, tx, ty);
-        energy.absorbed -= dt * L.w[q] * sf.N[a] * (tx * bx + ty * by);
+        energy.absorbed -= dt * L.w[q] * N[a] * (tx * bx + ty * by);
       }
     }
   }
   // Perfectly matched layers: the damping force's power, and that of the explicit loads; then
   // the particles' displacements advance (USF: in pml_loads).
   if (pml.active()) {
-    constexpr int K = S::kNodes;
     for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
       const long* pn = pml.nodes.data() + K * q;
       const double* N = pml.N.data() + K * q;
@@ -1038,7 +1053,6 @@ void Solver::boundary_work(bool remapped) {
   // weights the blocks were assembled with.
   for (auto& dl : dampers) {
     const auto& L = dl.layer;
-    constexpr int K = S::kNodes;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       if (dl.alpha[q] == 0) continue;
       const long* dn = dl.nodes.data() + K * q;

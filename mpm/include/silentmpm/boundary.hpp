@@ -49,6 +49,10 @@ struct TractionLoad {
   // Traction = f(t) * (normal * n + tangential * s + (vx, vy)); s = (-n_y, n_x).
   double normal = 0, tangential = 0, vx = 0, vy = 0;
   TimeFunction fn;
+  // This step's load weights, K nodes and shape values per entry (K: the shape's nodes), set
+  // where the forces are assembled and used again for their work.
+  std::vector<long> nodes;
+  std::vector<double> N;
 };
 
 enum class SilentForm {
@@ -70,6 +74,8 @@ struct SilentBoundary {
   double delta = 0, alpha_n = 1, alpha_t = 1;
   std::vector<double> kn, kt;        // alpha_n rho c_d^2 / delta and alpha_t rho c_s^2 / delta
   std::vector<double> ux, uy;        // displacement of each particle's anchor since the start
+  std::vector<long> nodes;           // this step's load weights, as TractionLoad's
+  std::vector<double> N;
   // MUSL, nodal form, one velocity field: strain the particles with the updated grid velocity
   // v+ (the one the dashpots acted on) at this layer's dashpot nodes, where they are heavy
   // enough, instead of the re-mapped one (docs/physics.md section 4; the case key
