@@ -289,6 +289,29 @@ TEST(CaseLoad, ParticlesOnGridLinesGetANote) {
   EXPECT_EQ(build(0.0005, 1, "bspline"), "");
 }
 
+// MUSL's updated edge velocity above the CFL it was measured stable at gets a note.
+TEST(CaseLoad, UpdatedEdgeVelocityAboveCfl085GetsANote) {
+  auto notes = [](double cfl) {
+    nlohmann::json j = {
+        {"grid", {{"size", {0.008, 0.004}}, {"cell", 0.001}}},
+        {"time", {{"end", 1e-6}, {"cfl", cfl}}},
+        {"materials", {{"m", {{"model", "elastic"}, {"young", 1e9}, {"poisson", 0.25},
+                              {"density", 1000}}}}},
+        {"bodies", {{{"name", "b"}, {"material", "m"}, {"box", {0, 0, 0.004, 0.002}}}}},
+        {"boundaries", {{{"type", "silent"}, {"body", "b"}, {"side", "bottom"},
+                         {"edge_velocity", "updated"}}}}};
+    std::string out;
+    for (const auto& n : smpm::build_case(j, "inline").notes)
+      if (n.find("edge_velocity") != std::string::npos) out += n;
+    return out;
+  };
+  EXPECT_NE(notes(0.9).find("note: edge_velocity \"updated\" at CFL 0.9: measured stable up to "
+                            "CFL 0.85 only"),
+            std::string::npos) << notes(0.9);
+  EXPECT_EQ(notes(0.85), "");
+  EXPECT_EQ(notes(0.5), "");
+}
+
 // The complete example of docs/case-reference.md is a valid case (the reference stays honest).
 TEST(CaseLoad, ReferenceExampleBuilds) {
   const std::string doc = read_file(fs::path(SMPM_SOURCE_DIR) / "docs" / "case-reference.md");
