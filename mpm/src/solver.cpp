@@ -183,11 +183,11 @@ void Solver::finalize() {
       s.kt[k] = s.alpha_t * m.rho * m.cs * m.cs / s.delta;
     }
   }
-  updated_weight_.clear();
+  bool updated = false;  // a layer strained with the updated velocity (MUSL, one field)
   for (const auto& s : silents)
-    if (opt.scheme == Scheme::MUSL && body_of_group_.empty() && s.form == SilentForm::Nodal &&
-        s.updated_velocity)
-      updated_weight_.assign(grid.nodes(), 0.0);
+    updated = updated || (s.form == SilentForm::Nodal && s.updated_velocity);
+  updated = updated && opt.scheme == Scheme::MUSL && body_of_group_.empty();
+  updated_weight_.assign(updated ? grid.nodes() : 0, 0.0);
   // Damping of each layer particle from its depth and its material's c_d.
   for (auto& dl : dampers) {
     const BoundaryLayer& L = dl.layer;
@@ -775,14 +775,11 @@ template <class S>
 void Solver::apply_loads() {
   S sf;
   constexpr int K = S::kNodes;
-  // Each entry's weights, kept for boundary_work: the work of this step's forces is taken with
-  // the weights they were mapped with (under MUSL the particles have moved by then).
+  // Each entry's weights (nodes into wn, shape values into wN, sized by the caller), kept so
+  // that boundary_work takes the work of this step's forces with the weights they were mapped
+  // with instead of mapping them again.
   auto weights = [&](const BoundaryLayer& L, std::size_t q, Anchor anchor, std::vector<long>& wn,
                      std::vector<double>& wN) -> long* {
-    if (q == 0) {
-      wn.resize(K * L.idx.size());
-      wN.resize(K * L.idx.size());
-    }
     long* nodes = wn.data() + K * q;
     load_weights(L, q, anchor, sf, nodes);
     std::copy(sf.N, sf.N + K, wN.data() + K * q);
@@ -791,6 +788,8 @@ void Solver::apply_loads() {
   for (auto& tl : tractions) {
     const double f = tl.fn(t);
     if (f == 0.0) continue;
+    tl.nodes.resize(K * tl.layer.idx.size());
+    tl.N.resize(K * tl.layer.idx.size());
     for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
       double tx, ty;
       traction_of(tl, q, f, tx, ty);
@@ -814,6 +813,8 @@ void Solver::apply_loads() {
   has_nodal_dashpot_ = false;
   for (auto& sl : silents) {
     const auto& L = sl.layer;
+    sl.nodes.resize(K * L.idx.size());
+    sl.N.resize(K * L.idx.size());
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       const long* nodes = weights(L, q, sl.anchor, sl.nodes, sl.N);
       if (sl.springs()) {  // explicit: the displacement at the start of the step
@@ -859,12 +860,10 @@ void Solver::apply_loads() {
     dl.N.resize(K * L.idx.size());
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       if (dl.alpha[q] == 0) continue;
-      long* dn = dl.nodes.data() + K * q;
-      load_weights(L, q, Anchor::Particle, sf, dn);
+      const long* dn = weights(L, q, Anchor::Particle, dl.nodes, dl.N);
       has_nodal_dashpot_ = true;
       const double c = dl.alpha[q] * p.mass[L.idx[q]];
       for (int a = 0; a < K; ++a) {
-        dl.N[K * q + a] = sf.N[a];
         grid.cxx[dn[a]] += c * sf.N[a];
         grid.cyy[dn[a]] += c * sf.N[a];
         add_dashpot_node(dn[a]);
