@@ -69,11 +69,10 @@ struct Solver::Impl {
     std::vector<double> m_sum, m_prod;       // m_i (d_x + d_y), m_i d_x d_y
     std::vector<double> zeta;                // 4 per node: the memories I1, I2 of u_x, then of u_y
     std::vector<std::uint32_t> touched;      // every node of a layer cell
-    // Recursive-convolution coefficients (e, ca, cb) for dt_coef: per kind of point for
-    // alpha + d_x and alpha + d_y (cx, cy), and for alpha; and per kind of point, packed for the
-    // step, kl, km, cx, cy.
+    // For the step dt_coef: per kind of point kl, km and the recursive-convolution coefficients
+    // (e, ca, cb) for alpha + d_x and for alpha + d_y, 8 values packed; those for alpha alone.
     double dt_coef = 0;
-    std::vector<double> cx, cy, packed;
+    std::vector<double> packed;
     double e_a = 1, ca_a = 0, cb_a = 0;
     bool active() const { return !touched.empty(); }
   };

@@ -244,15 +244,16 @@ void pml_cells(Solver::Impl& m) {
 void pml_forces(Solver::Impl& m, double dt) {
   Solver::Impl::Pml& P = m.pml;
   if (P.dt_coef != dt) {
-    convolution_tables(P.alpha, P.dx, P.dy, dt, P.cx, P.cy, P.e_a, P.ca_a, P.cb_a);
+    std::vector<double> cx, cy;  // (e, ca, cb) per kind of point for alpha + d_x, alpha + d_y
+    convolution_tables(P.alpha, P.dx, P.dy, dt, cx, cy, P.e_a, P.ca_a, P.cb_a);
     P.packed.resize(8 * P.kl.size());
     for (std::size_t j = 0; j < P.kl.size(); ++j) {
       double* t = P.packed.data() + 8 * j;
       t[0] = P.kl[j];
       t[1] = P.km[j];
       for (int i = 0; i < 3; ++i) {
-        t[2 + i] = P.cx[3 * j + i];
-        t[5 + i] = P.cy[3 * j + i];
+        t[2 + i] = cx[3 * j + i];
+        t[5 + i] = cy[3 * j + i];
       }
     }
     P.dt_coef = dt;
