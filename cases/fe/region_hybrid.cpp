@@ -147,11 +147,7 @@ class HybridRegion final : public Region {
     j["energy_regions_note"] = "energy_mpm and energy_fem hold each region's own terms; their "
                                "imbalances are the energy that crossed the MPM-FEM interface and "
                                "sum to the total imbalance in energy";
-    j["silent_boundaries"] = silents_json(s_);
-    j["loads"] = c_.notes;
-    j["bodies"] = bodies_json(c_, s_);
-    ranks_.total_counts(j);
-    j["curve_probes"] = curve_probes_json(c_.probes);
+    put_mpm_blocks(j, c_, s_, ranks_);
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
                     {"snapshots", snapshots ? snaps_.count() : 0},

@@ -289,6 +289,14 @@ void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {
   j["grid"] = {{"origin", {s.grid.x0, s.grid.y0}}, {"cells", {s.grid.nx, s.grid.ny}}, {"cell", s.grid.h}};
 }
 
+void put_mpm_blocks(nlohmann::ordered_json& j, const Case& c, const Solver& s, const MpmRanks& ranks) {
+  j["silent_boundaries"] = silents_json(s);
+  j["loads"] = c.notes;
+  j["bodies"] = bodies_json(c, s);
+  ranks.total_counts(j);
+  j["curve_probes"] = curve_probes_json(c.probes);
+}
+
 void write_probe_table(const fs::path& dir, const std::vector<ProbeSpec>& probes) {
   std::ofstream f(dir / "probes.csv");
   if (!f) throw std::runtime_error((dir / "probes.csv").string() + ": cannot write");

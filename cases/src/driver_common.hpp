@@ -187,6 +187,10 @@ void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s);  // "scheme", "
 void write_probe_table(const std::filesystem::path& dir, const std::vector<ProbeSpec>& probes);
 nlohmann::ordered_json curve_probes_json(const std::vector<ProbeSpec>& probes);  // "curve_probes"
 nlohmann::ordered_json bodies_json(const Case& c, const Solver& s);              // "bodies"
+// The MPM region's blocks of summary.json that follow its energies (the MPM and the hybrid
+// regions): "silent_boundaries", "loads", "bodies" (counts summed over the ranks) and
+// "curve_probes". Every rank calls it.
+void put_mpm_blocks(nlohmann::ordered_json& j, const Case& c, const Solver& s, const MpmRanks& ranks);
 // Writes DIR/summary.json through a temporary file, so that it appears complete or not at all.
 void write_summary(const std::filesystem::path& dir, const nlohmann::ordered_json& j);
 

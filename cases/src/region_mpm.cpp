@@ -208,11 +208,7 @@ class MpmRegion final : public Region {
     put_mpm_scheme(j, s_);
     j["grid"] = ranks_.grid_json();
     j["energy"] = energy_json(s_.total_energy());
-    j["silent_boundaries"] = silents_json(s_);
-    j["loads"] = c_.notes;
-    j["bodies"] = bodies_json(c_, s_);
-    ranks_.total_counts(j);
-    j["curve_probes"] = curve_probes_json(c_.probes);
+    put_mpm_blocks(j, c_, s_, ranks_);
     j["outputs"] = {{"history", "history.csv"},
                     {"probes", "probes.csv"},
                     {"snapshots", snapshots ? snaps_.count() : 0},
