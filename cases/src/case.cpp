@@ -1346,13 +1346,14 @@ class Builder {
     sb.anchor = o.choice("anchor", {"boundary", "particle"}, anchor_default.c_str()) == "boundary"
                     ? Anchor::Boundary
                     : Anchor::Particle;
-    // Which velocity MUSL strains the particles with at the dashpots' nodes (docs/physics.md
-    // section 4): the re-mapped one (default) or the updated one, for edges off the grid lines.
+    // Which velocity MUSL and USF strain the particles with at the dashpots' nodes
+    // (docs/physics.md section 4): the particles' own (MUSL's re-mapped one, USF's start-of-step
+    // one; default) or the updated one the dashpots produced (USF: the last step's).
     if (o.choice("edge_velocity", {"remapped", "updated"}, "remapped") == "updated") {
-      if (s_->opt.scheme != Scheme::MUSL)
-        o.fail("edge_velocity", "\"updated\" applies under scheme.update \"MUSL\" only (USL "
-                                "strains the particles with the updated velocity everywhere, USF "
-                                "with the start-of-step one)");
+      if (s_->opt.scheme == Scheme::USL)
+        o.fail("edge_velocity", "\"updated\" applies under scheme.update \"MUSL\" or \"USF\" "
+                                "(USL strains the particles with the updated velocity "
+                                "everywhere)");
       if (sb.form != SilentForm::Nodal)
         o.fail("edge_velocity", "\"updated\" needs the nodal form (the particle form puts no "
                                 "dashpot on the nodes)");

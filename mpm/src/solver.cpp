@@ -186,8 +186,10 @@ void Solver::finalize() {
   bool updated = false;  // a layer strained with the updated velocity (MUSL, one field)
   for (const auto& s : silents)
     updated = updated || (s.form == SilentForm::Nodal && s.updated_velocity);
-  updated = updated && opt.scheme == Scheme::MUSL && body_of_group_.empty();
+  updated = updated && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
+            body_of_group_.empty();
   updated_weight_.assign(updated ? grid.nodes() : 0, 0.0);
+  edge_velocity_.clear();
   // Damping of each layer particle from its depth and its material's c_d.
   for (auto& dl : dampers) {
     const BoundaryLayer& L = dl.layer;
@@ -528,6 +530,37 @@ void Solver::start_velocities() {
   for (const VelocityField& F : fields_)
     kernels::nodal_velocity(grid, F.box, F.f.m, grid.fix.data(), F.f.px, F.f.py, F.f.vx, F.f.vy,
                             mass_floor_, nthreads_);
+  // Layers strained with the updated velocity: the last step's v+ at their dashpot nodes, under
+  // the mass condition of remapped_velocities() (docs/physics.md section 4).
+  const std::array<int, 2> o = window_origin();
+  for (std::size_t e = 0; e < edge_velocity_.size(); e += 5) {
+    const long i = static_cast<long>(edge_velocity_[e]) - o[0];
+    const long j = static_cast<long>(edge_velocity_[e + 1]) - o[1];
+    if (i < 0 || j < 0 || i >= grid.nnx || j >= grid.nny) continue;
+    const long n = j * grid.nnx + i;
+    if (grid.m[n] > mass_floor_ && 0.5 * dt * edge_velocity_[e + 2] <= grid.m[n]) {
+      grid.vx[n] = edge_velocity_[e + 3];
+      grid.vy[n] = edge_velocity_[e + 4];
+    }
+  }
+}
+
+// USF with layers strained with the updated velocity: this step's v+ at their dashpot nodes
+// (those with a weight), for the next step's start_velocities().
+void Solver::keep_edge_velocities() {
+  edge_velocity_.clear();
+  const std::array<int, 2> o = window_origin();
+  for (const long n : dashpot_nodes_) {
+    if (!(updated_weight_[n] > 0)) continue;
+    const double i = static_cast<double>(n % grid.nnx + o[0]);
+    const double j = static_cast<double>(n / grid.nnx + o[1]);
+    edge_velocity_.insert(edge_velocity_.end(),
+                          {i, j, updated_weight_[n], grid.vnx[n], grid.vny[n]});
+  }
+}
+
+std::array<int, 2> Solver::window_origin() const {
+  return dist_ ? dist_->window_origin() : std::array<int, 2>{0, 0};
 }
 
 // MUSL: every field's re-mapped momentum q becomes the velocity q / m, with the constraints.
@@ -1331,6 +1364,7 @@ void Solver::step_with() {
       break;
     case Scheme::USF:
       g2p<S>(false, true);
+      if (!updated_weight_.empty()) keep_edge_velocities();
       break;
   }
   t += dt;

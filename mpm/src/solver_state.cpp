@@ -62,6 +62,25 @@ void put_head(StateWriter& w, const std::string& pre, double dt, double t, long 
   particle_arrays(p, [&](const char* n, const auto& v) { w.put(pre + "p." + n, v); });
 }
 
+// USF with layers strained with the updated velocity (Solver::edge_velocity_): the entries
+// of the nodes in `own` (window numbering, origin o; i1 < i0: every node), ordered by the whole
+// grid's (j, i), so that a checkpoint does not depend on the ranks or the order nodes were met.
+std::vector<double> own_edge_velocities(const std::vector<double>& all, const NodeBox& own,
+                                        std::array<int, 2> o) {
+  std::vector<std::array<double, 5>> e;
+  for (std::size_t k = 0; k < all.size(); k += 5) {
+    const long i = static_cast<long>(all[k]) - o[0], j = static_cast<long>(all[k + 1]) - o[1];
+    if (own[1] >= own[0] && (i < own[0] || i > own[1] || j < own[2] || j > own[3])) continue;
+    e.push_back({all[k], all[k + 1], all[k + 2], all[k + 3], all[k + 4]});
+  }
+  std::sort(e.begin(), e.end(), [](const auto& a, const auto& b) {
+    return a[1] != b[1] ? a[1] < b[1] : a[0] < b[0];
+  });
+  std::vector<double> out;
+  for (const auto& v : e) out.insert(out.end(), v.begin(), v.end());
+  return out;
+}
+
 }  // namespace
 
 void Solver::save_state(StateWriter& w, const std::string& pre) const {
@@ -88,6 +107,9 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   std::vector<std::int32_t> boxes;
   for (const auto& F : fields_) boxes.insert(boxes.end(), F.box.begin(), F.box.end());
   w.put(pre + "field_boxes", boxes);
+  if (!updated_weight_.empty() && opt.scheme == Scheme::USF)
+    w.put(pre + "edge_velocity", own_edge_velocities(edge_velocity_, NodeBox{0, -1, 0, -1},
+                                                     window_origin()));
 }
 
 void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
@@ -125,6 +147,14 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
   const Energies e = total_energy();
   if (!dist_) all = mine;
   else dist_->gather(mine, all);
+  // USF's kept edge velocities: each node's from its owner.
+  const bool edge = !updated_weight_.empty() && opt.scheme == Scheme::USF;
+  std::vector<double> edge_all;
+  if (edge) {
+    const std::vector<double> own = own_edge_velocities(edge_velocity_, own_, window_origin());
+    if (!dist_) edge_all = own;
+    else dist_->gather(own, edge_all);
+  }
   if (dist_ && dist_->rank() != 0) return;
   Particles q;
   if (p.has_film()) q.enable_film();
@@ -179,6 +209,7 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
   w.put(pre + "strips", static_cast<std::int32_t>(0));  // no strips: the reader re-sorts
   w.put(pre + "ranges", std::vector<std::uint32_t>{});
   w.put(pre + "field_boxes", std::vector<std::int32_t>{});
+  if (edge) w.put(pre + "edge_velocity", own_edge_velocities(edge_all, NodeBox{0, -1, 0, -1}, {0, 0}));
 }
 
 bool Solver::load_state(const StateReader& r, const std::string& pre) {
@@ -220,6 +251,19 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
   steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
   energy = r.get<Energies>(pre + "energy");
   contact.dissipated = r.get<double>(pre + "contact_dissipated");
+  edge_velocity_.clear();
+  if (!updated_weight_.empty() && opt.scheme == Scheme::USF) {
+    r.get(pre + "edge_velocity", edge_velocity_);
+    if (edge_velocity_.size() % 5 != 0)
+      r.fail("edge_velocity holds " + std::to_string(edge_velocity_.size()) +
+             " values, not a multiple of 5 (corrupt checkpoint)");
+    for (std::size_t k = 0; k < edge_velocity_.size(); k += 5) {
+      const double i = edge_velocity_[k], j = edge_velocity_[k + 1];
+      if (!(i >= 0 && i < grid.nnx && j >= 0 && j < grid.nny && i == std::floor(i) &&
+            j == std::floor(j)))
+        r.fail("edge_velocity names a node outside the grid (corrupt checkpoint)");
+    }
+  }
   // What the step indexes with must be valid whatever the file says (a checksum guards against
   // accidents, not edits): ids a permutation, groups and bodies in range, particles finite and
   // on the grid.

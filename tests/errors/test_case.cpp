@@ -299,7 +299,7 @@ std::vector<Bad> bad_cases() {
        "boundaries[2].edge_velocity: must be one of \"remapped\", \"updated\", got \"update\""},
       {"edge_velocity_under_usl",
        [](ojson& j) { j["scheme"]["update"] = "USL"; bnd(j, 2)["edge_velocity"] = "updated"; },
-       "boundaries[2].edge_velocity: \"updated\" applies under scheme.update \"MUSL\" only"},
+       "boundaries[2].edge_velocity: \"updated\" applies under scheme.update \"MUSL\" or \"USF\""},
       {"edge_velocity_particle_form",
        [](ojson& j) { bnd(j, 2)["form"] = "particle"; bnd(j, 2)["edge_velocity"] = "updated"; },
        "boundaries[2].edge_velocity: \"updated\" needs the nodal form"},

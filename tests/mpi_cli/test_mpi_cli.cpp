@@ -495,6 +495,15 @@ TEST(MpiCli, CheckpointOnTwoRanksRestartsOnAnyCount) {
   expect_checkpoint_restarts(kCase + kShort, "ck", 300, {0, 2, 4}, 1e-10);
 }
 
+// USF with the updated velocity at the silent edge: the last step's v+ at the edge's dashpot
+// nodes is state, gathered from each node's owner; restarts on 1 process and on 4 ranks.
+TEST(MpiCli, UsfUpdatedEdgeCheckpointOnTwoRanksRestartsOnAnyCount) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  expect_checkpoint_restarts(
+      kCase + kShort + " --set scheme.update=USF --set boundaries.1.edge_velocity=updated",
+      "ckusf", 300, {0, 4}, 1e-10);
+}
+
 // The plate thrown upwards: its top rows leave the grid on the top rank only (20 steps); that
 // rank's error ends both.
 TEST(MpiCli, FailureOnOneRankStopsAllWithItsReason) {

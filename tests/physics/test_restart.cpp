@@ -74,6 +74,17 @@ TEST(Restart, MpmSpringsAndDampingBandBitIdentical) {
   EXPECT_EQ(from, 200);
 }
 
+// USF with the updated velocity at the silent edge's dashpot nodes: the last step's v+ there is
+// state (the next step strains the particles with it). The pulse is at the edge at step 300.
+TEST(Restart, MpmUsfUpdatedEdgeBitIdentical) {
+  using namespace hybrid_case_testing;
+  json c = small_plate(4, 340);
+  c["scheme"]["update"] = "USF";
+  c["boundaries"][1]["edge_velocity"] = "updated";
+  const long from = expect_restart_identical("mpm_usf_updated", c, "checkpoint_every", 100);
+  EXPECT_EQ(from, 300);
+}
+
 // A perfectly matched layer on particles (USL): its displacements and memories are state.
 TEST(Restart, MpmPmlBitIdentical) {
   using namespace hybrid_case_testing;

@@ -224,11 +224,17 @@ class Solver {
     dashpot_mark_[i] = 1;
     dashpot_nodes_.push_back(i);
   }
-  // MUSL, one velocity field: per grid node, the full LK impedance (rho c_d times the edge
-  // length) the dashpots of layers strained with the updated velocity put on it this step
+  // MUSL or USF, one velocity field: per grid node, the full LK impedance (rho c_d times the
+  // edge length) the dashpots of layers strained with the updated velocity put on it this step
   // (SilentBoundary::updated_velocity; summed over the halo with the blocks); empty when no
   // layer is.
   std::vector<double> updated_weight_;
+  // USF with such layers: the last step's updated velocity at their dashpot nodes, which the
+  // next step strains the particles with (start_velocities). Per node: the whole grid's node
+  // (i, j), its weight (updated_weight_) and v+ (x, y); part of a checkpoint.
+  std::vector<double> edge_velocity_;
+  void keep_edge_velocities();
+  std::array<int, 2> window_origin() const;  // the whole grid's node of the window's (0, 0)
   double mass_floor_ = 0;
   double viscous_beta_ = -1;  // the largest beta at a particle (finalize()); -1: not yet
   double viscous_beta() const;
