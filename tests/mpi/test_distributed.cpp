@@ -243,15 +243,20 @@ void expect_agreement(const Outcome& d, const Outcome& s, const std::string& wha
                 what.c_str(), ranks(), *std::max_element(diff.begin(), diff.end()), de);
 }
 
+// `steps` steps of the plate `c` on one process and on every layout of the ranks: fields and
+// energies agree (expect_agreement); returns the one process's outcome.
+Outcome expect_layouts_agree(const PlateSpec& c, int steps, const std::string& what) {
+  const Outcome s = run_serial(c, steps);
+  for (int a : layouts()) expect_agreement(run_distributed(c, steps, a), s, what + ", " + layout_name(a));
+  return s;
+}
+
 // The pulse crosses the slab borders and reaches the silent layers; every scheme.
 TEST(Ranks, PulsePlateAgreesWithOneProcessEveryScheme) {
   for (Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF}) {
     PlateSpec c;
     c.scheme = sc;
-    const Outcome s = run_serial(c, 200);
-    for (int a : layouts())
-      expect_agreement(run_distributed(c, 200, a), s,
-                       std::string(scheme_name(sc)) + ", " + layout_name(a));
+    const Outcome s = expect_layouts_agree(c, 200, scheme_name(sc));
     EXPECT_GT(s.e.absorbed, 0.01 * s.e.external_work) << "the pulse reached the silent layers";
   }
   // MUSL and USF with the updated velocity at the layers' dashpot nodes: which nodes take it
@@ -260,10 +265,7 @@ TEST(Ranks, PulsePlateAgreesWithOneProcessEveryScheme) {
     PlateSpec c;
     c.scheme = sc;
     c.updated = true;
-    const Outcome s = run_serial(c, 200);
-    for (int a : layouts())
-      expect_agreement(run_distributed(c, 200, a), s,
-                       std::string(scheme_name(sc)) + ", updated edges, " + layout_name(a));
+    expect_layouts_agree(c, 200, std::string(scheme_name(sc)) + ", updated edges");
   }
 }
 
@@ -271,11 +273,7 @@ TEST(Ranks, WiderStencilsAgreeWithOneProcess) {
   for (ShapeKind sh : {ShapeKind::UGimp, ShapeKind::BSpline2}) {
     PlateSpec c;
     c.shape = sh;
-    const Outcome s = run_serial(c, 150);
-    for (int a : layouts())
-      expect_agreement(run_distributed(c, 150, a), s,
-                       std::string(sh == ShapeKind::UGimp ? "GIMP" : "B-spline") + ", " +
-                           layout_name(a));
+    expect_layouts_agree(c, 150, sh == ShapeKind::UGimp ? "GIMP" : "B-spline");
   }
 }
 
@@ -286,11 +284,7 @@ TEST(Ranks, BandPmlAndGravityAgreeWithOneProcess) {
     PlateSpec c;
     c.other_layers = true;
     c.scheme = sc;
-    const Outcome s = run_serial(c, 200);
-    for (int a : layouts())
-      expect_agreement(run_distributed(c, 200, a), s,
-                       std::string("band, PML, gravity, ") + scheme_name(sc) + ", " +
-                           layout_name(a));
+    expect_layouts_agree(c, 200, std::string("band, PML, gravity, ") + scheme_name(sc));
   }
 }
 
