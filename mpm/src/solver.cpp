@@ -465,7 +465,7 @@ void Solver::reset_grid() {
   for (long i = 0; i < n; ++i) {
     m[i] = 0; px[i] = 0; py[i] = 0; fx[i] = 0; fy[i] = 0;
   }
-  if (opt.scheme == Scheme::MUSL) {
+  if (opt.scheme != Scheme::USL) {  // MUSL's re-map (USF: for the loads' power)
     std::fill(grid.qx.begin(), grid.qx.end(), 0.0);
     std::fill(grid.qy.begin(), grid.qy.end(), 0.0);
   }
@@ -559,23 +559,41 @@ void Solver::keep_edge_velocities() {
   }
 }
 
+// USF takes the loads' power with the velocity the particles carry back, their momenta
+// re-mapped as MUSL's (one more scatter in its g2p), when the step books any: tractions,
+// dashpots, damping bands, gravity. Not with a damping band's stiffness part, whose viscous
+// stress (boundary_work) takes v+ at the particles' positions before they move.
+bool Solver::usf_remapped_power() const {
+  for (const auto& dl : dampers)
+    if (dl.beta0 > 0) return false;
+  return !tractions.empty() || !silents.empty() || !dampers.empty() || opt.gravity_x != 0 ||
+         opt.gravity_y != 0;
+}
+
 std::array<int, 2> Solver::window_origin() const {
   return dist_ ? dist_->window_origin() : std::array<int, 2>{0, 0};
 }
 
-// MUSL: every field's re-mapped momentum q becomes the velocity q / m, with the constraints.
-// At the dashpot nodes of layers strained with the updated velocity (their weight > 0), v+
-// instead: the velocity the dashpots acted on (docs/physics.md section 4) -- where the node
+// MUSL, and USF for the loads' power: every field's re-mapped momentum q (summed over the
+// halo, with the hooks' share) becomes the velocity q / m, with the constraints. MUSL
+// (updated_edges): at the dashpot nodes of layers strained with the updated velocity (their
+// weight > 0), v+ instead: the velocity the dashpots acted on (docs/physics.md section 4) -- where the node
 // holds at least dt/2 times the full LK impedance rho c_d of its share of the edge, the mass
 // of a matched edge node times the CFL number. A lighter node (of a nearly empty cell) keeps
 // the re-mapped value: there v+ = v + dt f / m amplifies the internal force, and a strong
 // dashpot makes the trapezoidal update ring. The boundary work, the springs and the stress
 // update then all take the velocity chosen here.
-void Solver::remapped_velocities() {
+void Solver::remapped_velocities(bool updated_edges) {
+  if (dist_) {  // every field's re-mapped momenta
+    std::vector<double*> q;
+    for (const VelocityField& F : fields_) q.insert(q.end(), {F.f.qx, F.f.qy});
+    dist_->sum_halo(q.data(), static_cast<int>(q.size()));
+  }
+  call([&](StepHooks& h) { h.after_remap(*this); });
   for (const VelocityField& F : fields_)
     kernels::nodal_velocity(grid, F.box, F.f.m, grid.fix.data(), F.f.qx, F.f.qy, F.f.qx, F.f.qy,
                             mass_floor_, nthreads_);
-  if (updated_weight_.empty()) return;
+  if (!updated_edges || updated_weight_.empty()) return;
   for (const long i : dashpot_nodes_) {
     if (updated_weight_[i] > 0 && grid.m[i] > mass_floor_ &&
         0.5 * dt * updated_weight_[i] <= grid.m[i]) {
@@ -1154,7 +1172,8 @@ void Solver::g2p(bool remap, bool move) {
     auto body = [&](uint32_t b, uint32_t e, int g, int s) {
       RowSpan r;
       const double ir = inv_rho(g);
-      if (remap) kernels::g2p<S, true, false>(grid, p, b, e, f, ir, flip, DT, r);
+      if (remap && move) kernels::g2p<S, true, true>(grid, p, b, e, f, ir, flip, DT, r);
+      else if (remap) kernels::g2p<S, true, false>(grid, p, b, e, f, ir, flip, DT, r);
       else if (move) kernels::g2p<S, false, true>(grid, p, b, e, f, ir, flip, DT, r);
       else kernels::g2p<S, false, false>(grid, p, b, e, f, ir, flip, DT, r);
       if (move) merge_rows(s, r);
@@ -1340,7 +1359,7 @@ void Solver::step_with() {
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
-  bool remapped_power = sc == Scheme::MUSL;
+  bool remapped_power = sc == Scheme::MUSL || (sc == Scheme::USF && usf_remapped_power());
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
   if (!remapped_power) boundary_work<S>(false);
   call([&](StepHooks& h) { h.before_g2p(*this); });
@@ -1348,13 +1367,7 @@ void Solver::step_with() {
   switch (sc) {
     case Scheme::MUSL:
       g2p<S>(true, false);
-      if (dist_) {  // every field's re-mapped momenta
-        std::vector<double*> q;
-        for (const VelocityField& F : fields_) q.insert(q.end(), {F.f.qx, F.f.qy});
-        dist_->sum_halo(q.data(), static_cast<int>(q.size()));
-      }
-      call([&](StepHooks& h) { h.after_remap(*this); });
-      remapped_velocities();
+      remapped_velocities(true);
       if (remapped_power) boundary_work<S>(true);
       update_stress<S>(true, false, true);
       break;
@@ -1363,7 +1376,13 @@ void Solver::step_with() {
       update_stress<S>(false, false, true);
       break;
     case Scheme::USF:
-      g2p<S>(false, true);
+      // The particles move here; the loads' power is taken with the velocity they carry back,
+      // their momenta re-mapped as MUSL's (unless a hook keeps v+).
+      g2p<S>(remapped_power, true);
+      if (remapped_power) {
+        remapped_velocities(false);
+        boundary_work<S>(true);
+      }
       if (!updated_weight_.empty()) keep_edge_velocities();
       break;
   }

@@ -235,6 +235,7 @@ class Solver {
   std::vector<double> edge_velocity_;
   void keep_edge_velocities();
   std::array<int, 2> window_origin() const;  // the whole grid's node of the window's (0, 0)
+  bool usf_remapped_power() const;
   double mass_floor_ = 0;
   double viscous_beta_ = -1;  // the largest beta at a particle (finalize()); -1: not yet
   double viscous_beta() const;
@@ -279,7 +280,9 @@ class Solver {
   void grid_update();
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
-  void remapped_velocities();
+  // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
+  // velocities q / m; updated_edges: v+ at the updated layers' dashpot nodes (MUSL).
+  void remapped_velocities(bool updated_edges);
   template <class S> void update_stress(bool remapped_field, bool start_field, bool move);
   void begin_moving_pass();
   void merge_rows(int strip, const RowSpan& r);
