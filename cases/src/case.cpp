@@ -723,13 +723,16 @@ class Builder {
                     ") is outside the grid " + grid_.describe());
     }
     set_time_step();
-    // The updated edge velocity was measured stable up to CFL 0.85 (docs/physics.md section 4).
+    // The updated edge velocity was measured stable up to CFL 0.85 under MUSL, 0.9 under USF
+    // (docs/physics.md section 4).
     const double cfl = s_->dt / s_->critical_dt();
+    const double stable = s_->opt.scheme == Scheme::USF ? 0.9 : 0.85;
     for (const auto& sb : s_->silents)
-      if (sb.updated_velocity && cfl > 0.85 + 1e-12) {
+      if (sb.updated_velocity && cfl > stable + 1e-12) {
         c.notes.push_back("note: edge_velocity \"updated\" at CFL " + fmt(cfl) +
-                          ": measured stable up to CFL 0.85 only (docs/physics.md section 4); "
-                          "lower time.cfl if the run blows up");
+                          ": measured stable up to CFL " + fmt(stable) + " only under " +
+                          scheme_name(s_->opt.scheme) + " (docs/physics.md section 4); lower "
+                          "time.cfl if the run blows up");
         break;
       }
     c.solver = std::move(s_);

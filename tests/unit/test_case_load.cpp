@@ -291,10 +291,11 @@ TEST(CaseLoad, ParticlesOnGridLinesGetANote) {
 
 // MUSL's updated edge velocity above the CFL it was measured stable at gets a note.
 TEST(CaseLoad, UpdatedEdgeVelocityAboveCfl085GetsANote) {
-  auto notes = [](double cfl) {
+  auto notes = [](double cfl, const char* scheme = "MUSL") {
     nlohmann::json j = {
         {"grid", {{"size", {0.008, 0.004}}, {"cell", 0.001}}},
         {"time", {{"end", 1e-6}, {"cfl", cfl}}},
+        {"scheme", {{"update", scheme}}},
         {"materials", {{"m", {{"model", "elastic"}, {"young", 1e9}, {"poisson", 0.25},
                               {"density", 1000}}}}},
         {"bodies", {{{"name", "b"}, {"material", "m"}, {"box", {0, 0, 0.004, 0.002}}}}},
@@ -306,10 +307,14 @@ TEST(CaseLoad, UpdatedEdgeVelocityAboveCfl085GetsANote) {
     return out;
   };
   EXPECT_NE(notes(0.9).find("note: edge_velocity \"updated\" at CFL 0.9: measured stable up to "
-                            "CFL 0.85 only"),
+                            "CFL 0.85 only under MUSL"),
             std::string::npos) << notes(0.9);
   EXPECT_EQ(notes(0.85), "");
   EXPECT_EQ(notes(0.5), "");
+  // USF: measured stable up to 0.9.
+  EXPECT_NE(notes(0.95, "USF").find("at CFL 0.95: measured stable up to CFL 0.9 only under USF"),
+            std::string::npos) << notes(0.95, "USF");
+  EXPECT_EQ(notes(0.9, "USF"), "");
 }
 
 // The complete example of docs/case-reference.md is a valid case (the reference stays honest).
