@@ -183,7 +183,7 @@ void Solver::finalize() {
       s.kt[k] = s.alpha_t * m.rho * m.cs * m.cs / s.delta;
     }
   }
-  bool updated = false;  // a layer strained with the updated velocity (MUSL, one field)
+  bool updated = false;  // a layer strained with the updated velocity (MUSL or USF, one field)
   for (const auto& s : silents)
     updated = updated || (s.form == SilentForm::Nodal && s.updated_velocity);
   updated = updated && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
@@ -577,11 +577,11 @@ std::array<int, 2> Solver::window_origin() const {
 // MUSL, and USF for the loads' power: every field's re-mapped momentum q (summed over the
 // halo, with the hooks' share) becomes the velocity q / m, with the constraints. MUSL
 // (updated_edges): at the dashpot nodes of layers strained with the updated velocity (their
-// weight > 0), v+ instead: the velocity the dashpots acted on (docs/physics.md section 4) -- where the node
-// holds at least dt/2 times the full LK impedance rho c_d of its share of the edge, the mass
-// of a matched edge node times the CFL number. A lighter node (of a nearly empty cell) keeps
-// the re-mapped value: there v+ = v + dt f / m amplifies the internal force, and a strong
-// dashpot makes the trapezoidal update ring. The boundary work, the springs and the stress
+// weight > 0), v+ instead: the velocity the dashpots acted on (docs/physics.md section 4) --
+// where the node holds at least dt/2 times the full LK impedance rho c_d of its share of the
+// edge, the mass of a matched edge node times the CFL number. A lighter node (of a nearly
+// empty cell) keeps the re-mapped value: there v+ = v + dt f / m amplifies the internal force,
+// and a strong dashpot makes the trapezoidal update ring. The boundary work, the springs and the stress
 // update then all take the velocity chosen here.
 void Solver::remapped_velocities(bool updated_edges) {
   if (dist_) {  // every field's re-mapped momenta

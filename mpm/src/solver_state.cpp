@@ -209,7 +209,8 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
   w.put(pre + "strips", static_cast<std::int32_t>(0));  // no strips: the reader re-sorts
   w.put(pre + "ranges", std::vector<std::uint32_t>{});
   w.put(pre + "field_boxes", std::vector<std::int32_t>{});
-  if (edge) w.put(pre + "edge_velocity", own_edge_velocities(edge_all, NodeBox{0, -1, 0, -1}, {0, 0}));
+  if (edge)
+    w.put(pre + "edge_velocity", own_edge_velocities(edge_all, NodeBox{0, -1, 0, -1}, {0, 0}));
 }
 
 bool Solver::load_state(const StateReader& r, const std::string& pre) {
