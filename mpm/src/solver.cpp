@@ -581,8 +581,8 @@ std::array<int, 2> Solver::window_origin() const {
 // where the node holds at least dt/2 times the full LK impedance rho c_d of its share of the
 // edge, the mass of a matched edge node times the CFL number. A lighter node (of a nearly
 // empty cell) keeps the re-mapped value: there v+ = v + dt f / m amplifies the internal force,
-// and a strong dashpot makes the trapezoidal update ring. The boundary work, the springs and the stress
-// update then all take the velocity chosen here.
+// and a strong dashpot makes the trapezoidal update ring. The boundary work, the springs and
+// the stress update then all take the velocity chosen here.
 void Solver::remapped_velocities(bool updated_edges) {
   if (dist_) {  // every field's re-mapped momenta
     std::vector<double*> q;
