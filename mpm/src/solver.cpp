@@ -538,7 +538,7 @@ void Solver::start_velocities() {
     const long j = static_cast<long>(edge_velocity_[e + 1]) - o[1];
     if (i < 0 || j < 0 || i >= grid.nnx || j >= grid.nny) continue;
     const long n = j * grid.nnx + i;
-    if (grid.m[n] > mass_floor_ && 0.5 * dt * edge_velocity_[e + 2] <= grid.m[n]) {
+    if (takes_updated(n, edge_velocity_[e + 2])) {
       grid.vx[n] = edge_velocity_[e + 3];
       grid.vy[n] = edge_velocity_[e + 4];
     }
@@ -595,8 +595,7 @@ void Solver::remapped_velocities(bool updated_edges) {
                             mass_floor_, nthreads_);
   if (!updated_edges || updated_weight_.empty()) return;
   for (const long i : dashpot_nodes_) {
-    if (updated_weight_[i] > 0 && grid.m[i] > mass_floor_ &&
-        0.5 * dt * updated_weight_[i] <= grid.m[i]) {
+    if (takes_updated(i, updated_weight_[i])) {
       grid.qx[i] = grid.vnx[i];
       grid.qy[i] = grid.vny[i];
     }
@@ -1383,7 +1382,7 @@ void Solver::step_with() {
         remapped_velocities(false);
         boundary_work<S>(true);
       }
-      if (!updated_weight_.empty()) keep_edge_velocities();
+      if (usf_edges()) keep_edge_velocities();
       break;
   }
   t += dt;

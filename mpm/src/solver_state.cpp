@@ -107,7 +107,7 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   std::vector<std::int32_t> boxes;
   for (const auto& F : fields_) boxes.insert(boxes.end(), F.box.begin(), F.box.end());
   w.put(pre + "field_boxes", boxes);
-  if (!updated_weight_.empty() && opt.scheme == Scheme::USF)
+  if (usf_edges())
     w.put(pre + "edge_velocity", own_edge_velocities(edge_velocity_, NodeBox{0, -1, 0, -1},
                                                      window_origin()));
 }
@@ -148,7 +148,7 @@ void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
   if (!dist_) all = mine;
   else dist_->gather(mine, all);
   // USF's kept edge velocities: each node's from its owner.
-  const bool edge = !updated_weight_.empty() && opt.scheme == Scheme::USF;
+  const bool edge = usf_edges();
   std::vector<double> edge_all;
   if (edge) {
     const std::vector<double> own = own_edge_velocities(edge_velocity_, own_, window_origin());
@@ -253,7 +253,7 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
   energy = r.get<Energies>(pre + "energy");
   contact.dissipated = r.get<double>(pre + "contact_dissipated");
   edge_velocity_.clear();
-  if (!updated_weight_.empty() && opt.scheme == Scheme::USF) {
+  if (usf_edges()) {
     r.get(pre + "edge_velocity", edge_velocity_);
     if (edge_velocity_.size() % 5 != 0)
       r.fail("edge_velocity holds " + std::to_string(edge_velocity_.size()) +

@@ -109,6 +109,26 @@ TEST(RestartErrors, UnusableCheckpointsAreRefused) {
                  "particle material group out of range");
   const double far = 1e9;
   expect_refused(s.file, edited("mpm.p.x", 8 * 5, &far, 8, "far"), "far", "is not on the grid");
+  {  // USF's kept edge velocities (edge_velocity "updated"): a node off the grid
+    json u = small_plate(1, 150);
+    u["scheme"]["update"] = "USF";
+    u["boundaries"][1]["edge_velocity"] = "updated";
+    u["output"]["checkpoint_every"] = 100;
+    const std::string file = write_case("ck_usf_edge", u);
+    const fs::path out = scratch() / "ck_usf_edge_out";
+    const Cli run = cli("run " + file + " --out " + out.string(), "ck_usf_edge");
+    ASSERT_EQ(run.code, 0) << run.err;
+    std::string b = read_file(out / "checkpoint.smpm");
+    const std::string block = "mpm.edge_velocity";
+    const std::size_t at = b.find(block);
+    ASSERT_NE(at, std::string::npos);
+    std::memcpy(&b[at + block.size() + 12], &far, 8);  // the first node's i
+    const std::uint64_t sum = fnv1a64(b.data(), b.size() - 8);
+    std::memcpy(&b[b.size() - 8], &sum, 8);
+    const fs::path f = scratch() / "edge_far.smpm";
+    std::ofstream(f, std::ios::binary) << b;
+    expect_refused(file, f, "edge_far", "edge_velocity names a node outside the grid");
+  }
 
   // Another version: a checkpoint written by "0.0.1".
   StateWriter w;

@@ -233,7 +233,13 @@ class Solver {
   // next step strains the particles with (start_velocities). Per node: the whole grid's node
   // (i, j), its weight (updated_weight_) and v+ (x, y); part of a checkpoint.
   std::vector<double> edge_velocity_;
+  bool usf_edges() const { return !updated_weight_.empty() && opt.scheme == Scheme::USF; }
   void keep_edge_velocities();
+  // Whether node n, holding `weight` of such layers' impedance, takes v+: it must hold at least
+  // dt/2 times that weight of mass (remapped_velocities()).
+  bool takes_updated(long n, double weight) const {
+    return weight > 0 && grid.m[n] > mass_floor_ && 0.5 * dt * weight <= grid.m[n];
+  }
   std::array<int, 2> window_origin() const;  // the whole grid's node of the window's (0, 0)
   bool usf_remapped_power() const;
   double mass_floor_ = 0;
