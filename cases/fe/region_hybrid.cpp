@@ -75,7 +75,7 @@ class HybridRegion final : public Region {
                                " (t = " + std::to_string(s_.t) + " s): energy is not finite");
   }
 
-  // Several ranks: one process's checkpoint, written by rank 0 (Hybrid::save_state).
+  // Several ranks: one process's checkpoint, written by every rank at once (Hybrid::save_state).
   void save(StateWriter& w) const override {
     split();
     hy_.save_state(w);

@@ -118,7 +118,8 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
 
 // A checkpoint (DIR/checkpoint.smpm); with `failed` (the failure's message) the state of a failed
 // step instead (DIR/failed.smpm), which a restart refuses.
-// Several MPI ranks: every rank takes part (the region gathers the whole body), rank 0 writes.
+// Several MPI ranks: every rank writes its share of the one file at once (the region puts its
+// particles as parts of the blocks), rank 0 the rest.
 void write_checkpoint(const Case& c, const detail::Region& region, const fs::path& dir,
                       HistoryWriter& hist, const std::string& failed = "") {
   const bool root = process_rank() == 0;
@@ -133,9 +134,9 @@ void write_checkpoint(const Case& c, const detail::Region& region, const fs::pat
   w.put("run.threads", static_cast<std::int32_t>(region.threads()));
   if (root) w.put_string("run.history", read_whole(dir / "history.csv"));
   region.save(w);
-  if (!root) return;
-  detail::write_file_atomically(
-      dir / (failed.empty() ? checkpoint_file_name() : failed_state_file_name()), w.bytes());
+  const fs::path file = dir / (failed.empty() ? checkpoint_file_name() : failed_state_file_name());
+  if (process_count() > 1) detail::mpi()->write_state(w, file.string());
+  else detail::write_file_atomically(file, w.bytes());
 }
 
 // After a step failed: its state, for inspection, as DIR/failed.smpm and (when the run writes

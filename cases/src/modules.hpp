@@ -44,7 +44,7 @@ struct FarFieldModule {
 };
 
 // Bumped whenever the table or a signature in it changes.
-inline constexpr int kMpiModuleApi = 3;
+inline constexpr int kMpiModuleApi = 4;
 
 // The MPI module (parallel/: MPI and PETSc), loaded only when an MPI launcher started the
 // program (processes.cpp).
@@ -65,6 +65,9 @@ struct MpiModule {
   // writers that open one file from every rank, SnapshotWriter::set_ranks).
   const void* (*world)();
   const void* (*no_info)();
+  // One checkpoint file written by every rank at once (collective; parallel/state_write.hpp):
+  // whole or not at all, an error on every rank when any rank's write fails.
+  void (*write_state)(const StateWriter& w, const std::string& path);
 };
 
 const GmshModule& gmsh_module();  // loads libsilentmpm_gmsh.so on first use

@@ -159,11 +159,11 @@ class MpmRegion final : public Region {
                                std::to_string(s_.t) + " s): energy is not finite; reduce time.dt");
   }
 
-  // Several ranks write one checkpoint of the whole body (rank 0 writes it), which a restart
-  // on any number of ranks, or on one process, reads whole before it splits.
+  // Several ranks write one checkpoint of the whole body (each its own particles, at once),
+  // which a restart on any number of ranks, or on one process, reads whole before it splits.
   void save(StateWriter& w) const override {
     split();
-    if (ranks_.several()) s_.save_state_gathered(w, "mpm.");
+    if (ranks_.several()) s_.save_state_parts(w, "mpm.");
     else s_.save_state(w, "mpm.");
     snaps_.save(w);
   }

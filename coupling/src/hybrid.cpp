@@ -625,11 +625,11 @@ namespace smpm {
 
 // Checkpoints: both regions' states and the coupling's own accounts (the FE region's energy
 // terms as the coupled step books them) and work arrays.
-// Split over ranks (every rank calls it; rank 0's writer holds one process's checkpoint): the
-// particles gathered, the FE state and -K u^n from each node's owner, the booked terms summed.
+// Split over ranks (every rank calls it; the ranks write one process's checkpoint at once): the
+// particles as every rank's parts, the FE state and -K u^n from each node's owner, the booked terms summed.
 // (mpm_v and sum_v live within a step; they are saved as this rank holds them.)
 void Hybrid::save_state(StateWriter& w) const {
-  if (dist_) mpm_.save_state_gathered(w, "mpm.");
+  if (dist_) mpm_.save_state_parts(w, "mpm.");
   else mpm_.save_state(w, "mpm.");
   fe_.save_state(w, "fem.");
   w.put("hybrid.energy", energy);

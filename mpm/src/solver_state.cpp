@@ -112,105 +112,45 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
                                                      window_origin()));
 }
 
-void Solver::save_state_gathered(StateWriter& w, const std::string& pre) const {
-  // Every particle's record with, per layer that carries state, its entry's values.
-  std::vector<double> mine, all;
-  std::vector<std::vector<std::pair<std::size_t, int>>> entries(p.size());  // (layer, entry)
+void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
+  // The whole account (collective), rank 0's contact dissipation (every rank holds the same).
+  const Energies e = total_energy();
+  w.put(pre + "dt", dt);
+  w.put(pre + "t", t);
+  w.put(pre + "steps", static_cast<std::int64_t>(steps));
+  w.put(pre + "energy", e);
+  w.put(pre + "contact_dissipated", contact.dissipated);
+  w.put(pre + "film", static_cast<std::uint8_t>(p.has_film()));
+  particle_arrays(p, [&](const char* n, const auto& v) { w.put_part(pre + "p." + n, v); });
+  // A layer's entries with their particles' ids; its values `stride` per entry.
+  auto layer = [&](const std::string& name, const BoundaryLayer& L,
+                   std::vector<std::pair<const char*, std::pair<const std::vector<double>*, int>>>
+                       arrays) {
+    std::vector<std::uint32_t> ids(L.idx.size());
+    for (std::size_t q = 0; q < ids.size(); ++q) ids[q] = p.id[L.idx[q]];
+    w.put_part(name + ".ids", ids);
+    for (const auto& [suffix, a] : arrays) {
+      const auto& [v, stride] = a;
+      w.put_part(name + "." + suffix,
+                 std::vector<double>(v->begin(), v->begin() + stride * ids.size()));
+    }
+  };
   for (std::size_t k = 0; k < silents.size(); ++k)
     if (silents[k].springs())
-      for (std::size_t q = 0; q < silents[k].layer.idx.size(); ++q)
-        entries[silents[k].layer.idx[q]].push_back({k, static_cast<int>(q)});
-  const std::size_t pml_tag = silents.size(), damper_tag = pml_tag + 1;  // damper k: + k
-  for (std::size_t q = 0; q < pml.layer.idx.size(); ++q)
-    entries[pml.layer.idx[q]].push_back({pml_tag, static_cast<int>(q)});
+      layer(pre + "silent" + std::to_string(k), silents[k].layer,
+            {{"ux", {&silents[k].ux, 1}}, {"uy", {&silents[k].uy, 1}}});
   for (std::size_t k = 0; k < dampers.size(); ++k)
     if (dampers[k].beta0 > 0)
-      for (std::size_t q = 0; q < dampers[k].layer.idx.size(); ++q)
-        entries[dampers[k].layer.idx[q]].push_back({damper_tag + k, static_cast<int>(q)});
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    p.pack(k, mine);
-    mine.push_back(static_cast<double>(entries[k].size()));
-    for (const auto& [l, q] : entries[k]) {
-      mine.push_back(static_cast<double>(l));
-      if (l < pml_tag) {
-        mine.push_back(silents[l].ux[q]);
-        mine.push_back(silents[l].uy[q]);
-      } else if (l >= damper_tag) {
-        const double* sv = dampers[l - damper_tag].sv.data() + 3 * q;
-        mine.insert(mine.end(), sv, sv + 3);
-      } else {
-        for (const auto* v : {&pml.H, &pml.xi, &pml.zeta}) mine.insert(mine.end(), v->begin() + 4 * q, v->begin() + 4 * q + 4);
-        mine.insert(mine.end(), pml.u.begin() + 2 * q, pml.u.begin() + 2 * q + 2);
-      }
-    }
-  }
-  const Energies e = total_energy();
-  if (!dist_) all = mine;
-  else dist_->gather(mine, all);
-  // USF's kept edge velocities: each node's from its owner.
-  const bool edge = usf_edges();
-  std::vector<double> edge_all;
-  if (edge) {
-    const std::vector<double> own = own_edge_velocities(edge_velocity_, own_, window_origin());
-    if (!dist_) edge_all = own;
-    else dist_->gather(own, edge_all);
-  }
-  if (dist_ && dist_->rank() != 0) return;
-  Particles q;
-  if (p.has_film()) q.enable_film();
-  std::vector<std::vector<double>> ux(silents.size()), uy(silents.size());
-  std::vector<std::vector<std::uint32_t>> sids(silents.size());
-  std::vector<double> H, xi, zeta, u;
-  std::vector<std::uint32_t> pids;
-  std::vector<std::vector<double>> dsv(dampers.size());
-  std::vector<std::vector<std::uint32_t>> dids(dampers.size());
-  for (std::size_t r = 0; r < all.size();) {
-    r += q.unpack(all.data() + r);
-    const std::uint32_t id = q.id.back();
-    const auto ne = static_cast<std::size_t>(all[r++]);
-    for (std::size_t k = 0; k < ne; ++k) {
-      const auto l = static_cast<std::size_t>(all[r++]);
-      if (l < pml_tag) {
-        sids[l].push_back(id);
-        ux[l].push_back(all[r++]);
-        uy[l].push_back(all[r++]);
-      } else if (l >= damper_tag) {
-        dids[l - damper_tag].push_back(id);
-        dsv[l - damper_tag].insert(dsv[l - damper_tag].end(), all.begin() + r, all.begin() + r + 3);
-        r += 3;
-      } else {
-        pids.push_back(id);
-        for (auto* v : {&H, &xi, &zeta}) v->insert(v->end(), all.begin() + r, all.begin() + r + 4), r += 4;
-        u.insert(u.end(), all.begin() + r, all.begin() + r + 2);
-        r += 2;
-      }
-    }
-  }
-  q.sort_by_id();
-  put_head(w, pre, dt, t, steps, e, contact.dissipated, q);
-  for (std::size_t k = 0; k < silents.size(); ++k) {
-    if (!silents[k].springs()) continue;
-    w.put(pre + "silent" + std::to_string(k) + ".ids", sids[k]);
-    w.put(pre + "silent" + std::to_string(k) + ".ux", ux[k]);
-    w.put(pre + "silent" + std::to_string(k) + ".uy", uy[k]);
-  }
-  for (std::size_t k = 0; k < dampers.size(); ++k)
-    if (dampers[k].beta0 > 0) {
-      w.put(pre + "damper" + std::to_string(k) + ".ids", dids[k]);
-      w.put(pre + "damper" + std::to_string(k) + ".sv", dsv[k]);
-    }
-  if (!pml_bands.empty()) {
-    w.put(pre + "pml.ids", pids);
-    w.put(pre + "pml.H", H);
-    w.put(pre + "pml.u", u);
-    w.put(pre + "pml.xi", xi);
-    w.put(pre + "pml.zeta", zeta);
-  }
+      layer(pre + "damper" + std::to_string(k), dampers[k].layer, {{"sv", {&dampers[k].sv, 3}}});
+  if (!pml_bands.empty())
+    layer(pre + "pml", pml.layer,
+          {{"H", {&pml.H, 4}}, {"u", {&pml.u, 2}}, {"xi", {&pml.xi, 4}}, {"zeta", {&pml.zeta, 4}}});
   w.put(pre + "strips", static_cast<std::int32_t>(0));  // no strips: the reader re-sorts
   w.put(pre + "ranges", std::vector<std::uint32_t>{});
   w.put(pre + "field_boxes", std::vector<std::int32_t>{});
-  if (edge)
-    w.put(pre + "edge_velocity", own_edge_velocities(edge_all, NodeBox{0, -1, 0, -1}, {0, 0}));
+  // USF's kept edge velocities: each node's from its owner.
+  if (usf_edges())
+    w.put_part(pre + "edge_velocity", own_edge_velocities(edge_velocity_, own_, window_origin()));
 }
 
 bool Solver::load_state(const StateReader& r, const std::string& pre) {

@@ -1,11 +1,13 @@
 // Named binary blocks of a run's state (the layout in state_io.hpp).
 #include "silentmpm/state_io.hpp"
 
+#include <array>
+
 namespace smpm {
 
 namespace {
 constexpr char kMagic[10] = {'S', 'M', 'P', 'M', 'S', 'T', 'A', 'T', 'E', '\0'};
-constexpr std::uint32_t kLayout = 1;
+constexpr std::uint32_t kLayout = 2;  // 2: the joinable checksum (1: FNV-1a)
 constexpr std::uint32_t kOrderMark = 0x01020304u;
 
 template <class T>
@@ -23,6 +25,62 @@ std::uint64_t fnv1a64(const void* data, std::size_t n, std::uint64_t h) {
   return h;
 }
 
+namespace {
+// Arithmetic modulo p = 2^61 - 1.
+constexpr std::uint64_t kP = (std::uint64_t{1} << 61) - 1;
+constexpr std::uint64_t kX = 0x2F6B3C1D9E4A5871ull % kP;  // the hash's base
+
+std::uint64_t mod_p(unsigned __int128 v) {
+  std::uint64_t r = static_cast<std::uint64_t>(v & kP) + static_cast<std::uint64_t>(v >> 61);
+  r = (r & kP) + (r >> 61);
+  return r >= kP ? r - kP : r;
+}
+std::uint64_t mul_p(std::uint64_t a, std::uint64_t b) {
+  return mod_p(static_cast<unsigned __int128>(a) * b);
+}
+std::uint64_t pow_p(std::uint64_t x, std::uint64_t n) {
+  std::uint64_t r = 1;
+  for (; n; n >>= 1, x = mul_p(x, x))
+    if (n & 1) r = mul_p(r, x);
+  return r;
+}
+}  // namespace
+
+std::uint64_t state_hash(const void* data, std::size_t n, std::uint64_t h) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  // Eight bytes at a time: h x^8 + sum (b_k + 1) x^(7-k); only the first product is in the chain.
+  static const std::array<std::uint64_t, 9> X = [] {
+    std::array<std::uint64_t, 9> a{};
+    a[0] = 1;
+    for (int k = 1; k < 9; ++k) a[k] = mul_p(a[k - 1], kX);
+    return a;
+  }();
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    unsigned __int128 s = static_cast<unsigned __int128>(h) * X[8];
+    for (int k = 0; k < 8; ++k) s += static_cast<unsigned __int128>(b[i + k] + 1u) * X[7 - k];
+    h = mod_p(s);
+  }
+  for (; i < n; ++i) h = mod_p(static_cast<unsigned __int128>(h) * kX + (b[i] + 1u));
+  return h;
+}
+
+std::uint64_t state_hash_join(std::uint64_t a, std::uint64_t b, std::uint64_t length_of_b) {
+  return mod_p(static_cast<unsigned __int128>(mul_p(a, pow_p(kX, length_of_b))) + b);
+}
+
+std::size_t StateWriter::head_size() { return sizeof kMagic + 8; }
+
+std::string StateWriter::block_head(const std::string& name, std::uint32_t elem,
+                                    std::uint64_t count) {
+  std::string s;
+  append(s, static_cast<std::uint32_t>(name.size()));
+  s += name;
+  append(s, elem);
+  append(s, count);
+  return s;
+}
+
 StateWriter::StateWriter() {
   buf_.append(kMagic, sizeof kMagic);
   append(buf_, kLayout);
@@ -30,13 +88,11 @@ StateWriter::StateWriter() {
 }
 
 void StateWriter::raw(const std::string& name, std::size_t elem, std::size_t count,
-                      const void* data) {
+                      const void* data, bool part) {
   if (name == "end" || !names_.emplace(name, true).second)
     throw std::logic_error("state block '" + name + "' written twice");
-  append(buf_, static_cast<std::uint32_t>(name.size()));
-  buf_ += name;
-  append(buf_, static_cast<std::uint32_t>(elem));
-  append(buf_, static_cast<std::uint64_t>(count));
+  buf_ += block_head(name, static_cast<std::uint32_t>(elem), count);
+  blocks_.push_back({name, static_cast<std::uint32_t>(elem), count, buf_.size(), part});
   if (count) buf_.append(static_cast<const char*>(data), elem * count);
 }
 
@@ -44,11 +100,9 @@ std::string StateWriter::bytes() {
   std::string out = std::move(buf_);
   buf_.clear();
   names_.clear();
-  append(out, static_cast<std::uint32_t>(3));
-  out += "end";
-  append(out, static_cast<std::uint32_t>(0));
-  append(out, static_cast<std::uint64_t>(0));
-  append(out, fnv1a64(out.data(), out.size()));
+  blocks_.clear();
+  out += end_mark();
+  append(out, state_hash(out.data(), out.size()));
   return out;
 }
 
@@ -96,7 +150,7 @@ StateReader::StateReader(std::string bytes, std::string file)
   need(8);
   std::uint64_t sum;
   std::memcpy(&sum, data_.data() + pos, 8);
-  if (sum != fnv1a64(data_.data(), pos)) fail("checksum mismatch (the file is corrupt)");
+  if (sum != state_hash(data_.data(), pos)) fail("checksum mismatch (the file is corrupt)");
   if (pos + 8 != data_.size()) fail("trailing bytes after the end mark (the file is corrupt)");
 }
 

@@ -399,14 +399,6 @@ std::array<int, 4> Distributed::own_nodes() const {
 }
 std::array<int, 2> Distributed::window_origin() const { return {d_->gx0, d_->gy0}; }
 
-// Rank by rank, in messages of at most gather_piece() values (an MPI count is an int), so the
-// whole may hold more than 2^31 - 1 values.
-void Distributed::gather(const std::vector<double>& mine, std::vector<double>& on_root) {
-  std::vector<long long> counts;
-  gather_doubles(mine, on_root, counts, d_->comm, static_cast<long long>(gather_piece()));
-}
-
-std::size_t Distributed::gather_piece_ = std::size_t{1} << 30;
 
 void Distributed::sum(double* v, int n) {
   if (d_->size > 1) MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, d_->comm);

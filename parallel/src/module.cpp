@@ -8,6 +8,7 @@
 #include "silentmpm/distributed.hpp"
 #include "silentmpm/mpi_bytes.hpp"
 #include "silentmpm/solver.hpp"
+#include "silentmpm/state_write.hpp"
 
 namespace smpm::detail {
 namespace {
@@ -44,8 +45,12 @@ const void* no_info() {
   return &i;
 }
 
-const MpiModule kTable = {kMpiModuleApi, start, stop,  rank,      size,
-                          distribute,    any,   abort, broadcast, world, no_info};
+void write_state(const StateWriter& w, const std::string& path) {
+  write_state_collectively(w, path, MPI_COMM_WORLD);
+}
+
+const MpiModule kTable = {kMpiModuleApi, start, stop,  rank,      size,    distribute,
+                          any,           abort, broadcast, world, no_info, write_state};
 
 }  // namespace
 }  // namespace smpm::detail

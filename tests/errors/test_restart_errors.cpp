@@ -98,7 +98,7 @@ TEST(RestartErrors, UnusableCheckpointsAreRefused) {
     const std::size_t at = b.find(block);
     EXPECT_NE(at, std::string::npos) << block;
     std::memcpy(&b[at + block.size() + 12 + offset], v, n);  // after elem size and count
-    const std::uint64_t sum = fnv1a64(b.data(), b.size() - 8);
+    const std::uint64_t sum = state_hash(b.data(), b.size() - 8);
     std::memcpy(&b[b.size() - 8], &sum, 8);
     const fs::path f = scratch() / (tag + ".smpm");
     std::ofstream(f, std::ios::binary) << b;
@@ -123,7 +123,7 @@ TEST(RestartErrors, UnusableCheckpointsAreRefused) {
     const std::size_t at = b.find(block);
     ASSERT_NE(at, std::string::npos);
     std::memcpy(&b[at + block.size() + 12], &far, 8);  // the first node's i
-    const std::uint64_t sum = fnv1a64(b.data(), b.size() - 8);
+    const std::uint64_t sum = state_hash(b.data(), b.size() - 8);
     std::memcpy(&b[b.size() - 8], &sum, 8);
     const fs::path f = scratch() / "edge_far.smpm";
     std::ofstream(f, std::ios::binary) << b;

@@ -414,31 +414,6 @@ TEST(Ranks, MultiFieldContactAgreesWithOneProcess) {
   }
 }
 
-// Rank 0 gathers every rank's values in rank order, in messages of at most gather_piece()
-// values (so a checkpoint may hold more than an MPI count): with pieces of 7 values, ranks
-// holding 0, 7, 23 and 100 values (each value names its rank and place), rank 0 gets them all,
-// exactly, and the others nothing.
-TEST(Ranks, GatherInPiecesHoldsEveryValueInRankOrder) {
-  auto s = make_plate(PlateSpec{});
-  Distributed d(*s, MPI_COMM_WORLD, 1);
-  const std::size_t kept = Distributed::gather_piece();
-  Distributed::set_gather_piece(7);
-  const int rank = d.rank();
-  auto count = [](int r) { return std::vector<std::size_t>{0, 7, 23, 100}[r % 4]; };
-  std::vector<double> mine(count(rank)), all;
-  for (std::size_t k = 0; k < mine.size(); ++k) mine[k] = 1000.0 * rank + k;
-  d.gather(mine, all);
-  Distributed::set_gather_piece(kept);
-  if (rank != 0) {
-    EXPECT_TRUE(all.empty());
-    return;
-  }
-  std::vector<double> want;
-  for (int r = 0; r < d.size(); ++r)
-    for (std::size_t k = 0; k < count(r); ++k) want.push_back(1000.0 * r + k);
-  EXPECT_EQ(all, want);
-}
-
 TEST(Ranks, TooManyRanksForTheGridIsAnError) {
   if (ranks() == 1) GTEST_SKIP() << "one rank takes any grid";
   PlateSpec c;

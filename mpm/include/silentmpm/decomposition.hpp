@@ -34,8 +34,6 @@ class Decomposition {
   // whole grid's node of its window's node (0, 0).
   virtual std::array<int, 4> own_nodes() const = 0;
   virtual std::array<int, 2> window_origin() const = 0;
-  // Rank 0 receives every rank's `mine`, in rank order (the others receive nothing).
-  virtual void gather(const std::vector<double>& mine, std::vector<double>& on_root) = 0;
   // This rank's communication so far: seconds in halo sums and in migrations, bytes it sent in
   // halo sums and in migrations, particles it sent.
   struct Traffic {

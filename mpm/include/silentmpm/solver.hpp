@@ -202,11 +202,12 @@ class Solver {
   // the checkpoint was cut into another number of strips (another thread count): the particles
   // are then re-sorted, and sums over them run in another order. Throws StateError.
   bool load_state(const StateReader& r, const std::string& prefix);
-  // Split over ranks: every rank takes part, rank 0 writes into w the state of the whole body in
-  // save_state's form (particles in the order of their ids, layer data with its particles' ids,
-  // the energy account summed, no strips: a restart re-sorts), which load_state reads into a
-  // solver built whole, on one process or before it is split again.
-  void save_state_gathered(StateWriter& w, const std::string& prefix) const;
+  // Split over ranks (collective): every rank puts its particles and its layer entries (with
+  // their particles' ids) as its parts of the blocks (StateWriter::put_part), the clock and the
+  // energy account summed over the ranks as whole blocks, and no strips (a restart re-sorts).
+  // Written by every rank at once, the file is the state of the whole body, which load_state
+  // reads into a solver built whole, on one process or before it is split again.
+  void save_state_parts(StateWriter& w, const std::string& prefix) const;
 
  private:
   int nthreads_ = 1;

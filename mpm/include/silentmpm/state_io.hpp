@@ -11,7 +11,12 @@
 // File layout (StateWriter::bytes):
 //   "SMPMSTATE\0" (10 bytes), uint32 layout version, uint32 byte-order mark 0x01020304,
 //   then per block: uint32 name length, name, uint32 element size, uint64 count, the data;
-//   then the block "end" (no data) and a uint64 FNV-1a hash of every byte before it.
+//   then the block "end" (no data) and a uint64 checksum of every byte before it (state_hash).
+//
+// Several MPI ranks write one file at once (the MPI module's write_state): a block put with
+// put_part holds every rank's part joined in rank order, a block put with put comes from
+// rank 0 alone. The checksum is a hash that pieces hashed apart can join, so each rank hashes
+// what it writes.
 #include <cstdint>
 #include <cstring>
 #include <map>
@@ -28,8 +33,16 @@ struct StateError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// 64-bit FNV-1a of a byte string (checksums and case fingerprints).
+// 64-bit FNV-1a of a byte string (case fingerprints).
 std::uint64_t fnv1a64(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull);
+
+// A checkpoint's checksum: the polynomial sum over its bytes b_1..b_n of (b_k + 1) x^(n-k)
+// modulo the prime 2^61 - 1 (x fixed). `h` is the hash of the bytes before `data`, so
+// state_hash(B, state_hash(A)) is the hash of A followed by B; state_hash_join does the same from
+// the two pieces' hashes and the second's length, so that pieces hashed apart (by the ranks that
+// wrote them) give the whole file's. A one-byte change always changes it.
+std::uint64_t state_hash(const void* data, std::size_t n, std::uint64_t h = 0);
+std::uint64_t state_hash_join(std::uint64_t a, std::uint64_t b, std::uint64_t length_of_b);
 
 class StateWriter {
  public:
@@ -45,14 +58,39 @@ class StateWriter {
     raw(name, sizeof(T), 1, &value);
   }
   void put_string(const std::string& name, const std::string& s) { raw(name, 1, s.size(), s.data()); }
+  // This process's part of a block whose whole is every rank's part in rank order (on one
+  // process, the block itself). Every rank puts the same part blocks in the same order.
+  template <class T>
+  void put_part(const std::string& name, const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>, "blocks hold plain values");
+    raw(name, sizeof(T), v.size(), v.data(), true);
+  }
   // The file's bytes: header, blocks, end mark and checksum. Moves the buffer out (no copy of a
   // state that may be most of the memory): the writer is empty afterwards.
   std::string bytes();
 
+  // What a writer over several ranks needs: the blocks in the order put, each with where its
+  // data lies in buffer() (which holds the header and the blocks as one process's file would).
+  struct Block {
+    std::string name;
+    std::uint32_t elem = 0;
+    std::uint64_t count = 0;
+    std::size_t offset = 0;
+    bool part = false;
+  };
+  const std::vector<Block>& blocks() const { return blocks_; }
+  const std::string& buffer() const { return buf_; }
+  static std::size_t head_size();  // the header's bytes (magic, layout, byte-order mark)
+  // A block's table entry (name length, name, element size, count) and the end block's.
+  static std::string block_head(const std::string& name, std::uint32_t elem, std::uint64_t count);
+  static std::string end_mark() { return block_head("end", 0, 0); }
+
  private:
   std::string buf_;
   std::map<std::string, bool> names_;
-  void raw(const std::string& name, std::size_t elem, std::size_t count, const void* data);
+  std::vector<Block> blocks_;
+  void raw(const std::string& name, std::size_t elem, std::size_t count, const void* data,
+           bool part = false);
 };
 
 class StateReader {

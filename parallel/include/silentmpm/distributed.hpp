@@ -38,11 +38,6 @@ class Distributed final : public Decomposition {
   bool migrate(Solver& s) override;
   void sum(double* v, int n) override;
   void max(double* v, int n) override;
-  // In messages of at most gather_piece() values each (2^30; a test sets it smaller): the whole
-  // may exceed an MPI count.
-  void gather(const std::vector<double>& mine, std::vector<double>& on_root) override;
-  static std::size_t gather_piece() { return gather_piece_; }
-  static void set_gather_piece(std::size_t n) { gather_piece_ = n > 0 ? n : 1; }
   std::array<int, 4> own_nodes() const override;
   std::array<int, 2> window_origin() const override;
   Traffic traffic() const override;
@@ -62,7 +57,6 @@ class Distributed final : public Decomposition {
  private:
   struct Impl;
   std::unique_ptr<Impl> d_;
-  static std::size_t gather_piece_;
 };
 
 }  // namespace smpm
