@@ -626,7 +626,8 @@ namespace smpm {
 // Checkpoints: both regions' states and the coupling's own accounts (the FE region's energy
 // terms as the coupled step books them) and work arrays.
 // Split over ranks (every rank calls it; the ranks write one process's checkpoint at once): the
-// particles as every rank's parts, the FE state and -K u^n from each node's owner, the booked terms summed.
+// particles and the FE nodes as every rank's parts (each node's from its owner), the booked
+// terms summed.
 // (mpm_v and sum_v live within a step; they are saved as this rank holds them.)
 void Hybrid::save_state(StateWriter& w) const {
   if (dist_) mpm_.save_state_parts(w, "mpm.");
@@ -637,7 +638,7 @@ void Hybrid::save_state(StateWriter& w) const {
   if (dist_) dist_->sum(terms.data(), static_cast<int>(terms.size()));
   terms.push_back(fe_initial_);
   w.put("hybrid.fe_terms", terms);
-  w.put("hybrid.fint", fe_.gathered(fint_));
+  fe_.put_nodes(w, "hybrid.fint", fint_);
   w.put("hybrid.fext", fext_);
   w.put("hybrid.mpm_v", mpm_v_);
   w.put("hybrid.sum_v", sum_v_);
@@ -657,7 +658,7 @@ bool Hybrid::load_state(const StateReader& r) {
   fe_absorbed_ = terms[3];
   fe_work_ = terms[4];
   fe_initial_ = terms[5];
-  r.get("hybrid.fint", fint_, fint_.size());
+  fe_.get_nodes(r, "fem.", "hybrid.fint", fint_);
   r.get("hybrid.fext", fext_, fext_.size());
   r.get("hybrid.mpm_v", mpm_v_, mpm_v_.size());
   r.get("hybrid.sum_v", sum_v_, sum_v_.size());

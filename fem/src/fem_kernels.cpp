@@ -479,50 +479,96 @@ namespace smpm::fem {
 
 // Checkpoints: displacement, velocity, -K u^n (the step and the elastic energy reuse it), the
 // clock, the energies and the snapshot times (fem.xdmf is rebuilt from them on restart).
-// Several ranks (every rank calls it): the booked energies summed, each node's state from its
-// owner and each layer cell's memories from its part's rank gathered on rank 0, which puts the
-// checkpoint of one process (the others put nothing of the far field).
+// Several ranks (every rank calls it; the ranks write the file at once): the booked energies
+// summed, and each rank's own nodes and its part's layer cells as its parts of the blocks,
+// with their numbers (blocks `nodes`, `pml_cells`, `pml_nodes`), which load_state reads into a
+// model built whole.
+namespace {
+// The items (nodes, layer cells ...) whose owner is `me`, ascending.
+std::vector<std::uint32_t> owned(const std::vector<std::uint32_t>& owner, std::uint32_t me) {
+  std::vector<std::uint32_t> out;
+  for (std::size_t i = 0; i < owner.size(); ++i)
+    if (owner[i] == me) out.push_back(static_cast<std::uint32_t>(i));
+  return out;
+}
+// `width` values per item of `v` for the items `which`, in that order.
+std::vector<double> values_of(const std::vector<double>& v, const std::vector<std::uint32_t>& which,
+                              std::size_t width) {
+  std::vector<double> out;
+  out.reserve(width * which.size());
+  for (const auto i : which) out.insert(out.end(), v.begin() + width * i, v.begin() + width * (i + 1));
+  return out;
+}
+// A block of `width` values per item (`items` of them), whole or as parts with the items'
+// numbers in the block `numbers` (which must name every item once).
+void get_items(const StateReader& r, const std::string& name, const std::string& numbers,
+               std::size_t items, std::size_t width, std::vector<double>& v) {
+  if (!r.has(numbers)) {
+    r.get(name, v, width * items);
+    return;
+  }
+  std::vector<std::uint32_t> at;
+  r.get(numbers, at, items);
+  std::vector<double> parts;
+  r.get(name, parts, width * items);
+  std::vector<std::uint8_t> seen(items, 0);
+  v.assign(width * items, 0.0);
+  for (std::size_t q = 0; q < items; ++q) {
+    if (at[q] >= items || seen[at[q]]++)
+      r.fail("block '" + numbers + "' does not name every item once (corrupt checkpoint)");
+    std::copy_n(parts.begin() + width * q, width, v.begin() + width * at[q]);
+  }
+}
+}  // namespace
+
+void Solver::put_nodes(StateWriter& w, const std::string& name,
+                       const std::vector<double>& per_node) const {
+  const Impl& m = *impl_;
+  if (!m.part) w.put(name, per_node);
+  else w.put_part(name, values_of(per_node, m.part->own, 2));
+}
+
+void Solver::get_nodes(const StateReader& r, const std::string& prefix, const std::string& name,
+                       std::vector<double>& per_node) const {
+  get_items(r, name, prefix + "nodes", impl_->x.size(), 2, per_node);
+}
+
 void Solver::save_state(StateWriter& w, const std::string& pre) const {
   const Impl& m = *impl_;
   Energies e = energy;
-  const std::vector<double>*u = &m.u, *v = &m.v, *ku = &m.ku, *xi = &m.pml.xi, *zeta = &m.pml.zeta;
-  std::vector<std::vector<double>> nodes, cells, memories;
   if (m.part) {
     const Impl::Part& P = *m.part;
     double b[2] = {P.work, P.absorbed};
     sum_over_ranks(m, b, 2);
     e.external_work = b[0];
     e.absorbed = b[1];
-    gather_on_root(m, P.node_rank, {&m.u, &m.v, &m.ku}, 2, nodes);
-    if (m.pml.active()) {
-      std::vector<std::uint32_t> cell_owner(m.pml.cell.size()), node_owner(m.pml.node.size());
-      for (std::size_t c = 0; c < cell_owner.size(); ++c) cell_owner[c] = P.cell_rank[m.pml.cell[c]];
-      for (std::size_t j = 0; j < node_owner.size(); ++j) node_owner[j] = P.node_rank[m.pml.node[j]];
-      gather_on_root(m, cell_owner, {&m.pml.xi}, 4 * m.pml.nq, cells);
-      gather_on_root(m, node_owner, {&m.pml.zeta}, 4, memories);
-    }
-    if (P.rank != 0) return;
-    u = &nodes[0];
-    v = &nodes[1];
-    ku = &nodes[2];
-    if (m.pml.active()) {
-      xi = &cells[0];
-      zeta = &memories[0];
-    }
   }
   w.put(pre + "dt", dt);
   w.put(pre + "t", t);
   w.put(pre + "steps", static_cast<std::int64_t>(steps));
   w.put(pre + "energy", e);
-  w.put(pre + "u", *u);
-  w.put(pre + "v", *v);
-  w.put(pre + "ku", *ku);
+  if (m.part) w.put_part(pre + "nodes", m.part->own);
+  put_nodes(w, pre + "u", m.u);
+  put_nodes(w, pre + "v", m.v);
+  put_nodes(w, pre + "ku", m.ku);
   w.put(pre + "ku_valid", static_cast<std::uint8_t>(m.ku_valid));
   w.put(pre + "snapshot_times", snapshot_times());
-  if (m.pml.active()) {
-    w.put(pre + "pml_xi", *xi);
-    w.put(pre + "pml_zeta", *zeta);
+  if (!m.pml.active()) return;
+  if (!m.part) {
+    w.put(pre + "pml_xi", m.pml.xi);
+    w.put(pre + "pml_zeta", m.pml.zeta);
+    return;
   }
+  const Impl::Part& P = *m.part;
+  const auto me = static_cast<std::uint32_t>(P.rank);
+  std::vector<std::uint32_t> cell_owner(m.pml.cell.size()), node_owner(m.pml.node.size());
+  for (std::size_t c = 0; c < cell_owner.size(); ++c) cell_owner[c] = P.cell_rank[m.pml.cell[c]];
+  for (std::size_t j = 0; j < node_owner.size(); ++j) node_owner[j] = P.node_rank[m.pml.node[j]];
+  const std::vector<std::uint32_t> cells = owned(cell_owner, me), nodes = owned(node_owner, me);
+  w.put_part(pre + "pml_cells", cells);
+  w.put_part(pre + "pml_xi", values_of(m.pml.xi, cells, 4 * m.pml.nq));
+  w.put_part(pre + "pml_nodes", nodes);
+  w.put_part(pre + "pml_zeta", values_of(m.pml.zeta, nodes, 4));
 }
 
 void Solver::load_state(const StateReader& r, const std::string& pre) {
@@ -531,9 +577,9 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   if (dt_saved != dt)
     r.fail("FE time step " + fmt(dt_saved) + " s in the checkpoint, " + fmt(dt) +
            " s in this case (a checkpoint of another case)");
-  r.get(pre + "u", m.u, m.u.size());
-  r.get(pre + "v", m.v, m.v.size());
-  r.get(pre + "ku", m.ku, m.ku.size());
+  get_nodes(r, pre, pre + "u", m.u);
+  get_nodes(r, pre, pre + "v", m.v);
+  get_nodes(r, pre, pre + "ku", m.ku);
   m.ku_valid = r.get<std::uint8_t>(pre + "ku_valid") != 0;
   t = r.get<double>(pre + "t");
   steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
@@ -541,8 +587,8 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   r.get(pre + "snapshot_times", m.snapshot_times);
   m.snapshots = static_cast<int>(m.snapshot_times.size());
   if (m.pml.active()) {
-    r.get(pre + "pml_xi", m.pml.xi, m.pml.xi.size());
-    r.get(pre + "pml_zeta", m.pml.zeta, m.pml.zeta.size());
+    get_items(r, pre + "pml_xi", pre + "pml_cells", m.pml.cell.size(), 4 * m.pml.nq, m.pml.xi);
+    get_items(r, pre + "pml_zeta", pre + "pml_nodes", m.pml.node.size(), 4, m.pml.zeta);
   }
   if (m.part) {  // several ranks: the booked energies stay with rank 0
     m.part->work = m.part->rank == 0 ? energy.external_work : 0.0;

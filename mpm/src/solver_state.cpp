@@ -23,7 +23,7 @@ void particle_arrays(P& p, Fn&& fn) {
   fn("dttf", p.dttf); fn("jump_n", p.jump_n); fn("jump_t", p.jump_t); fn("ubar", p.ubar);
 }
 
-// A gathered checkpoint (save_state_gathered) lists a layer's entries by particle id
+// A checkpoint written by several ranks (save_state_parts) lists a layer's entries by particle id
 // (NAME.ids), in another order than this solver's: its arrays (value, stride) are put in this
 // solver's entry order. The ids must be exactly the layer's.
 void reorder_by_ids(const StateReader& r, const std::string& name, const BoundaryLayer& L,

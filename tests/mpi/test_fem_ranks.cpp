@@ -10,6 +10,10 @@
 //     steps: u and v on the own nodes as on one process (bound 1e-14 of their maxima; measured
 //     0), the probes within 1e-14 of their maxima, each energy term within 1e-14 of the largest
 //     and the balance kinetic + elastic + absorbed - work within 1e-13 of it.
+//   * The same square's checkpoint written by the ranks at once (each its own nodes and layer
+//     cells) restarts the model on one process: 100 steps on, u and v on every node within
+//     1e-14 of the uninterrupted one-process run's maxima (measured 0), energies within 1e-14;
+//     a node list naming a node twice is refused.
 //   * The oblique study's measurement, P at 30 degrees on a 10-cell PML and on LK: the
 //     reflection coefficients as on one process (1e-12 relative), on 2 ranks.
 #include <gtest/gtest.h>
@@ -17,14 +21,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
 #include "../../studies/oblique/oblique.hpp"
 #include "fem_common.hpp"
 #include "mpi_testing.hpp"
+#include "silentmpm/state_io.hpp"
+#include "silentmpm/state_write.hpp"
 
 namespace smpm::fem_testing {
 namespace {
@@ -197,6 +208,67 @@ TEST(FemRanks, SquareWithEveryBoundaryAsOneProcess) {
   EXPECT_GT(e2.absorbed, 0.05 * big);  // the layers took part
   EXPECT_LE(energy_diff, 1e-14 * big);
   EXPECT_LE(std::fabs(balance), 1e-13 * big);
+}
+
+TEST(FemRanks, CheckpointFromTheRanksRestartsOneProcess) {
+  namespace fs = std::filesystem;
+  fem::Solver one(square(1, true)), split(square(1, true)), restarted(square(1, true));
+  split.distribute();
+  for (fem::Solver* s : {&one, &split, &restarted}) s->set_dt(0.5 * s->critical_dt());
+  for (int n = 0; n < 200; ++n) {
+    one.step();
+    split.step();
+  }
+  const fs::path file = fs::temp_directory_path() /
+                        ("smpm_fem_ranks_" + std::to_string(world_size()) + ".smpm");
+  StateWriter w;
+  split.save_state(w, "fem.");
+  write_state_collectively(w, file.string(), MPI_COMM_WORLD);
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  const StateReader r(bytes.str(), file.string());
+  EXPECT_TRUE(r.has("fem.nodes")) << "parts with their nodes' numbers";
+  {  // a node named twice (edited behind a recomputed checksum) is refused
+    std::string b = bytes.str();
+    const std::size_t at = b.find("fem.nodes") + std::string("fem.nodes").size() + 12;
+    std::memcpy(&b[at + 4], &b[at], 4);  // the second node's number := the first's
+    const std::uint64_t sum = state_hash(b.data(), b.size() - 8);
+    std::memcpy(&b[b.size() - 8], &sum, 8);
+    fem::Solver edited(square(1, true));
+    edited.set_dt(0.5 * edited.critical_dt());
+    try {
+      edited.load_state(StateReader(b, "edited"), "fem.");
+      ADD_FAILURE() << "an edited node list was read";
+    } catch (const StateError& e) {
+      EXPECT_NE(std::string(e.what()).find("'fem.nodes' does not name every item once"),
+                std::string::npos) << e.what();
+    }
+  }
+  restarted.load_state(r, "fem.");
+  for (int n = 0; n < 100; ++n) {
+    one.step();
+    restarted.step();
+  }
+  double worst = 0, scale = 0;
+  for (std::size_t k = 0; k < one.displacement().size(); ++k) {
+    worst = std::max({worst, std::fabs(restarted.displacement()[k] - one.displacement()[k]),
+                      std::fabs(restarted.velocity()[k] - one.velocity()[k])});
+    scale = std::max({scale, std::fabs(one.displacement()[k]), std::fabs(one.velocity()[k])});
+  }
+  one.update_energies();
+  restarted.update_energies();
+  const Energies &a = one.energy, &b = restarted.energy;
+  const double big = std::max({std::fabs(a.kinetic), std::fabs(a.absorbed), std::fabs(a.external_work)});
+  const double de = std::max({std::fabs(a.kinetic - b.kinetic), std::fabs(a.elastic - b.elastic),
+                              std::fabs(a.absorbed - b.absorbed),
+                              std::fabs(a.external_work - b.external_work)});
+  if (root()) std::printf("  restarted from %d rank(s): u, v %.3e of %.3e; energies %.3e of %.3e\n",
+                          world_size(), worst, scale, de, big);
+  EXPECT_GT(scale, 0.0);
+  EXPECT_GT(a.absorbed, 0.05 * big);  // the layers took part
+  EXPECT_LE(worst, 1e-14 * scale);
+  EXPECT_LE(de, 1e-14 * big);
 }
 
 TEST(FemRanks, ObliqueReflectionAsOneProcess) {

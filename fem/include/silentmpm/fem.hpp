@@ -192,6 +192,12 @@ class Solver {
   // blocks named `prefix` + ...; load_state restores it into a solver built from the same case.
   void save_state(StateWriter& w, const std::string& prefix) const;
   void load_state(const StateReader& r, const std::string& prefix);
+  // A per-node array (2 values a node) in a checkpoint: whole on one process, as this rank's
+  // own nodes' part on several (in the order of the block `prefix`nodes that save_state puts);
+  // get_nodes reads either form.
+  void put_nodes(StateWriter& w, const std::string& name, const std::vector<double>& per_node) const;
+  void get_nodes(const StateReader& r, const std::string& prefix, const std::string& name,
+                 std::vector<double>& per_node) const;
 
   // --- access for the MPM-FEM coupling and tests ---------------------------------------------
   const std::vector<double>& node_x() const;
