@@ -151,7 +151,7 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
     add(pos, heads.back().data(), heads.back().size());
   }
   pos += StateWriter::end_mark().size();
-  const std::uint64_t sum_at = pos, file_size = pos + 8;
+  const std::uint64_t sum_at = pos;
   for (Piece& p : pieces) p.hash = state_hash(p.data, p.length);
 
   // Every rank writes its pieces; rank 0 then joins the hashes and writes the checksum.
@@ -162,6 +162,14 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
     if (rc != MPI_SUCCESS && err.empty()) err = what + ": " + mpi_error(rc);
     return rc == MPI_SUCCESS;
   };
+  // A stale temporary file (an earlier write that was killed) goes first, so the file holds
+  // only what this write puts (a link is followed, as one process's write follows it).
+  if (rank == 0) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(std::filesystem::symlink_status(tmp, ec)))
+      std::filesystem::remove(tmp, ec);
+  }
+  MPI_Barrier(comm);
   MPI_File fh = MPI_FILE_NULL;
   const bool opened = check(MPI_File_open(comm, tmp.c_str(), MPI_MODE_CREATE | MPI_MODE_WRONLY,
                                           MPI_INFO_NULL, &fh),
@@ -169,7 +177,6 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
   int ok = opened;
   MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_LAND, comm);
   if (ok) {
-    check(MPI_File_set_size(fh, static_cast<MPI_Offset>(file_size)), "cannot size");
     for (const Piece& p : pieces)
       for (std::uint64_t done = 0; done < p.length && err.empty();) {
         const int n = static_cast<int>(std::min<std::uint64_t>(p.length - done, g_piece));
@@ -181,7 +188,8 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
         int wrote = 0;
         MPI_Get_count(&st, MPI_BYTE, &wrote);
         if (wrote != n) {
-          err = "cannot write: " + std::to_string(wrote) + " of " + std::to_string(n) + " bytes";
+          err = "cannot write: " + std::to_string(wrote) + " of " + std::to_string(n) +
+                " bytes written (disk full or an I/O error)";
           break;
         }
         done += static_cast<std::uint64_t>(n);

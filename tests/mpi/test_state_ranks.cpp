@@ -8,6 +8,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -129,6 +130,31 @@ TEST(StateRanks, AFailedWriteIsOneErrorOnEveryRank) {
   MPI_Bcast(root.data(), n, MPI_CHAR, 0, MPI_COMM_WORLD);
   EXPECT_EQ(what, root);
   EXPECT_FALSE(fs::exists(file));
+}
+
+// A full disk (the temporary file linked to /dev/full): every rank gets the same error naming
+// the file and the cause; no checkpoint is left.
+TEST(StateRanks, AFullDiskIsOneErrorOnEveryRank) {
+  const fs::path dir = folder("full"), file = dir / "state.smpm";
+  if (mpi_testing::world_rank() == 0) fs::create_symlink("/dev/full", dir / "state.smpm.tmp");
+  MPI_Barrier(MPI_COMM_WORLD);
+  StateWriter w;
+  w.put_part("a", std::vector<double>(1000, 1.0));
+  std::string what;
+  try {
+    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
+  } catch (const std::runtime_error& e) {
+    what = e.what();
+  }
+  EXPECT_EQ(what.rfind(file.string() + ": cannot ", 0), 0u) << what;
+  std::string root = what;
+  int n = static_cast<int>(root.size());
+  MPI_Bcast(&n, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  root.resize(static_cast<std::size_t>(n));
+  MPI_Bcast(root.data(), n, MPI_CHAR, 0, MPI_COMM_WORLD);
+  EXPECT_EQ(what, root);
+  EXPECT_FALSE(fs::exists(file));
+  if (mpi_testing::world_rank() == 0) std::printf("  a full disk: %s\n", what.c_str());
 }
 
 // A plate with a pulse, its layers carrying state (Kelvin-Voigt springs on LK edges; a damping
