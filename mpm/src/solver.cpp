@@ -561,11 +561,8 @@ void Solver::keep_edge_velocities() {
 
 // USF takes the loads' power with the velocity the particles carry back, their momenta
 // re-mapped as MUSL's (one more scatter in its g2p), when the step books any: tractions,
-// dashpots, damping bands, gravity. Not with a damping band's stiffness part, whose viscous
-// stress (boundary_work) takes v+ at the particles' positions before they move.
+// dashpots, damping bands, gravity.
 bool Solver::usf_remapped_power() const {
-  for (const auto& dl : dampers)
-    if (dl.beta0 > 0) return false;
   return !tractions.empty() || !silents.empty() || !dampers.empty() || opt.gravity_x != 0 ||
          opt.gravity_y != 0;
 }
@@ -919,19 +916,27 @@ void Solver::apply_loads() {
         add_dashpot_node(dn[a]);
       }
     }
-    // The stiffness-proportional part: the last step's viscous stress, -V sigma_v grad N_i.
-    if (dl.beta0 > 0)
+    // The stiffness-proportional part: the last step's viscous stress, -V sigma_v grad N_i,
+    // with the gradients at the step's start kept for boundary_work.
+    if (dl.beta0 > 0) {
+      dl.gnodes.resize(K * L.idx.size());
+      dl.dNx.resize(K * L.idx.size());
+      dl.dNy.resize(K * L.idx.size());
       for (std::size_t q = 0; q < L.idx.size(); ++q) {
+        if (dl.beta[q] == 0) continue;
+        long* dn = dl.gnodes.data() + K * q;
+        layer_shape(L, q, Anchor::Particle, sf, dn);
+        std::copy(sf.dNx, sf.dNx + K, dl.dNx.data() + K * q);
+        std::copy(sf.dNy, sf.dNy + K, dl.dNy.data() + K * q);
         const double* sv = dl.sv.data() + 3 * q;
         if (sv[0] == 0 && sv[1] == 0 && sv[2] == 0) continue;
-        long dn[K];
-        layer_shape(L, q, Anchor::Particle, sf, dn);
         const double V = p.vol[L.idx[q]];
         for (int a = 0; a < K; ++a) {
           grid.fx[dn[a]] -= V * (sv[0] * sf.dNx[a] + sv[2] * sf.dNy[a]);
           grid.fy[dn[a]] -= V * (sv[2] * sf.dNx[a] + sv[1] * sf.dNy[a]);
         }
       }
+    }
   }
   if (pml.active()) pml_loads<S>();
   // Split over ranks: every load is in; the shared nodes sum their forces.
@@ -1006,9 +1011,7 @@ void Solver::grid_update() {
 // anchor: external work x13 and a -93 % imbalance; with w, < 0.1 %).
 template <class S>
 void Solver::boundary_work(bool remapped) {
-  S sf;
   constexpr int K = S::kNodes;
-  long nodes[K];
   const std::vector<double>& ux = remapped ? grid.qx : grid.vnx;
   const std::vector<double>& uy = remapped ? grid.qy : grid.vny;
   auto vbar = [&](long i, double& ax, double& ay) {  // the forces' velocity
@@ -1117,23 +1120,29 @@ void Solver::boundary_work(bool remapped) {
     if (!(dl.beta0 > 0)) continue;
     // The stiffness-proportional part: the work of the viscous force this step applied (with
     // the power's velocity), then the viscous stress beta C : D for the next, D the strain rate
-    // of the velocity that strains the particles (at the same positions).
+    // of the velocity that strains the particles (MUSL's re-mapped, USL's v+; under USF, whose
+    // particles the start velocity strained, v+), all with the gradients the force was mapped
+    // with (apply_loads: the positions at the step's start).
+    const std::vector<double>& sx = opt.scheme == Scheme::USF ? grid.vnx : ux;
+    const std::vector<double>& sy = opt.scheme == Scheme::USF ? grid.vny : uy;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       if (dl.beta[q] == 0) continue;
       const std::uint32_t k = L.idx[q];
-      layer_shape(L, q, Anchor::Particle, sf, nodes);
+      const long* gn = dl.gnodes.data() + K * q;
+      const double* dNx = dl.dNx.data() + K * q;
+      const double* dNy = dl.dNy.data() + K * q;
       double* sv = dl.sv.data() + 3 * q;
       const double V = p.vol[k];
       double lxx = 0, lxy = 0, lyx = 0, lyy = 0;  // du_x/dx, du_x/dy, du_y/dx, du_y/dy
       for (int a = 0; a < K; ++a) {
         double bx, by;
-        wbar(nodes[a], bx, by);
-        energy.absorbed += dt * V * ((sv[0] * sf.dNx[a] + sv[2] * sf.dNy[a]) * bx +
-                                     (sv[2] * sf.dNx[a] + sv[1] * sf.dNy[a]) * by);
-        lxx += ux[nodes[a]] * sf.dNx[a];
-        lxy += ux[nodes[a]] * sf.dNy[a];
-        lyx += uy[nodes[a]] * sf.dNx[a];
-        lyy += uy[nodes[a]] * sf.dNy[a];
+        wbar(gn[a], bx, by);
+        energy.absorbed += dt * V * ((sv[0] * dNx[a] + sv[2] * dNy[a]) * bx +
+                                     (sv[2] * dNx[a] + sv[1] * dNy[a]) * by);
+        lxx += sx[gn[a]] * dNx[a];
+        lxy += sx[gn[a]] * dNy[a];
+        lyx += sy[gn[a]] * dNx[a];
+        lyy += sy[gn[a]] * dNy[a];
       }
       const Material& m = materials[p.group[k]];
       const double b = dl.beta[q], tr = lxx + lyy;

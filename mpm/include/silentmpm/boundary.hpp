@@ -103,6 +103,11 @@ struct DampingLayer {
   // the blocks; the power of the damping force is booked with the same ones.
   std::vector<long> nodes;
   std::vector<double> N;
+  // The stiffness part's shape gradients of each particle at its position when the step began
+  // (kNodes per particle: node, dN/dx, dN/dy): the viscous force, its power and the next viscous
+  // stress all take them, wherever the scheme has moved the particle by then.
+  std::vector<long> gnodes;
+  std::vector<double> dNx, dNy;
 };
 
 // A perfectly matched layer inside a straight side of a body (docs/physics.md section 9.3): the
