@@ -132,14 +132,7 @@ int compare_on_root(const fs::path& one, const fs::path& ranks, std::string& why
 }
 
 fs::path folder(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() /
-                     ("smpm_snapshot_ranks_" + std::to_string(mpi_testing::world_size()) + "_" + name);
-  if (mpi_testing::world_rank() == 0) {
-    fs::remove_all(d);
-    fs::create_directories(d);
-  }
-  MPI_Barrier(MPI_COMM_WORLD);
-  return d;
+  return mpi_testing::scratch_folder("snapshot_ranks", name);
 }
 
 void write_both(SnapshotWriter& one, SnapshotWriter& all, int s, long step, double time) {

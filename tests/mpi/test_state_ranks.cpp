@@ -29,16 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path folder(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() /
-                     ("smpm_state_ranks_" + std::to_string(mpi_testing::world_size()) + "_" + name);
-  if (mpi_testing::world_rank() == 0) {
-    fs::remove_all(d);
-    fs::create_directories(d);
-  }
-  MPI_Barrier(MPI_COMM_WORLD);
-  return d;
-}
+fs::path folder(const std::string& name) { return mpi_testing::scratch_folder("state_ranks", name); }
 
 std::string read_bytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -122,13 +113,7 @@ TEST(StateRanks, AFailedWriteIsOneErrorOnEveryRank) {
     what = e.what();
   }
   EXPECT_NE(what.find(file.string() + ": cannot create state.smpm.tmp"), std::string::npos) << what;
-  // The same message on every rank.
-  std::string root = what;
-  int n = static_cast<int>(root.size());
-  MPI_Bcast(&n, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  root.resize(static_cast<std::size_t>(n));
-  MPI_Bcast(root.data(), n, MPI_CHAR, 0, MPI_COMM_WORLD);
-  EXPECT_EQ(what, root);
+  EXPECT_EQ(what, mpi_testing::root_string(what)) << "the same message on every rank";
   EXPECT_FALSE(fs::exists(file));
 }
 
@@ -147,12 +132,7 @@ TEST(StateRanks, AFullDiskIsOneErrorOnEveryRank) {
     what = e.what();
   }
   EXPECT_EQ(what.rfind(file.string() + ": cannot ", 0), 0u) << what;
-  std::string root = what;
-  int n = static_cast<int>(root.size());
-  MPI_Bcast(&n, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  root.resize(static_cast<std::size_t>(n));
-  MPI_Bcast(root.data(), n, MPI_CHAR, 0, MPI_COMM_WORLD);
-  EXPECT_EQ(what, root);
+  EXPECT_EQ(what, mpi_testing::root_string(what)) << "the same message on every rank";
   EXPECT_FALSE(fs::exists(file));
   if (mpi_testing::world_rank() == 0) std::printf("  a full disk: %s\n", what.c_str());
 }
