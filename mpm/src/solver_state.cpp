@@ -64,7 +64,8 @@ void put_head(StateWriter& w, const std::string& pre, double dt, double t, long 
 
 // USF with layers strained with the updated velocity (Solver::edge_velocity_): the entries
 // of the nodes in `own` (window numbering, origin o; i1 < i0: every node), ordered by the whole
-// grid's (j, i), so that a checkpoint does not depend on the ranks or the order nodes were met.
+// grid's (j, i), so that a rank's part does not depend on the order nodes were met (the reader
+// keys each entry by its node).
 std::vector<double> own_edge_velocities(const std::vector<double>& all, const NodeBox& own,
                                         std::array<int, 2> o) {
   std::vector<std::array<double, 5>> e;

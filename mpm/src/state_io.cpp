@@ -121,7 +121,7 @@ StateReader::StateReader(std::string bytes, std::string file)
   if (order != kOrderMark) fail("written on a machine of another byte order");
   if (layout != kLayout)
     fail("checkpoint layout " + std::to_string(layout) + ", this build reads layout " +
-         std::to_string(kLayout));
+         std::to_string(kLayout) + " (written by another version: run the case from the start)");
   std::size_t pos = head;
   auto need = [&](std::size_t n) {
     if (data_.size() - pos < n)

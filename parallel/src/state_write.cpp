@@ -81,7 +81,9 @@ std::string mpi_error(int rc) {
 }  // namespace
 
 std::size_t state_write_piece() { return g_piece; }
-void set_state_write_piece(std::size_t bytes) { g_piece = bytes > 0 ? bytes : 1; }
+void set_state_write_piece(std::size_t bytes) {
+  g_piece = std::clamp<std::size_t>(bytes, 1, std::size_t{1} << 30);
+}
 
 void write_state_collectively(const StateWriter& w, const std::string& path, MPI_Comm comm) {
   int rank = 0, size = 1;
@@ -163,7 +165,8 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
     return rc == MPI_SUCCESS;
   };
   // A stale temporary file (an earlier write that was killed) goes first, so the file holds
-  // only what this write puts (a link is followed, as one process's write follows it).
+  // only what this write puts; a link is followed, as one process's write follows it, and a
+  // regular file behind it is cut to this write's length once written.
   if (rank == 0) {
     std::error_code ec;
     if (std::filesystem::is_regular_file(std::filesystem::symlink_status(tmp, ec)))
@@ -227,6 +230,14 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
   if (ok) {
     check(MPI_File_sync(fh), "cannot sync");
     check(MPI_File_close(&fh), "cannot close");
+  }
+  if (ok && rank == 0 && err.empty()) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(tmp, ec) &&
+        std::filesystem::file_size(tmp, ec) != sum_at + 8) {
+      std::filesystem::resize_file(tmp, sum_at + 8, ec);
+      if (ec) err = "cannot cut " + tmp_name + " to its length: " + ec.message();
+    }
   }
 
   // The first failing rank's reason, to every rank.

@@ -219,8 +219,7 @@ TEST(FemRanks, CheckpointFromTheRanksRestartsOneProcess) {
     one.step();
     split.step();
   }
-  const fs::path file = fs::temp_directory_path() /
-                        ("smpm_fem_ranks_" + std::to_string(world_size()) + ".smpm");
+  const fs::path file = mpi_testing::scratch_folder("fem_ranks", "checkpoint") / "state.smpm";
   StateWriter w;
   split.save_state(w, "fem.");
   write_state_collectively(w, file.string(), MPI_COMM_WORLD);

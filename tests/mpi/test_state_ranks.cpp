@@ -137,6 +137,26 @@ TEST(StateRanks, AFullDiskIsOneErrorOnEveryRank) {
   if (mpi_testing::world_rank() == 0) std::printf("  a full disk: %s\n", what.c_str());
 }
 
+// A temporary file left as a link to a longer file (as a one-process write follows a link and
+// truncates its target): the file behind it is cut to the checkpoint's length and reads back.
+TEST(StateRanks, ALinkedLongerTemporaryFileIsCutToLength) {
+  const fs::path dir = folder("linked"), file = dir / "state.smpm", big = dir / "big";
+  if (mpi_testing::world_rank() == 0) {
+    std::ofstream(big, std::ios::binary) << std::string(100000, 'x');
+    fs::create_symlink(big, dir / "state.smpm.tmp");
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  StateWriter w;
+  w.put_part("a", part_a(mpi_testing::world_rank()));
+  write_state_collectively(w, file.string(), MPI_COMM_WORLD);
+  if (mpi_testing::world_rank() == 0) {
+    const std::string b = read_bytes(file);
+    EXPECT_LT(b.size(), 100000u);
+    EXPECT_NO_THROW(StateReader(b, file.string()));
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+}
+
 // A plate with a pulse, its layers carrying state (Kelvin-Voigt springs on LK edges; a damping
 // band with a stiffness part and a PML band), stepped on the ranks in slabs: the file the
 // ranks write holds each rank's particles and layer entries bit for bit, the energy account
