@@ -629,8 +629,13 @@ class Builder {
   // A checking builder (`checking` true) reads every key, with a gmsh geometry's physical groups
   // but without meshing it or seeding particles, and stops before the particles would be needed:
   // a case with a geometry is read so first, and its mistakes are reported before the mesh is made.
-  Builder(const Ctx& ctx, const ojson& doc, bool checking = false)
-      : ctx_(ctx), doc_(doc), checking_(checking) {}
+  // On several MPI ranks (`scatter`) rank 0 builds the whole case and the others (`skeleton`) the
+  // case without its particles, which rank 0 then sends them (docs/parallel.md "Set-up"); the
+  // checks that need the particles run on rank 0 only. Not with multi-field contact, whose
+  // material groups follow the particles: every rank then builds the whole case.
+  Builder(const Ctx& ctx, const ojson& doc, bool checking = false, bool scatter = false,
+          bool skeleton = false)
+      : ctx_(ctx), doc_(doc), checking_(checking), scatter_(scatter), skeleton_(skeleton) {}
 
   Case build() {
     if (!doc_.is_object())
@@ -667,6 +672,10 @@ class Builder {
       c.notes.push_back("gravity (" + fmt(g[0]) + ", " + fmt(g[1]) + ") m/s^2");
     }
     if (const ojson* ct = top.find("contact")) parse_contact(Obj(ctx_, *ct, "contact"), c);
+    c.scattered = scatter_ && !s_->contact.multi();
+    scattered_ = c.scattered;
+    skeleton_ = skeleton_ && c.scattered;
+    s_->seed_nothing = skeleton_;
     if (const ojson* o = top.find("output")) parse_output(Obj(ctx_, *o, "output"), c.output);
     parse_materials(top);
     if (const ojson* g = top.find("geometry")) parse_geometry(Obj(ctx_, *g, "geometry"));
@@ -692,11 +701,11 @@ class Builder {
         parse_boundary(Obj(ctx_, (*bnd)[i], index_path("boundaries", i)), i, c);
     if (checking_) return c;  // no solver: the keys are read
 
-    note_particles_on_grid_lines(c);
+    if (!skeleton_) note_particles_on_grid_lines(c);
     s_->finalize();
     // A point probe must see particles (of its body, when it names one): else it would record
     // zeros all run. (Points along a curve are checked against their bodies when placed.)
-    for (std::size_t q = 0; q < c.probes.size(); ++q) {
+    for (std::size_t q = 0; q < c.probes.size() && !skeleton_; ++q) {
       const ProbeSpec& pr = c.probes[q];
       if (!pr.along.empty()) continue;
       if (pr.region) {
@@ -714,7 +723,7 @@ class Builder {
                       (pr.body >= 0 ? " named \"" + bodies_[pr.body].name + "\"" : std::string()) +
                       ": no particle within a cell of it, so it would record zeros");
     }
-    const long out = s_->first_particle_outside();
+    const long out = skeleton_ ? -1 : s_->first_particle_outside();
     if (out >= 0) {
       const auto k = static_cast<std::size_t>(out);
       const int b = s_->p.body[k];
@@ -743,6 +752,9 @@ class Builder {
   const Ctx& ctx_;
   const ojson& doc_;
   const bool checking_;  // read the keys only (see the constructor)
+  const bool scatter_;   // several ranks: rank 0 sends the others their particles
+  bool skeleton_;        // this rank builds the case without its particles
+  bool scattered_ = false;  // scatter_, and the case allows it
   GridSpec grid_;
   std::unique_ptr<Solver> s_ = std::make_unique<Solver>();
   std::vector<Material> materials_;
@@ -1049,7 +1061,8 @@ class Builder {
                               " particles); this machine has " + fmt_down(phys / 1e9) +
                               " GB of memory: use larger cells or a smaller grid");
     }
-    s_->grid.init(grid_.x0, grid_.y0, grid_.h, grid_.nx, grid_.ny);
+    // Split from the start (scatter): the ranks' windows hold the nodal fields, not this grid.
+    s_->grid.init(grid_.x0, grid_.y0, grid_.h, grid_.nx, grid_.ny, !scattered_);
     s_->materials = materials_;
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
       const auto& b = bodies_[i];
@@ -1162,7 +1175,7 @@ class Builder {
     if (checking_) return {};  // no particles yet
     BoundaryLayer layer = s_->select_layer(name, bi, e.ex0, e.ey0, e.ex1, e.ey1, e.nx, e.ny, width);
     what = side + " side of body \"" + b.name + "\"" + part + ", width " + fmt(width);
-    if (layer.ids.empty()) o.fail("", "selects no particle (" + what + ")");
+    if (layer.ids.empty() && !skeleton_) o.fail("", "selects no particle (" + what + ")");
     return layer;
   }
 
@@ -1278,7 +1291,7 @@ class Builder {
                               fmt(other.alpha) + ", this one " + fmt(band.alpha) + ")");
       o.done();
       std::size_t inside = 0;  // particles inside the band (its depth > 0 at their centre)
-      if (!checking_) {
+      if (!checking_ && !skeleton_) {
         const Particles& P = s_->p;
         for (std::size_t k = 0; k < P.size(); ++k) {
           if (P.body[k] != band.body) continue;
@@ -1561,7 +1574,7 @@ class Builder {
       o.fail("curve", std::string(e.what()) + " (body \"" + b.name + "\")");
     }
     what = label + " of body \"" + b.name + "\", width " + fmt(width);
-    if (layer.ids.empty())
+    if (layer.ids.empty() && !skeleton_)
       o.fail("curve", geo_->file + ": " + label + " selects no particle of body \"" + b.name +
                           "\" (none within width " + fmt(width) + " of the curve)");
     return layer;
@@ -1592,9 +1605,10 @@ class Builder {
   }
 };
 
-Case build_ordered(const Ctx& ctx, const ojson& doc, bool checking = false) {
+Case build_ordered(const Ctx& ctx, const ojson& doc, bool checking = false, bool scatter = false,
+                   bool skeleton = false) {
   try {
-    return Builder(ctx, doc, checking).build();
+    return Builder(ctx, doc, checking, scatter, skeleton).build();
   } catch (const CaseError&) {
     throw;
   } catch (const std::bad_alloc&) {
@@ -1610,7 +1624,8 @@ std::string did_you_mean(const std::string& word, const std::vector<std::string>
   return detail::suggestion(word, candidates);
 }
 
-Case load_case(const std::string& path, const std::vector<std::string>& overrides) {
+namespace {
+std::string read_case_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw CaseError(path + ": cannot open file (it is a directory)");
@@ -1619,17 +1634,50 @@ Case load_case(const std::string& path, const std::vector<std::string>& override
   std::ostringstream ss;
   ss << f.rdbuf();
   if (f.bad()) throw CaseError(path + ": cannot read file");
-  return load_case_text(ss.str(), path, overrides);
+  return ss.str();
+}
+
+Case load_text(const std::string& text, const std::string& source,
+               const std::vector<std::string>& overrides, bool scatter, bool skeleton) {
+  Ctx ctx{source, {}};
+  ojson doc = parse_text(text, source);
+  for (const auto& o : overrides) apply_override(ctx, doc, o);
+  Case c = build_ordered(ctx, doc, false, scatter, skeleton);
+  c.fingerprint = detail::case_fingerprint(doc);
+  return c;
+}
+}  // namespace
+
+Case load_case(const std::string& path, const std::vector<std::string>& overrides) {
+  return load_text(read_case_file(path), path, overrides, false, false);
+}
+
+Case load_case_on_ranks(const std::string& path, const std::vector<std::string>& overrides) {
+  const detail::MpiModule* mpi = detail::mpi();
+  if (!mpi || mpi->size() <= 1) return load_case(path, overrides);
+  const bool root = mpi->rank() == 0;
+  std::string error;
+  Case c;
+  try {
+    c = load_text(read_case_file(path), path, overrides, true, !root);
+  } catch (const std::exception& e) {
+    error = e.what();
+    if (error.empty()) error = path + ": the case could not be built";
+  }
+  // Every rank learns whether any failed, then takes rank 0's message (rank 0 built the whole
+  // case and ran every check; a rank whose skeleton failed alone names its rank).
+  if (!mpi->any(!error.empty())) return c;
+  std::string verdict = error;
+  mpi->broadcast(verdict);
+  if (verdict.empty())
+    verdict = error.empty() ? path + ": the case could not be built on another rank"
+                            : error + " (rank " + std::to_string(mpi->rank()) + ")";
+  throw CaseError(verdict);
 }
 
 Case load_case_text(const std::string& text, const std::string& source,
                     const std::vector<std::string>& overrides) {
-  Ctx ctx{source, {}};
-  ojson doc = parse_text(text, source);
-  for (const auto& o : overrides) apply_override(ctx, doc, o);
-  Case c = build_ordered(ctx, doc);
-  c.fingerprint = detail::case_fingerprint(doc);
-  return c;
+  return load_text(text, source, overrides, false, false);
 }
 
 namespace {

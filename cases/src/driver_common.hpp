@@ -101,7 +101,9 @@ class MpmSnapshots {
 // nothing is cut and every call is the solver's own.
 class MpmRanks {
  public:
-  MpmRanks(Solver& s, int across);
+  // `scattered`: rank 0 holds the whole body and the other ranks a skeleton (load_case_on_ranks);
+  // the split sends each rank its block.
+  MpmRanks(Solver& s, int across, bool scattered = false);
   // Cuts the solver to this rank's block, once (nothing on one process); true when it cut now.
   bool split();
   Decomposition* dist() const { return dist_.get(); }
@@ -131,6 +133,7 @@ class MpmRanks {
     int nx, ny;
   } whole_;  // the grid of the whole case (a rank's solver holds its window of it)
   int across_ = 0;
+  bool scattered_ = false;
   std::unique_ptr<Decomposition> dist_;
 };
 

@@ -44,7 +44,7 @@ struct FarFieldModule {
 };
 
 // Bumped whenever the table or a signature in it changes.
-inline constexpr int kMpiModuleApi = 4;
+inline constexpr int kMpiModuleApi = 5;
 
 // The MPI module (parallel/: MPI and PETSc), loaded only when an MPI launcher started the
 // program (processes.cpp).
@@ -56,8 +56,9 @@ struct MpiModule {
   int (*size)();
   // Cuts a finalized solver, built whole on every rank, to this rank's block (`across` ranks
   // across x; 0: the layout with the fewest shared nodes); the decomposition is attached to the
-  // solver and must outlive its steps.
-  std::unique_ptr<Decomposition> (*distribute)(Solver& s, int across);
+  // solver and must outlive its steps. `scatter`: only rank 0 holds the particles (the others
+  // are skeletons, Solver::seed_nothing), and it sends each rank its block's.
+  std::unique_ptr<Decomposition> (*distribute)(Solver& s, int across, bool scatter);
   bool (*any)(bool b);                 // over every rank
   void (*abort)(int code);             // MPI_Abort: every rank stops
   void (*broadcast)(std::string& bytes);  // rank 0's bytes to every rank (collective)

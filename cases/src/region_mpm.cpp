@@ -16,12 +16,13 @@ namespace smpm::detail {
 static_assert(kLayerSilent == 1 && kLayerTraction == 2 && kLayerSpring == 4 &&
               kLayerDamping == 8 && kLayerPml == 16);
 
-MpmRanks::MpmRanks(Solver& s, int across)
-    : s_(s), whole_{s.grid.x0, s.grid.y0, s.grid.h, s.grid.nx, s.grid.ny}, across_(across) {}
+MpmRanks::MpmRanks(Solver& s, int across, bool scattered)
+    : s_(s), whole_{s.grid.x0, s.grid.y0, s.grid.h, s.grid.nx, s.grid.ny}, across_(across),
+      scattered_(scattered) {}
 
 bool MpmRanks::split() {
   if (dist_ || !mpi()) return false;
-  dist_ = mpi()->distribute(s_, across_);
+  dist_ = mpi()->distribute(s_, across_, scattered_);
   return true;
 }
 
@@ -116,7 +117,8 @@ namespace {
 
 class MpmRegion final : public Region {
  public:
-  MpmRegion(Case& c, int across, bool resuming) : c_(c), s_(*c.solver), ranks_(s_, across) {
+  MpmRegion(Case& c, int across, bool resuming)
+      : c_(c), s_(*c.solver), ranks_(s_, across, c.scattered) {
     for (const auto& pr : c.probes) {
       pts_.push_back({pr.x, pr.y});
       bodies_.push_back(pr.body);

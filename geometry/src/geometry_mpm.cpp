@@ -207,6 +207,7 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
   }
   std::size_t count = 0;
   for (uint8_t m : mark) count += m;
+  if (sol.seed_nothing) return count;
   const double rho = sol.materials.at(group).rho;
   Particles& p = sol.p;
   const std::size_t first = p.size();

@@ -53,6 +53,7 @@ std::size_t Solver::seed_rectangle(double x0, double y0, double x1, double y1, i
   const long cy = std::max(1L, std::lround((y1 - y0) / sp));
   const double dx = (x1 - x0) / cx, dy = (y1 - y0) / cy;
   const double rho = materials.at(group).rho;
+  if (seed_nothing) return cx * cy;
   const std::size_t first = p.size();
   p.resize(first + cx * cy);
   std::size_t k = first;
@@ -236,10 +237,12 @@ void Solver::finalize() {
       }
     pml.pic.push_back(std::pow(std::min(depth, 1.0), kPmlPicPower));
   }
-  if (pml.active()) {
-    const std::size_t n = pml.layer.ids.size();
+  if (!pml_bands.empty()) {  // (a skeleton too: its particles arrive later)
     pml.layer.name = "pml";
     pml.alpha = pml_bands.front().alpha;
+  }
+  if (pml.active()) {
+    const std::size_t n = pml.layer.ids.size();
     pml.H.assign(4 * n, 0.0);
     pml.u.assign(2 * n, 0.0);
     pml.xi.assign(4 * n, 0.0);
@@ -1120,9 +1123,9 @@ void Solver::boundary_work(bool remapped) {
     if (!(dl.beta0 > 0)) continue;
     // The stiffness-proportional part: the work of the viscous force this step applied (with
     // the power's velocity), then the viscous stress beta C : D for the next, D the strain rate
-    // of the velocity that strains the particles (MUSL's re-mapped, USL's v+; under USF, whose
-    // particles the start velocity strained, v+), all with the gradients the force was mapped
-    // with (apply_loads: the positions at the step's start).
+    // of the updated velocity (MUSL's re-mapped, USL's and USF's v+; under USF the start
+    // velocity has already strained the particles this step), all with the gradients the force
+    // was mapped with (apply_loads: the positions at the step's start).
     const std::vector<double>& sx = opt.scheme == Scheme::USF ? grid.vnx : ux;
     const std::vector<double>& sy = opt.scheme == Scheme::USF ? grid.vny : uy;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {

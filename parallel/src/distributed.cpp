@@ -175,7 +175,49 @@ struct Distributed::Impl {
   }
 };
 
-Distributed::Distributed(Solver& s, MPI_Comm comm, int across) : d_(std::make_unique<Impl>()) {
+namespace {
+
+// Rank 0's bytes or doubles to every rank, in pieces of at most 2^30 (an MPI count is an int).
+template <class T>
+void broadcast_all(std::vector<T>& v, MPI_Datatype type, MPI_Comm comm) {
+  unsigned long long n = v.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
+  v.resize(n);
+  for (unsigned long long at = 0; at < n;) {
+    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
+    MPI_Bcast(v.data() + at, piece, type, 0, comm);
+    at += static_cast<unsigned long long>(piece);
+  }
+}
+
+constexpr int kScatterTag = 7304;
+
+// Rank 0 sends `v` to `to`, which receives it (its length first, then pieces of at most 2^30).
+void send_doubles(const std::vector<double>& v, int to, MPI_Comm comm) {
+  unsigned long long n = v.size();
+  MPI_Send(&n, 1, MPI_UNSIGNED_LONG_LONG, to, kScatterTag, comm);
+  for (unsigned long long at = 0; at < n;) {
+    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
+    MPI_Send(v.data() + at, piece, MPI_DOUBLE, to, kScatterTag, comm);
+    at += static_cast<unsigned long long>(piece);
+  }
+}
+std::vector<double> receive_doubles(int from, MPI_Comm comm) {
+  unsigned long long n = 0;
+  MPI_Recv(&n, 1, MPI_UNSIGNED_LONG_LONG, from, kScatterTag, comm, MPI_STATUS_IGNORE);
+  std::vector<double> v(n);
+  for (unsigned long long at = 0; at < n;) {
+    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
+    MPI_Recv(v.data() + at, piece, MPI_DOUBLE, from, kScatterTag, comm, MPI_STATUS_IGNORE);
+    at += static_cast<unsigned long long>(piece);
+  }
+  return v;
+}
+
+}  // namespace
+
+Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
+    : d_(std::make_unique<Impl>()) {
   Impl& d = *d_;
   d.comm = comm;
   MPI_Comm_rank(comm, &d.rank);
@@ -214,6 +256,16 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across) : d_(std::make_un
     const double c = s.materials[s.p.group[k]].model == Model::J2Film ? 5.0 : 1.0;
     cx[ci] += c;
     cy[cj] += c;
+  }
+  if (scatter) {  // rank 0 holds the body: its costs, its grid's constraints and body scalars
+    broadcast_all(cx, MPI_DOUBLE, comm);
+    broadcast_all(cy, MPI_DOUBLE, comm);
+    std::vector<std::uint8_t> fix(s.grid.fix.begin(), s.grid.fix.end());
+    broadcast_all(fix, MPI_UNSIGNED_CHAR, comm);
+    std::copy(fix.begin(), fix.end(), s.grid.fix.begin());
+    std::array<double, 4> b = s.body_scalars();
+    MPI_Bcast(b.data(), 4, MPI_DOUBLE, 0, comm);
+    s.set_body_scalars(b);
   }
   d.Cx = cuts(cx, d.m, d.w);
   d.Ry = cuts(cy, d.n, d.w);
@@ -267,12 +319,25 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across) : d_(std::make_un
       if (sl.form == SilentForm::Nodal) return true;
     return !s.dampers.empty() || !s.pml_bands.empty();
   }();
-  std::vector<std::uint8_t> keep(s.p.size(), 0);
-  for (std::size_t k = 0; k < s.p.size(); ++k) {
+  auto owner = [&](std::size_t k) {
     int ci, cj;
     cell(k, ci, cj);
-    keep[k] = ci >= d.Cx[d.pi] && ci < d.Cx[d.pi + 1] && cj >= d.Ry[d.pj] && cj < d.Ry[d.pj + 1];
+    return std::clamp(part_of(d.Ry, cj), 0, d.n - 1) * d.m + std::clamp(part_of(d.Cx, ci), 0, d.m - 1);
+  };
+  if (scatter && d.rank == 0) {  // every other rank's particles, with their layer entries
+    for (int r = 1; r < P; ++r) {
+      std::vector<int> to(s.p.size(), -1);
+      for (std::size_t k = 0; k < s.p.size(); ++k)
+        if (owner(k) == r) to[k] = 0;
+      std::vector<std::vector<double>> out(1);
+      s.export_particles(to, out);
+      send_doubles(out[0], r, comm);
+    }
+  } else if (scatter) {
+    s.import_particles(receive_doubles(0, comm));
   }
+  std::vector<std::uint8_t> keep(s.p.size(), 0);
+  for (std::size_t k = 0; k < s.p.size(); ++k) keep[k] = owner(k) == d.rank;
   Grid win;
   win.init(g.x0 + d.gx0 * g.h, g.y0 + d.gy0 * g.h, g.h, d.gnx - 1, d.gny - 1);
   for (int j = 0; j < d.gny; ++j)

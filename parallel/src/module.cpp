@@ -25,8 +25,8 @@ int size() {
   MPI_Comm_size(MPI_COMM_WORLD, &n);
   return n;
 }
-std::unique_ptr<Decomposition> distribute(Solver& s, int across) {
-  return std::make_unique<Distributed>(s, MPI_COMM_WORLD, across);
+std::unique_ptr<Decomposition> distribute(Solver& s, int across, bool scatter) {
+  return std::make_unique<Distributed>(s, MPI_COMM_WORLD, across, scatter);
 }
 bool any(bool b) {
   int v = b ? 1 : 0;

@@ -56,6 +56,7 @@ struct PlateSpec {
   // the particle form, and gravity.
   bool other_layers = false;
   bool updated = false;        // MUSL, USF: the LK edges strained with the updated velocity
+  bool skeleton = false;       // the case without its particles (Solver::seed_nothing)
 };
 
 // A tungsten plate on a grid with margins: a sin^2 pressure pulse on its top edge, LK silent
@@ -67,6 +68,7 @@ std::unique_ptr<Solver> make_plate(const PlateSpec& c) {
   s->materials.push_back(tungsten());
   s->grid.init(-3 * h, -3 * h, h, c.nx + 6, c.ny + 6);
   const double W = c.nx * h, H = c.ny * h;
+  s->seed_nothing = c.skeleton;
   s->seed_rectangle(0, 0, W, H, c.ppc, 0, 0, 0, c.vy0);
   if (c.spin != 0)
     for (std::size_t k = 0; k < s->p.size(); ++k) {
@@ -412,6 +414,77 @@ TEST(Ranks, MultiFieldContactAgreesWithOneProcess) {
       EXPECT_LE(df, 1e-10 * fmax) << what << ": contact force";
     }
   }
+}
+
+// Set-up from rank 0 (docs/parallel.md "Set-up"): rank 0 builds the whole plate, the others its
+// skeleton, and the split sends each rank its block. Each rank then holds what the split of the
+// plate built whole on every rank gives it: the same particles, every array bit for bit by id,
+// and the same layer entries with every per-entry value (normals, widths, impedances, springs,
+// band and PML coefficients), in the same order: 200 steps on, the two are bit-identical.
+TEST(Ranks, SetUpFromRankZeroAsTheWholeCaseSplit) {
+  for (const bool other : {false, true})
+    for (int l : layouts()) {
+      PlateSpec c;
+      c.other_layers = other;
+      c.scheme = other ? Scheme::USL : Scheme::MUSL;
+      auto whole = make_plate(c);
+      Distributed dw(*whole, MPI_COMM_WORLD, l);
+      PlateSpec k = c;
+      k.skeleton = mpi_testing::world_rank() != 0;
+      auto sent = make_plate(k);
+      Distributed ds(*sent, MPI_COMM_WORLD, l, true);
+      const std::string what = std::string(other ? "band, PML, particle LK" : "LK, springs") +
+                               ", " + layout_name(l);
+      ASSERT_EQ(sent->p.size(), whole->p.size()) << what;
+      // Every particle array by id.
+      std::map<std::uint32_t, std::size_t> at;
+      for (std::size_t q = 0; q < sent->p.size(); ++q) at[sent->p.id[q]] = q;
+      long same = 0;
+      for (std::size_t q = 0; q < whole->p.size(); ++q) {
+        const auto it = at.find(whole->p.id[q]);
+        if (it == at.end()) continue;
+        const std::size_t r = it->second;
+        const Particles &a = whole->p, &b = sent->p;
+        same += a.x[q] == b.x[r] && a.y[q] == b.y[r] && a.vx[q] == b.vx[r] && a.vy[q] == b.vy[r] &&
+                a.mass[q] == b.mass[r] && a.vol[q] == b.vol[r] && a.sxx[q] == b.sxx[r] &&
+                a.group[q] == b.group[r] && a.body[q] == b.body[r];
+      }
+      EXPECT_EQ(same, static_cast<long>(whole->p.size())) << what;
+      // Every layer entry by its particle's id, with its values.
+      auto entries = [](const Solver& s) {
+        std::map<std::pair<int, std::uint32_t>, std::vector<double>> e;
+        int n = 0;
+        auto put = [&](const BoundaryLayer& L, std::initializer_list<const std::vector<double>*> v) {
+          for (std::size_t q = 0; q < L.ids.size(); ++q) {
+            std::vector<double>& row = e[{n, L.ids[q]}];
+            row = {L.nx[q], L.ny[q], L.d[q], L.w[q]};
+            for (const auto* a : v) row.push_back(a->empty() ? 0.0 : (*a)[q]);
+          }
+          ++n;
+        };
+        for (const auto& t : s.tractions) put(t.layer, {});
+        for (const auto& l : s.silents) put(l.layer, {&l.zn, &l.zt, &l.kn, &l.kt, &l.ux, &l.uy});
+        for (const auto& d : s.dampers) put(d.layer, {&d.alpha, &d.beta});
+        for (std::size_t q = 0; q < s.pml.layer.ids.size(); ++q)
+          e[{n, s.pml.layer.ids[q]}] = {s.pml.dx[q], s.pml.dy[q], s.pml.pic[q]};
+        return e;
+      };
+      const auto ew = entries(*whole), es = entries(*sent);
+      EXPECT_EQ(es.size(), ew.size()) << what;
+      EXPECT_TRUE(es == ew) << what << ": layer entries";
+      EXPECT_EQ(sent->dt, whole->dt) << what;
+      EXPECT_EQ(sent->critical_dt(), whole->critical_dt()) << what;
+      // On: both as one process.
+      for (int n = 0; n < 200; ++n) {
+        whole->step();
+        sent->step();
+      }
+      whole->update_energies();
+      sent->update_energies();
+      const Outcome a{gather(*whole), whole->total_energy(), 0, 0};
+      const Outcome b{gather(*sent), sent->total_energy(), 0, 0};
+      expect_agreement(b, a, "set-up from rank 0 against the split whole case, " + what, 0.0);
+    }
 }
 
 TEST(Ranks, TooManyRanksForTheGridIsAnError) {

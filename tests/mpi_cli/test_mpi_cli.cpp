@@ -234,6 +234,29 @@ TEST(MpiCli, UnreadableGeometryOrMeshIsOneProcessError) {
   }
 }
 
+// Rank 0 alone builds the whole case (the others its skeleton, without particles), so the
+// checks that need the particles run there: a probe in no body, a body off the grid. Its error
+// is every rank's: one line, the same as one process's, exit 1, before the output folder.
+TEST(MpiCli, ParticleChecksOfRankZeroAreEveryRanksError) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const fs::path o = out_dir("particle_checks");
+  for (const std::string& args : {kCase + kShort + " --set probes.0.at=[0.052,0.2]",
+                                  kCase + kShort + " --set grid.size=[0.03,0.204]"}) {
+    const Proc one = run(0, args + " --out " + o.string(), "checks1");
+    const Proc two = run(2, args + " --out " + o.string(), "checks2");
+    EXPECT_EQ(one.status, 1) << one.err;
+    EXPECT_EQ(two.status, 1) << two.err;
+    const std::string line = one.err.substr(0, one.err.find('\n'));
+    EXPECT_EQ(two.err.substr(0, two.err.find('\n')), line) << two.err;
+    std::size_t n = 0;
+    for (std::size_t at = two.err.find("silentmpm: error"); at != std::string::npos;
+         at = two.err.find("silentmpm: error", at + 1))
+      ++n;
+    EXPECT_EQ(n, 1u) << two.err;
+    EXPECT_FALSE(fs::exists(o));
+  }
+}
+
 // The FE far field (fem_square.json: a traction pulse, PMLs on two sides meeting in a corner,
 // dashpots, a damping band (mass and stiffness parts) before Kelvin-Voigt springs, gravity; Q1
 // and Q2) on 1, 2, 3 and 4

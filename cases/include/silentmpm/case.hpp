@@ -79,6 +79,9 @@ struct Case {
   // Both an MPM and an FEM region (cases/fe/case_hybrid.cpp): the coupled step over solver and fem.
   std::shared_ptr<Hybrid> hybrid;
   std::vector<std::string> notes;  // human-readable description of the loads (time functions...)
+  // Several MPI ranks (load_case_on_ranks): rank 0 built the whole case and every other rank its
+  // skeleton; the split sends each rank its block's particles from rank 0.
+  bool scattered = false;
   // Hash of the validated document without the keys a restart may change (checkpoints carry it).
   std::uint64_t fingerprint = 0;
 };
@@ -87,6 +90,12 @@ struct Case {
 // string if it is not valid JSON) applied before validation; array elements by index
 // ("bodies.0.particles_per_cell=4").
 Case load_case(const std::string& path, const std::vector<std::string>& overrides = {});
+// Under an MPI launcher with several ranks (collective): rank 0 builds the whole case, the others
+// build it without particles (an MPM case without multi-field contact; any other case is built
+// whole on every rank), and the split sends each rank its block (docs/parallel.md "Set-up"), so
+// that only rank 0 holds every particle at start-up. Rank 0's verdict on the case is every
+// rank's: its error, when it has one, is thrown on every rank. On one process: load_case.
+Case load_case_on_ranks(const std::string& path, const std::vector<std::string>& overrides = {});
 // Same from the text of a case file; `source` names it in messages, and relative paths in it
 // are taken from source's folder (the working directory when source has none).
 Case load_case_text(const std::string& text, const std::string& source,

@@ -24,7 +24,9 @@ struct Grid {
   // Essential conditions: bit 0 fixes the x velocity, bit 1 fixes y.
   std::vector<uint8_t> fix;
 
-  void init(double x0_, double y0_, double h_, int nx_, int ny_);
+  // The geometry and the constraint flags; the nodal fields too unless `fields` is false (a grid
+  // that only describes the whole one to a split over ranks, whose windows hold the fields).
+  void init(double x0_, double y0_, double h_, int nx_, int ny_, bool fields = true);
   std::size_t nodes() const { return static_cast<std::size_t>(nnx) * nny; }
   double node_x(int i) const { return x0 + i * h; }
   double node_y(int j) const { return y0 + j * h; }

@@ -96,8 +96,13 @@ class Solver {
   Contact contact;  // contact of bodies: single velocity field (default) or one per body
 
   // --- setup -------------------------------------------------------------------------------
+  // A rank's skeleton (several MPI ranks; docs/parallel.md "Set-up"): seeding counts the
+  // particles it would add and adds none, so that the solver has the case's structure (its
+  // materials, layers, loads and settings) without the body, which rank 0 sends it in blocks.
+  bool seed_nothing = false;
   // Fill the rectangle [x0, x1] x [y0, y1] with particles on a lattice of n x n per cell
-  // (n = 1, 2, 3), spacing adjusted so the rectangle is covered exactly. Returns the number added.
+  // (n = 1, 2, 3), spacing adjusted so the rectangle is covered exactly. Returns the number added
+  // (with seed_nothing, the number it would add).
   std::size_t seed_rectangle(double x0, double y0, double x1, double y1, int n_per_side,
                              int group, int body, double vx0, double vy0);
   // Particles of `body` within `width` inside the straight edge p0 -> p1 whose outward normal is
@@ -108,6 +113,17 @@ class Solver {
   std::vector<uint32_t> nodes_in_box(double x0, double y0, double x1, double y1) const;
   // Call once after seeding and adding boundary conditions.
   void finalize();
+  // What finalize() and the time step take from the whole body: dt, the void threshold, the
+  // largest beta at a particle and the energy bound's floor. A skeleton takes rank 0's.
+  std::array<double, 4> body_scalars() const {
+    return {dt, mass_floor_, viscous_beta_, energy_floor_};
+  }
+  void set_body_scalars(const std::array<double, 4>& v) {
+    dt = v[0];
+    mass_floor_ = v[1];
+    viscous_beta_ = v[2];
+    energy_floor_ = v[3];
+  }
   // h / max c_d over materials present, lowered by the damping layers' stiffness parts (the
   // largest sum of beta over the layers at one particle, taken at finalize() on the whole body).
   double critical_dt() const;

@@ -24,10 +24,13 @@ class Distributed final : public Decomposition {
  public:
   // Cuts a finalized solver, on which every rank of comm built the whole case, to this rank's
   // block and attaches itself to it (it must outlive the solver's steps). `across`: ranks
-  // across x (1: slabs of rows; 0: the layout with the fewest shared nodes). Throws
+  // across x (1: slabs of rows; 0: the layout with the fewest shared nodes). `scatter`: rank 0
+  // built the whole case and the others its skeleton (Solver::seed_nothing): rank 0's costs,
+  // grid constraints and body scalars go to every rank, and rank 0 sends each rank its block's
+  // particles with their layer entries (docs/parallel.md "Set-up"). Throws
   // std::runtime_error, on every rank, when the ranks do not divide by `across` or the grid has
   // fewer cells than the blocks need (the halo's width each way).
-  Distributed(Solver& s, MPI_Comm comm, int across = 0);
+  Distributed(Solver& s, MPI_Comm comm, int across = 0, bool scatter = false);
   ~Distributed() override;
   Distributed(const Distributed&) = delete;
   Distributed& operator=(const Distributed&) = delete;
