@@ -208,10 +208,10 @@ int run_main(int argc, char** argv) {
     if (*run && !shape.empty()) setting("scheme", "shape", nlohmann::json(shape).dump());
     if (*run && quiet) setting("output", "progress", "false");
     overrides.insert(overrides.begin(), cli.begin(), cli.end());
-    // A run on several ranks from the start: rank 0 builds the whole case, the others receive
-    // their blocks from it (a restart reads the whole checkpoint on every rank: whole cases).
-    smpm::Case c = *run && restart.empty() ? smpm::load_case_on_ranks(case_path, overrides)
-                                            : smpm::load_case(case_path, overrides);
+    // A run on several ranks: rank 0 builds the whole case (and reads a restart's whole
+    // checkpoint), the others receive their blocks from it.
+    smpm::Case c = *run ? smpm::load_case_on_ranks(case_path, overrides)
+                        : smpm::load_case(case_path, overrides);
     smpm::RunOptions ropt;
     ropt.restart = restart;
     ropt.ranks_across = ranks_across;

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -82,7 +83,26 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
                  std::string& history, std::string& note) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) throw StateError(file + ": no such checkpoint file");
-  StateReader r(read_whole(file), file);
+  // A case set up from rank 0 (load_case_on_ranks): rank 0 reads the whole checkpoint, the
+  // others what is not the particles' (the clock, the accounts, the run record), which rank 0
+  // sends them; rank 0's error is every rank's. The particles follow with the split.
+  std::optional<StateReader> reader;
+  if (process_count() > 1 && c.scattered) {
+    std::string error, rest;
+    if (process_rank() == 0) try {
+        reader.emplace(read_whole(file), file);
+        rest = reader->without({"mpm.p.", "mpm.silent", "mpm.damper", "mpm.pml"});
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+    detail::mpi()->broadcast(error);
+    if (!error.empty()) throw StateError(error);
+    detail::mpi()->broadcast(rest);
+    if (process_rank() != 0) reader.emplace(std::move(rest), file);
+  } else {
+    reader.emplace(read_whole(file), file);
+  }
+  const StateReader& r = *reader;
   const std::string version = r.get_string("run.version");
   if (version != SMPM_VERSION)
     r.fail("written by silentmpm " + version + ", this is " + SMPM_VERSION +

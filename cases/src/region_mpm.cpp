@@ -169,9 +169,27 @@ class MpmRegion final : public Region {
     else s_.save_state(w, "mpm.");
     snaps_.save(w);
   }
+  // Set up from rank 0 (c.scattered): rank 0 loads the whole body, the others the clock and the
+  // accounts; rank 0's error is every rank's; the split then sends each rank its particles.
   bool restore(const StateReader& r) override {
     snaps_.restore(r);
-    const bool same_order = s_.load_state(r, "mpm.");
+    const bool skeleton = c_.scattered && mpi() && mpi()->rank() != 0;
+    bool same_order = false;
+    std::string error;
+    try {
+      if (skeleton) s_.load_clock(r, "mpm.");
+      else same_order = s_.load_state(r, "mpm.");
+    } catch (const std::exception& e) {
+      if (!c_.scattered || !mpi()) throw;
+      error = e.what();
+    }
+    if (c_.scattered && mpi() && mpi()->any(!error.empty())) {
+      std::string verdict = error;
+      mpi()->broadcast(verdict);
+      throw StateError(verdict.empty() ? r.file() + ": the checkpoint could not be read on rank " +
+                                             std::to_string(mpi()->rank())
+                                       : verdict);
+    }
     if (!mpi()) return same_order;
     const Energies e = s_.energy;
     split();

@@ -154,6 +154,30 @@ void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
     w.put_part(pre + "edge_velocity", own_edge_velocities(edge_velocity_, own_, window_origin()));
 }
 
+void Solver::load_clock(const StateReader& r, const std::string& pre) {
+  const double dt_saved = r.get<double>(pre + "dt");
+  if (dt_saved != dt)
+    r.fail("time step " + std::to_string(dt_saved) + " s in the checkpoint, " + std::to_string(dt) +
+           " s in this case (a checkpoint of another case)");
+  t = r.get<double>(pre + "t");
+  steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
+  energy = r.get<Energies>(pre + "energy");
+  contact.dissipated = r.get<double>(pre + "contact_dissipated");
+  edge_velocity_.clear();
+  if (usf_edges()) {
+    r.get(pre + "edge_velocity", edge_velocity_);
+    if (edge_velocity_.size() % 5 != 0)
+      r.fail("edge_velocity holds " + std::to_string(edge_velocity_.size()) +
+             " values, not a multiple of 5 (corrupt checkpoint)");
+    for (std::size_t k = 0; k < edge_velocity_.size(); k += 5) {
+      const double i = edge_velocity_[k], j = edge_velocity_[k + 1];
+      if (!(i >= 0 && i < grid.nnx && j >= 0 && j < grid.nny && i == std::floor(i) &&
+            j == std::floor(j)))
+        r.fail("edge_velocity names a node outside the grid (corrupt checkpoint)");
+    }
+  }
+}
+
 bool Solver::load_state(const StateReader& r, const std::string& pre) {
   const std::size_t n = p.size();
   if (r.get<std::uint8_t>(pre + "film") != static_cast<std::uint8_t>(p.has_film()))
@@ -185,27 +209,7 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
       reorder_by_ids(r, pre + "pml", pml.layer, n,
                      {{&pml.H, 4}, {&pml.u, 2}, {&pml.xi, 4}, {&pml.zeta, 4}});
   }
-  const double dt_saved = r.get<double>(pre + "dt");
-  if (dt_saved != dt)
-    r.fail("time step " + std::to_string(dt_saved) + " s in the checkpoint, " + std::to_string(dt) +
-           " s in this case (a checkpoint of another case)");
-  t = r.get<double>(pre + "t");
-  steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
-  energy = r.get<Energies>(pre + "energy");
-  contact.dissipated = r.get<double>(pre + "contact_dissipated");
-  edge_velocity_.clear();
-  if (usf_edges()) {
-    r.get(pre + "edge_velocity", edge_velocity_);
-    if (edge_velocity_.size() % 5 != 0)
-      r.fail("edge_velocity holds " + std::to_string(edge_velocity_.size()) +
-             " values, not a multiple of 5 (corrupt checkpoint)");
-    for (std::size_t k = 0; k < edge_velocity_.size(); k += 5) {
-      const double i = edge_velocity_[k], j = edge_velocity_[k + 1];
-      if (!(i >= 0 && i < grid.nnx && j >= 0 && j < grid.nny && i == std::floor(i) &&
-            j == std::floor(j)))
-        r.fail("edge_velocity names a node outside the grid (corrupt checkpoint)");
-    }
-  }
+  load_clock(r, pre);
   // What the step indexes with must be valid whatever the file says (a checksum guards against
   // accidents, not edits): ids a permutation, groups and bodies in range, particles finite and
   // on the grid.

@@ -1,6 +1,7 @@
 // Named binary blocks of a run's state (the layout in state_io.hpp).
 #include "silentmpm/state_io.hpp"
 
+#include <algorithm>
 #include <array>
 
 namespace smpm {
@@ -166,6 +167,22 @@ const StateReader::Block& StateReader::find(const std::string& name, std::size_t
 void StateReader::mismatch(const std::string& name, std::size_t got, std::size_t want) const {
   fail("block '" + name + "' holds " + std::to_string(got) + " values, this case has " +
        std::to_string(want) + " (a checkpoint of another case)");
+}
+
+std::string StateReader::without(const std::vector<std::string>& prefixes) const {
+  std::vector<std::pair<std::size_t, std::string>> kept;  // in the file's order
+  for (const auto& [name, b] : blocks_) {
+    bool drop = false;
+    for (const auto& p : prefixes) drop = drop || name.rfind(p, 0) == 0;
+    if (!drop) kept.push_back({b.offset, name});
+  }
+  std::sort(kept.begin(), kept.end());
+  StateWriter w;
+  for (const auto& [offset, name] : kept) {
+    const Block& b = blocks_.at(name);
+    w.put_block(name, b.elem, b.count, data_.data() + b.offset);
+  }
+  return w.bytes();
 }
 
 std::string StateReader::get_string(const std::string& name) const {

@@ -22,6 +22,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -29,6 +31,7 @@
 
 #include "cli_common.hpp"
 #include "silentmpm/history.hpp"
+#include "silentmpm/state_io.hpp"
 
 #ifndef SMPM_MPIEXEC
 #define SMPM_MPIEXEC "mpirun"
@@ -525,6 +528,51 @@ TEST(MpiCli, UsfUpdatedEdgeCheckpointOnTwoRanksRestartsOnAnyCount) {
   expect_checkpoint_restarts(
       kCase + kShort + " --set scheme.update=USF --set boundaries.1.edge_velocity=updated",
       "ckusf", 300, {0, 4}, 1e-10);
+}
+
+// A restart on several ranks: rank 0 reads the whole checkpoint and the others what is not the
+// particles', so rank 0's verdict is every rank's. A checkpoint with a corrupt byte, and one
+// whose particle lies off the grid behind a recomputed checksum (which rank 0 alone sees), are
+// each one error line on 2 ranks, the same as one process's, exit 1.
+TEST(MpiCli, UnusableCheckpointIsOneProcessErrorOnRanks) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  const std::string ck = kCase + kShort + " --set output.checkpoint_every=100";
+  const fs::path a = out_dir("bad_ck");
+  ASSERT_EQ(run(2, ck + " --out " + a.string(), "bad_ck").status, 0);
+  const std::string bytes = case_testing::read_file(a / "checkpoint.smpm");
+  auto write = [&](const std::string& b, const std::string& name) {
+    const fs::path f = a / name;
+    std::ofstream(f, std::ios::binary) << b;
+    return f;
+  };
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x10;
+  std::string far = bytes;
+  const std::string block = "mpm.p.x";
+  const std::size_t at = far.find(block);
+  ASSERT_NE(at, std::string::npos);
+  const double x = 1e9;
+  std::memcpy(&far[at + block.size() + 12], &x, 8);
+  const std::uint64_t sum = state_hash(far.data(), far.size() - 8);
+  std::memcpy(&far[far.size() - 8], &sum, 8);
+  for (const auto& [file, message] :
+       {std::pair{write(flipped, "flipped.smpm"), std::string("checksum mismatch")},
+        std::pair{write(far, "far.smpm"), std::string("is not on the grid")}}) {
+    const fs::path o = out_dir("bad_ck_run");
+    const std::string args = ck + " --out " + o.string() + " --restart " + file.string();
+    const Proc one = run(0, args, "bad_ck1");
+    const Proc two = run(2, args, "bad_ck2");
+    EXPECT_EQ(one.status, 1) << one.err;
+    EXPECT_EQ(two.status, 1) << two.err;
+    const std::string line = one.err.substr(0, one.err.find('\n'));
+    EXPECT_NE(line.find(message), std::string::npos) << line;
+    EXPECT_EQ(two.err.substr(0, two.err.find('\n')), line) << two.err;
+    std::size_t n = 0;
+    for (std::size_t p = two.err.find("silentmpm: error"); p != std::string::npos;
+         p = two.err.find("silentmpm: error", p + 1))
+      ++n;
+    EXPECT_EQ(n, 1u) << two.err;
+  }
 }
 
 // The plate thrown upwards: its top rows leave the grid on the top rank only (20 steps); that

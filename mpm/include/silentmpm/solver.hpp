@@ -218,6 +218,10 @@ class Solver {
   // the checkpoint was cut into another number of strips (another thread count): the particles
   // are then re-sorted, and sums over them run in another order. Throws StateError.
   bool load_state(const StateReader& r, const std::string& prefix);
+  // The part of load_state that is not the particles' (the clock, the time step's check, the
+  // energy account, contact dissipation, USF's kept edge velocities): what a rank whose
+  // particles rank 0 sends it reads (docs/parallel.md "Set-up").
+  void load_clock(const StateReader& r, const std::string& prefix);
   // Split over ranks (collective): every rank puts its particles and its layer entries (with
   // their particles' ids) as its parts of the blocks (StateWriter::put_part), the clock and the
   // energy account summed over the ranks as whole blocks, and no strips (a restart re-sorts).

@@ -84,6 +84,10 @@ class StateWriter {
   // A block's table entry (name length, name, element size, count) and the end block's.
   static std::string block_head(const std::string& name, std::uint32_t elem, std::uint64_t count);
   static std::string end_mark() { return block_head("end", 0, 0); }
+  // A block of `count` values of `elem` bytes each, copied from `data` (a whole block).
+  void put_block(const std::string& name, std::size_t elem, std::size_t count, const void* data) {
+    raw(name, elem, count, data);
+  }
 
  private:
   std::string buf_;
@@ -115,6 +119,9 @@ class StateReader {
     return v;
   }
   std::string get_string(const std::string& name) const;
+  // The file without the blocks whose names start with one of `prefixes` (a new file, with its
+  // own checksum): what a rank that receives its particles from rank 0 reads of a checkpoint.
+  std::string without(const std::vector<std::string>& prefixes) const;
   const std::string& file() const { return file_; }
   [[noreturn]] void fail(const std::string& what) const;
 
