@@ -177,19 +177,6 @@ struct Distributed::Impl {
 
 namespace {
 
-// Rank 0's bytes or doubles to every rank, in pieces of at most 2^30 (an MPI count is an int).
-template <class T>
-void broadcast_all(std::vector<T>& v, MPI_Datatype type, MPI_Comm comm) {
-  unsigned long long n = v.size();
-  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
-  v.resize(n);
-  for (unsigned long long at = 0; at < n;) {
-    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
-    MPI_Bcast(v.data() + at, piece, type, 0, comm);
-    at += static_cast<unsigned long long>(piece);
-  }
-}
-
 constexpr int kScatterTag = 7304;
 
 // Rank 0 sends `v` to `to`, which receives it (its length first, then pieces of at most 2^30).

@@ -58,6 +58,15 @@ fs::path out_dir(const std::string& tag) {
   return d;
 }
 
+// The error lines in a run's stderr (rank 0 alone prints a case's error).
+std::size_t error_lines(const std::string& err) {
+  std::size_t n = 0;
+  for (std::size_t at = err.find("silentmpm: error"); at != std::string::npos;
+       at = err.find("silentmpm: error", at + 1))
+    ++n;
+  return n;
+}
+
 Proc run(int np, const std::string& args, const std::string& tag) {
   const std::string cmd = (np > 0 ? mpirun(np) : std::string("OMP_NUM_THREADS=1 ")) + SMPM_CLI +
                           " run " + args;
@@ -202,12 +211,7 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
     const Proc p = run(2, b.args + " --out " + o.string(), "refused" + std::to_string(k++));
     EXPECT_EQ(p.status, 1) << b.args << "\n" << p.err;
     EXPECT_NE(p.err.find(b.message), std::string::npos) << b.args << "\n" << p.err;
-    // One line from rank 0, not one per rank.
-    std::size_t n = 0;
-    for (std::size_t at = p.err.find("silentmpm: error"); at != std::string::npos;
-         at = p.err.find("silentmpm: error", at + 1))
-      ++n;
-    EXPECT_EQ(n, 1u) << p.err;
+    EXPECT_EQ(error_lines(p.err), 1u) << p.err << "one line from rank 0, not one per rank";
     EXPECT_FALSE(fs::exists(o)) << "refused before the output folder is made";
   }
 }
@@ -228,11 +232,7 @@ TEST(MpiCli, UnreadableGeometryOrMeshIsOneProcessError) {
     const std::string line = one.err.substr(0, one.err.find('\n'));
     EXPECT_NE(line.find("nothere.geo"), std::string::npos) << line;
     EXPECT_EQ(two.err.substr(0, two.err.find('\n')), line);
-    std::size_t n = 0;
-    for (std::size_t at = two.err.find("silentmpm: error"); at != std::string::npos;
-         at = two.err.find("silentmpm: error", at + 1))
-      ++n;
-    EXPECT_EQ(n, 1u) << two.err;
+    EXPECT_EQ(error_lines(two.err), 1u) << two.err;
     EXPECT_FALSE(fs::exists(o));
   }
 }
@@ -251,11 +251,7 @@ TEST(MpiCli, ParticleChecksOfRankZeroAreEveryRanksError) {
     EXPECT_EQ(two.status, 1) << two.err;
     const std::string line = one.err.substr(0, one.err.find('\n'));
     EXPECT_EQ(two.err.substr(0, two.err.find('\n')), line) << two.err;
-    std::size_t n = 0;
-    for (std::size_t at = two.err.find("silentmpm: error"); at != std::string::npos;
-         at = two.err.find("silentmpm: error", at + 1))
-      ++n;
-    EXPECT_EQ(n, 1u) << two.err;
+    EXPECT_EQ(error_lines(two.err), 1u) << two.err;
     EXPECT_FALSE(fs::exists(o));
   }
 }
@@ -567,11 +563,7 @@ TEST(MpiCli, UnusableCheckpointIsOneProcessErrorOnRanks) {
     const std::string line = one.err.substr(0, one.err.find('\n'));
     EXPECT_NE(line.find(message), std::string::npos) << line;
     EXPECT_EQ(two.err.substr(0, two.err.find('\n')), line) << two.err;
-    std::size_t n = 0;
-    for (std::size_t p = two.err.find("silentmpm: error"); p != std::string::npos;
-         p = two.err.find("silentmpm: error", p + 1))
-      ++n;
-    EXPECT_EQ(n, 1u) << two.err;
+    EXPECT_EQ(error_lines(two.err), 1u) << two.err;
   }
 }
 

@@ -9,17 +9,24 @@
 
 namespace smpm {
 
+// Rank 0's values (a string or a vector of `type`) to every rank of comm (collective), in
+// pieces of at most 2^30: the whole may exceed 2^31 - 1 values.
+template <class C>
+void broadcast_all(C& v, MPI_Datatype type, MPI_Comm comm) {
+  unsigned long long n = v.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
+  v.resize(n);
+  for (unsigned long long at = 0; at < n;) {
+    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
+    MPI_Bcast(v.data() + at, piece, type, 0, comm);
+    at += static_cast<unsigned long long>(piece);
+  }
+}
+
 // Rank 0's bytes to every rank of comm (collective): the MSH text of a mesh and a packed
 // geometry, which may exceed 2^31 - 1 bytes.
 inline void broadcast_bytes(std::string& bytes, MPI_Comm comm) {
-  unsigned long long n = bytes.size();
-  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
-  bytes.resize(n);
-  for (unsigned long long at = 0; at < n;) {
-    const int piece = static_cast<int>(std::min<unsigned long long>(n - at, 1ull << 30));
-    MPI_Bcast(bytes.data() + at, piece, MPI_CHAR, 0, comm);
-    at += static_cast<unsigned long long>(piece);
-  }
+  broadcast_all(bytes, MPI_CHAR, comm);
 }
 
 // Every rank's values to rank 0 (collective), joined in rank order, rank by rank in messages of
