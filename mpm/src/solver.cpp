@@ -1122,12 +1122,13 @@ void Solver::boundary_work(bool remapped) {
     }
     if (!(dl.beta0 > 0)) continue;
     // The stiffness-proportional part: the work of the viscous force this step applied (with
-    // the power's velocity), then the viscous stress beta C : D for the next, D the strain rate
-    // of the updated velocity (MUSL's re-mapped, USL's and USF's v+; under USF the start
-    // velocity has already strained the particles this step), all with the gradients the force
-    // was mapped with (apply_loads: the positions at the step's start).
-    const std::vector<double>& sx = opt.scheme == Scheme::USF ? grid.vnx : ux;
-    const std::vector<double>& sy = opt.scheme == Scheme::USF ? grid.vny : uy;
+    // the power's velocity), then the viscous stress beta C : D for the next, all with the
+    // gradients the force was mapped with (apply_loads: the positions at the step's start). D is
+    // the strain rate of the re-mapped velocity under MUSL and USF (the power's), of the start
+    // velocity p / m under USL: never v+, which at a node holding a sliver of a particle
+    // magnifies the force and broke the explicit limit (docs/physics.md section 9.2).
+    const std::vector<double>& sx = opt.scheme == Scheme::USL ? grid.vx : ux;
+    const std::vector<double>& sy = opt.scheme == Scheme::USL ? grid.vy : uy;
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       if (dl.beta[q] == 0) continue;
       const std::uint32_t k = L.idx[q];
