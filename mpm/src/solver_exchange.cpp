@@ -165,23 +165,60 @@ void Solver::export_particles(const std::vector<int>& to, std::vector<std::vecto
       if (!keep[L.idx[q]]) entries[L.idx[q]].push_back({nl, q});
     ++nl;
   });
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    if (keep[k]) continue;
-    std::vector<double>& b = out[to[k]];
-    p.pack(k, b);
-    b.push_back(static_cast<double>(entries[k].size()));
-    int l = 0;
-    std::size_t e = 0;
-    for_each_layer([&](BoundaryLayer&, Arrays a) {
-      for (; e < entries[k].size() && entries[k][e].first == l; ++e) {
-        const std::size_t q = entries[k][e].second;
-        b.push_back(l);
-        for (auto& [v, st] : a) b.insert(b.end(), v->data() + st * q, v->data() + st * (q + 1));
-      }
-      ++l;
-    });
-  }
+  for (std::size_t k = 0; k < p.size(); ++k)
+    if (!keep[k]) pack_record(k, entries[k], out[to[k]]);
   compact(keep);
+}
+
+void Solver::pack_record(std::size_t k, const std::vector<std::pair<int, std::size_t>>& entries,
+                         std::vector<double>& b) {
+  p.pack(k, b);
+  b.push_back(static_cast<double>(entries.size()));
+  int l = 0;
+  std::size_t e = 0;
+  for_each_layer([&](BoundaryLayer&, Arrays a) {
+    for (; e < entries.size() && entries[e].first == l; ++e) {
+      const std::size_t q = entries[e].second;
+      b.push_back(l);
+      for (auto& [v, st] : a) b.insert(b.end(), v->data() + st * q, v->data() + st * (q + 1));
+    }
+    ++l;
+  });
+}
+
+std::vector<std::size_t> Solver::group_by_rank(std::vector<int>& rank, int P) {
+  const std::size_t n = p.size();
+  std::vector<std::size_t> start(static_cast<std::size_t>(P) + 1, 0);
+  for (const int r : rank) ++start[static_cast<std::size_t>(r) + 1];
+  for (int r = 0; r < P; ++r) start[r + 1] += start[r];
+  std::vector<std::size_t> at(start.begin(), start.end() - 1);
+  std::vector<uint32_t> perm(n), now(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t to = at[rank[k]]++;
+    perm[to] = static_cast<uint32_t>(k);
+    now[k] = static_cast<uint32_t>(to);
+  }
+  for_each_layer([&](BoundaryLayer& L, Arrays) {
+    for (auto& i : L.idx) i = now[i];
+  });
+  p.permute(perm);
+  std::vector<int> sorted(n);
+  for (std::size_t k = 0; k < n; ++k) sorted[k] = rank[perm[k]];
+  rank.swap(sorted);
+  pml.dt_coef = 0;
+  strips_ok_ = false;
+  return start;
+}
+
+void Solver::export_range(std::size_t begin, std::size_t end, std::vector<double>& out) {
+  std::vector<std::vector<std::pair<int, std::size_t>>> entries(end - begin);
+  int nl = 0;
+  for_each_layer([&](BoundaryLayer& L, Arrays) {
+    for (std::size_t q = 0; q < L.ids.size(); ++q)
+      if (L.idx[q] >= begin && L.idx[q] < end) entries[L.idx[q] - begin].push_back({nl, q});
+    ++nl;
+  });
+  for (std::size_t k = begin; k < end; ++k) pack_record(k, entries[k - begin], out);
 }
 
 void Solver::import_particles(const std::vector<double>& in) {

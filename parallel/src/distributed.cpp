@@ -312,13 +312,15 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
     return std::clamp(part_of(d.Ry, cj), 0, d.n - 1) * d.m + std::clamp(part_of(d.Cx, ci), 0, d.m - 1);
   };
   if (scatter && d.rank == 0) {  // every other rank's particles, with their layer entries
+    // Grouped by owner (stably: each rank receives them in the whole case's order), so that
+    // each rank's share is one range: one pass to pack it, one to keep rank 0's at the end.
+    std::vector<int> rank_of(s.p.size());
+    for (std::size_t k = 0; k < s.p.size(); ++k) rank_of[k] = owner(k);
+    const std::vector<std::size_t> start = s.group_by_rank(rank_of, P);
     for (int r = 1; r < P; ++r) {
-      std::vector<int> to(s.p.size(), -1);
-      for (std::size_t k = 0; k < s.p.size(); ++k)
-        if (owner(k) == r) to[k] = 0;
-      std::vector<std::vector<double>> out(1);
-      s.export_particles(to, out);
-      send_doubles(out[0], r, comm);
+      std::vector<double> out;
+      s.export_range(start[r], start[r + 1], out);
+      send_doubles(out, r, comm);
     }
   } else if (scatter) {
     s.import_particles(receive_doubles(0, comm));

@@ -190,6 +190,11 @@ class Solver {
   // in every boundary layer; then removes those particles. export_particles and
   // import_particles leave the particles unsorted: sort_particles() before they are used.
   void export_particles(const std::vector<int>& to, std::vector<std::vector<double>>& out);
+  // Orders the particles by `rank` (one per particle, in [0, P); kept in step), stably, so that
+  // each rank's particles are one range, and returns the ranges' starts (P + 1 of them).
+  std::vector<std::size_t> group_by_rank(std::vector<int>& rank, int P);
+  // Appends to out export_particles' record of each particle in [begin, end), keeping them.
+  void export_range(std::size_t begin, std::size_t end, std::vector<double>& out);
   // Appends the particles of records written by export_particles (of a solver built from the
   // same case).
   void import_particles(const std::vector<double>& in);
@@ -283,6 +288,9 @@ class Solver {
   template <class Fn> void for_each_layer(Fn&& fn);
 
   void compact(const std::vector<std::uint8_t>& keep);
+  // One particle's record (export_particles) with its layer entries (layer number, entry).
+  void pack_record(std::size_t k, const std::vector<std::pair<int, std::size_t>>& entries,
+                   std::vector<double>& out);
   void refresh_strip_rows();
   void refresh_fields();
   bool strips_conflict() const;
