@@ -91,7 +91,7 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
     std::string error, rest;
     if (process_rank() == 0) try {
         reader.emplace(read_whole(file), file);
-        rest = reader->without({"mpm.p.", "mpm.silent", "mpm.damper", "mpm.pml"});
+        rest = reader->without(Solver::particle_blocks("mpm."));
       } catch (const std::exception& e) {
         error = e.what();
       }

@@ -50,16 +50,20 @@ void reorder_by_ids(const StateReader& r, const std::string& name, const Boundar
   }
 }
 
-// The clock, the energy account and the particles' arrays: the head of a solver's state.
+// The clock, the energy account and the particles' arrays: the head of a solver's state (the
+// arrays as this rank's parts when `parts`).
 void put_head(StateWriter& w, const std::string& pre, double dt, double t, long steps,
-              const Energies& e, double contact_dissipated, const Particles& p) {
+              const Energies& e, double contact_dissipated, const Particles& p, bool parts) {
   w.put(pre + "dt", dt);
   w.put(pre + "t", t);
   w.put(pre + "steps", static_cast<std::int64_t>(steps));
   w.put(pre + "energy", e);
   w.put(pre + "contact_dissipated", contact_dissipated);
   w.put(pre + "film", static_cast<std::uint8_t>(p.has_film()));
-  particle_arrays(p, [&](const char* n, const auto& v) { w.put(pre + "p." + n, v); });
+  particle_arrays(p, [&](const char* n, const auto& v) {
+    if (parts) w.put_part(pre + "p." + n, v);
+    else w.put(pre + "p." + n, v);
+  });
 }
 
 // USF with layers strained with the updated velocity (Solver::edge_velocity_): the entries
@@ -85,7 +89,7 @@ std::vector<double> own_edge_velocities(const std::vector<double>& all, const No
 }  // namespace
 
 void Solver::save_state(StateWriter& w, const std::string& pre) const {
-  put_head(w, pre, dt, t, steps, energy, contact.dissipated, p);
+  put_head(w, pre, dt, t, steps, energy, contact.dissipated, p, false);
   for (std::size_t k = 0; k < silents.size(); ++k) {
     if (!silents[k].springs()) continue;
     w.put(pre + "silent" + std::to_string(k) + ".ux", silents[k].ux);
@@ -115,43 +119,34 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
 
 void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
   // The whole account (collective), rank 0's contact dissipation (every rank holds the same).
-  const Energies e = total_energy();
-  w.put(pre + "dt", dt);
-  w.put(pre + "t", t);
-  w.put(pre + "steps", static_cast<std::int64_t>(steps));
-  w.put(pre + "energy", e);
-  w.put(pre + "contact_dissipated", contact.dissipated);
-  w.put(pre + "film", static_cast<std::uint8_t>(p.has_film()));
-  particle_arrays(p, [&](const char* n, const auto& v) { w.put_part(pre + "p." + n, v); });
-  // A layer's entries with their particles' ids; its values `stride` per entry.
+  put_head(w, pre, dt, t, steps, total_energy(), contact.dissipated, p, true);
+  // A layer's entries with their particles' ids, then its arrays (in entry order).
   auto layer = [&](const std::string& name, const BoundaryLayer& L,
-                   std::vector<std::pair<const char*, std::pair<const std::vector<double>*, int>>>
-                       arrays) {
+                   std::vector<std::pair<const char*, const std::vector<double>*>> arrays) {
     std::vector<std::uint32_t> ids(L.idx.size());
     for (std::size_t q = 0; q < ids.size(); ++q) ids[q] = p.id[L.idx[q]];
     w.put_part(name + ".ids", ids);
-    for (const auto& [suffix, a] : arrays) {
-      const auto& [v, stride] = a;
-      w.put_part(name + "." + suffix,
-                 std::vector<double>(v->begin(), v->begin() + stride * ids.size()));
-    }
+    for (const auto& [suffix, v] : arrays) w.put_part(name + "." + suffix, *v);
   };
   for (std::size_t k = 0; k < silents.size(); ++k)
     if (silents[k].springs())
       layer(pre + "silent" + std::to_string(k), silents[k].layer,
-            {{"ux", {&silents[k].ux, 1}}, {"uy", {&silents[k].uy, 1}}});
+            {{"ux", &silents[k].ux}, {"uy", &silents[k].uy}});
   for (std::size_t k = 0; k < dampers.size(); ++k)
     if (dampers[k].beta0 > 0)
-      layer(pre + "damper" + std::to_string(k), dampers[k].layer, {{"sv", {&dampers[k].sv, 3}}});
+      layer(pre + "damper" + std::to_string(k), dampers[k].layer, {{"sv", &dampers[k].sv}});
   if (!pml_bands.empty())
-    layer(pre + "pml", pml.layer,
-          {{"H", {&pml.H, 4}}, {"u", {&pml.u, 2}}, {"xi", {&pml.xi, 4}}, {"zeta", {&pml.zeta, 4}}});
+    layer(pre + "pml", pml.layer, {{"H", &pml.H}, {"u", &pml.u}, {"xi", &pml.xi}, {"zeta", &pml.zeta}});
   w.put(pre + "strips", static_cast<std::int32_t>(0));  // no strips: the reader re-sorts
   w.put(pre + "ranges", std::vector<std::uint32_t>{});
   w.put(pre + "field_boxes", std::vector<std::int32_t>{});
   // USF's kept edge velocities: each node's from its owner.
   if (usf_edges())
     w.put_part(pre + "edge_velocity", own_edge_velocities(edge_velocity_, own_, window_origin()));
+}
+
+std::vector<std::string> Solver::particle_blocks(const std::string& pre) {
+  return {pre + "p.", pre + "silent", pre + "damper", pre + "pml"};
 }
 
 void Solver::load_clock(const StateReader& r, const std::string& pre) {

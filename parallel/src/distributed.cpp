@@ -247,9 +247,7 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
   if (scatter) {  // rank 0 holds the body: its costs, its grid's constraints and body scalars
     broadcast_all(cx, MPI_DOUBLE, comm);
     broadcast_all(cy, MPI_DOUBLE, comm);
-    std::vector<std::uint8_t> fix(s.grid.fix.begin(), s.grid.fix.end());
-    broadcast_all(fix, MPI_UNSIGNED_CHAR, comm);
-    std::copy(fix.begin(), fix.end(), s.grid.fix.begin());
+    broadcast_all(s.grid.fix, MPI_UNSIGNED_CHAR, comm);
     std::array<double, 4> b = s.body_scalars();
     MPI_Bcast(b.data(), 4, MPI_DOUBLE, 0, comm);
     s.set_body_scalars(b);
@@ -311,11 +309,11 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
     cell(k, ci, cj);
     return std::clamp(part_of(d.Ry, cj), 0, d.n - 1) * d.m + std::clamp(part_of(d.Cx, ci), 0, d.m - 1);
   };
+  std::vector<int> rank_of(s.p.size());
+  for (std::size_t k = 0; k < s.p.size(); ++k) rank_of[k] = owner(k);
   if (scatter && d.rank == 0) {  // every other rank's particles, with their layer entries
     // Grouped by owner (stably: each rank receives them in the whole case's order), so that
     // each rank's share is one range: one pass to pack it, one to keep rank 0's at the end.
-    std::vector<int> rank_of(s.p.size());
-    for (std::size_t k = 0; k < s.p.size(); ++k) rank_of[k] = owner(k);
     const std::vector<std::size_t> start = s.group_by_rank(rank_of, P);
     for (int r = 1; r < P; ++r) {
       std::vector<double> out;
@@ -324,9 +322,10 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
     }
   } else if (scatter) {
     s.import_particles(receive_doubles(0, comm));
+    rank_of.assign(s.p.size(), d.rank);  // what rank 0 sent is this rank's
   }
   std::vector<std::uint8_t> keep(s.p.size(), 0);
-  for (std::size_t k = 0; k < s.p.size(); ++k) keep[k] = owner(k) == d.rank;
+  for (std::size_t k = 0; k < s.p.size(); ++k) keep[k] = rank_of[k] == d.rank;
   Grid win;
   win.init(g.x0 + d.gx0 * g.h, g.y0 + d.gy0 * g.h, g.h, d.gnx - 1, d.gny - 1);
   for (int j = 0; j < d.gny; ++j)

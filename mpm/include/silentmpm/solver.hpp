@@ -227,6 +227,9 @@ class Solver {
   // energy account, contact dissipation, USF's kept edge velocities): what a rank whose
   // particles rank 0 sends it reads (docs/parallel.md "Set-up").
   void load_clock(const StateReader& r, const std::string& prefix);
+  // The prefixes of the blocks that hold the particles and their layer entries (what
+  // load_clock does not read).
+  static std::vector<std::string> particle_blocks(const std::string& prefix);
   // Split over ranks (collective): every rank puts its particles and its layer entries (with
   // their particles' ids) as its parts of the blocks (StateWriter::put_part), the clock and the
   // energy account summed over the ranks as whole blocks, and no strips (a restart re-sorts).
