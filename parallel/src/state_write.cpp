@@ -7,6 +7,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
@@ -19,6 +22,7 @@ namespace smpm {
 namespace {
 
 std::size_t g_piece = std::size_t{1} << 30;
+int g_open_fault = -1;  // a rank whose open fails (tests)
 
 // A run of the file's bytes this rank writes: where, how long, its hash, and its source.
 struct Piece {
@@ -84,6 +88,7 @@ std::size_t state_write_piece() { return g_piece; }
 void set_state_write_piece(std::size_t bytes) {
   g_piece = std::clamp<std::size_t>(bytes, 1, std::size_t{1} << 30);
 }
+void set_state_write_open_fault(int rank) { g_open_fault = rank; }
 
 void write_state_collectively(const StateWriter& w, const std::string& path, MPI_Comm comm) {
   int rank = 0, size = 1;
@@ -173,10 +178,17 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
       std::filesystem::remove(tmp, ec);
   }
   MPI_Barrier(comm);
+  // Each rank opens the file on its own (MPI_COMM_SELF; the writes are independent anyway), so
+  // an open that fails on some ranks leaves no handle on the others that a collective close
+  // would have to wait for: each rank closes what it opened.
   MPI_File fh = MPI_FILE_NULL;
-  const bool opened = check(MPI_File_open(comm, tmp.c_str(), MPI_MODE_CREATE | MPI_MODE_WRONLY,
-                                          MPI_INFO_NULL, &fh),
-                            "cannot create " + tmp_name);
+  bool opened = false;
+  if (rank == g_open_fault)
+    err = "cannot create " + tmp_name + ": a fault set by a test";
+  else
+    opened = check(MPI_File_open(MPI_COMM_SELF, tmp.c_str(), MPI_MODE_CREATE | MPI_MODE_WRONLY,
+                                 MPI_INFO_NULL, &fh),
+                   "cannot create " + tmp_name);
   int ok = opened;
   MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_LAND, comm);
   if (ok) {
@@ -227,9 +239,19 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
     if (err.empty()) check(MPI_File_write_at(fh, static_cast<MPI_Offset>(sum_at), &h, 8, MPI_BYTE, &st),
                            "cannot write");
   }
-  if (ok) {
-    check(MPI_File_sync(fh), "cannot sync");
-    check(MPI_File_close(&fh), "cannot close");
+  if (opened) check(MPI_File_close(&fh), "cannot close");
+  // Each rank's pieces to the disk: fsync on its own descriptor (flushing the file's dirty
+  // pages of this node), with one process's leniency: a file system or device with no fsync
+  // (EINVAL, EROFS) is not an error.
+  if (ok && err.empty()) {
+    const int fd = ::open(tmp.c_str(), O_WRONLY);
+    if (fd < 0) {
+      err = "cannot reopen " + tmp_name + " to sync it: " + std::strerror(errno);
+    } else {
+      if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
+        err = std::string("cannot sync: ") + std::strerror(errno);
+      ::close(fd);
+    }
   }
   if (ok && rank == 0 && err.empty()) {
     std::error_code ec;

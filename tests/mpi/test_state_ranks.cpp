@@ -1,11 +1,16 @@
 // One checkpoint written by every rank at once (parallel/state_write.hpp), on 1, 2 and 4 ranks:
 //   * the file is byte for byte the one a single process writes with the ranks' parts joined
 //     in rank order, whatever the pieces each write carries;
-//   * a write that fails on the ranks is one error on every rank, and leaves no file;
+//   * a write that fails on the ranks is one error on every rank, and leaves no file and no
+//     open descriptor; a file system without fsync is no error, as on one process;
 //   * the MPM solver's parts hold every particle and every layer entry of every rank, bit for
 //     bit, and the file restarts a solver on one process.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <mpi.h>
+#include <unistd.h>
+
+#include <cerrno>
 
 #include <cstdint>
 #include <cstdio>
@@ -135,6 +140,72 @@ TEST(StateRanks, AFullDiskIsOneErrorOnEveryRank) {
   EXPECT_EQ(what, mpi_testing::root_string(what)) << "the same message on every rank";
   EXPECT_FALSE(fs::exists(file));
   if (mpi_testing::world_rank() == 0) std::printf("  a full disk: %s\n", what.c_str());
+}
+
+// An open that fails on one rank only (a test's fault on the last rank): every rank gets that
+// rank's error, no file is left, and no rank keeps a descriptor of the temporary file open (a
+// collective open would leave it open on the ranks where it succeeded); the next write works.
+TEST(StateRanks, AnOpenFailingOnOneRankLeavesNothingOpen) {
+  const int rank = mpi_testing::world_rank(), P = mpi_testing::world_size();
+  const fs::path dir = folder("open"), file = dir / "state.smpm";
+  StateWriter w;
+  w.put_part("a", part_a(rank));
+  write_state_collectively(w, file.string(), MPI_COMM_WORLD);  // MPI-IO's own set-up done
+  auto descriptors = [] {
+    std::size_t n = 0;
+    for (const auto& e : fs::directory_iterator("/proc/self/fd")) n += !e.path().empty();
+    return n;
+  };
+  const std::size_t before = descriptors();
+  set_state_write_open_fault(P - 1);
+  std::string what;
+  try {
+    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
+  } catch (const std::runtime_error& e) {
+    what = e.what();
+  }
+  set_state_write_open_fault(-1);
+  EXPECT_EQ(what, file.string() + ": cannot create state.smpm.tmp: a fault set by a test (rank " +
+                      std::to_string(P - 1) + " of " + std::to_string(P) + ")");
+  EXPECT_EQ(what, mpi_testing::root_string(what)) << "the same message on every rank";
+  EXPECT_EQ(descriptors(), before) << "rank " << rank << " kept a descriptor open";
+  MPI_Barrier(MPI_COMM_WORLD);
+  EXPECT_FALSE(fs::exists(file.string() + ".tmp"));
+  w.put_part("b", part_b(rank));
+  EXPECT_NO_THROW(write_state_collectively(w, file.string(), MPI_COMM_WORLD));
+  if (rank == 0) {
+    std::vector<std::uint32_t> b;
+    StateReader(read_bytes(file), file.string()).get("b", b);
+    std::size_t n = 0;
+    for (int r = 0; r < P; ++r) n += part_b(r).size();
+    EXPECT_EQ(b.size(), n);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+}
+
+// A file system without fsync (the temporary file linked to /dev/null, whose fsync fails with
+// EINVAL): as on one process, not an error; the write goes through.
+TEST(StateRanks, AFileSystemWithoutFsyncIsNoError) {
+  const int null = ::open("/dev/null", O_WRONLY);
+  ASSERT_GE(null, 0);
+  const int synced = ::fsync(null), why = errno;
+  ::close(null);
+  ASSERT_TRUE(synced != 0 && why == EINVAL) << "fsync of /dev/null is an error EINVAL here";
+  const fs::path dir = folder("nosync"), file = dir / "state.smpm";
+  if (mpi_testing::world_rank() == 0) fs::create_symlink("/dev/null", dir / "state.smpm.tmp");
+  MPI_Barrier(MPI_COMM_WORLD);
+  StateWriter w;
+  w.put_part("a", part_a(mpi_testing::world_rank()));
+  std::string what;
+  try {
+    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
+  } catch (const std::runtime_error& e) {
+    what = e.what();
+  }
+  EXPECT_EQ(what, "") << "a device without fsync is not an error";
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(file)) && fs::read_symlink(file) == "/dev/null")
+      << "the link renamed into place";
+  MPI_Barrier(MPI_COMM_WORLD);
 }
 
 // A temporary file left as a link to a longer file (as a one-process write follows a link and

@@ -16,14 +16,18 @@ namespace smpm {
 class StateWriter;
 
 // Collective over comm. Writes `path` whole or not at all: into `path`.tmp, renamed when every
-// rank has written and synced its pieces. A failure on any rank (a full disk, an I/O error) is a
-// std::runtime_error on every rank naming the file, the first failing rank and the cause; the
-// temporary file is removed. Ranks whose part blocks differ in name, order or element size
-// (a program error) get a std::logic_error.
+// rank has written and synced its pieces (fsync on each rank; a file system without fsync,
+// EINVAL or EROFS, is not an error, as on one process). A failure on any rank (a full disk, an
+// I/O error, an open that fails on some ranks only) is a std::runtime_error on every rank naming
+// the file, the first failing rank and the cause; the temporary file is removed and no rank
+// keeps it open. Ranks whose part blocks differ in name, order or element size (a program
+// error) get a std::logic_error.
 void write_state_collectively(const StateWriter& w, const std::string& path, MPI_Comm comm);
 
 // The most bytes one MPI write carries (2^30: an MPI count is an int); a test sets it smaller.
 std::size_t state_write_piece();
 void set_state_write_piece(std::size_t bytes);
+// A test's fault: the open of the temporary file fails on this rank (-1: on none).
+void set_state_write_open_fault(int rank);
 
 }  // namespace smpm
