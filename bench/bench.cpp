@@ -12,16 +12,18 @@
 // would need if every byte came from memory; its fraction of the triad says how far the step is
 // from the limit. Where the problem fits in the last-level cache the fraction can pass 1.
 //
-//   build/bench [--quick] [--shape bilinear|gimp|bspline|all]
+//   build/bench [--quick] [--shape bilinear|gimp|bspline|all] [--threads N,M,...]
 //     --quick: only the 1e5 size, fewer steps; --shape: the grid shape functions (default
 //     bilinear; all: the three, alternating per size and thread count; the byte count is that of
-//     the bilinear step)
+//     the bilinear step); --threads: the thread counts to run (default 1 and all; the triad is
+//     measured on each)
 #include <omp.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -98,6 +100,7 @@ double rate(double h, bool silent, int threads, int steps, ShapeKind shape) {
 
 int main(int argc, char** argv) {
   bool quick = false;
+  std::vector<int> thread_counts;
   std::vector<ShapeKind> shapes = {ShapeKind::Bilinear};
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) {
@@ -113,22 +116,42 @@ int main(int argc, char** argv) {
                      v.c_str());
         return 1;
       }
+    } else if (std::strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+      const std::string v = argv[++i];
+      std::size_t at = 0;
+      while (at <= v.size()) {
+        const std::size_t comma = std::min(v.find(',', at), v.size());
+        const std::string item = v.substr(at, comma - at);
+        char* end = nullptr;
+        const long n = std::strtol(item.c_str(), &end, 10);
+        if (item.empty() || *end != '\0' || n < 1 || n > 4096) {
+          std::fprintf(stderr, "bench: --threads: \"%s\" is not a thread count (1 to 4096) in "
+                               "\"%s\"\n", item.c_str(), v.c_str());
+          return 1;
+        }
+        thread_counts.push_back(static_cast<int>(n));
+        at = comma + 1;
+      }
     } else {
       std::fprintf(stderr, "bench: unknown argument \"%s\"; usage: bench [--quick] "
-                           "[--shape bilinear|gimp|bspline|all]\n", argv[i]);
+                           "[--shape bilinear|gimp|bspline|all] [--threads N,M,...]\n", argv[i]);
       return 1;
     }
   }
   const int all = omp_get_max_threads();
+  if (thread_counts.empty()) thread_counts = all > 1 ? std::vector<int>{1, all} : std::vector<int>{1};
   std::printf("silentmpm bench: pulse plate 50 x 200 mm, tungsten, elastic, MUSL, 1 ppc\n");
   std::printf("bytes per particle (particle arrays): %zu\n", Particles::bytes_per_particle());
   std::printf("bytes one step moves (R read, W written, RW both; per particle + per grid node):\n");
   for (const PassBytes& p : kMuslStep)
     std::printf("  %-20s %4.0f + %4.0f  %s\n", p.pass, p.particle, p.node, p.arrays);
-  const double triad1 = benchmarks::triad_gbs(1);
-  const double triad_all = all > 1 ? benchmarks::triad_gbs(all) : triad1;
-  std::printf("triad (3 x 512 MiB, best of 5): %.1f GB/s on 1 thread, %.1f GB/s on %d\n", triad1,
-              triad_all, all);
+  std::vector<double> triad;
+  std::printf("triad (3 x 512 MiB, best of 5):");
+  for (int th : thread_counts) {
+    triad.push_back(benchmarks::triad_gbs(th));
+    std::printf(" %.1f GB/s on %d thread%s%s", triad.back(), th, th == 1 ? "" : "s",
+                th == thread_counts.back() ? "\n" : ",");
+  }
   std::printf("%10s %9s %8s %8s %14s %9s %8s %8s %9s\n", "particles", "boundary", "threads",
               "steps", "updates/s", "shape", "B/update", "GB/s", "of triad");
   for (double h : {1e-4 * std::sqrt(10.0), 1e-4, 5e-5}) {
@@ -143,17 +166,17 @@ int main(int argc, char** argv) {
                 (Particles::bytes_per_particle() * double(n) + grid_bytes) / 1e6);
     probe.reset();
     const int steps = quick ? 20 : (n > 2000000 ? 10 : n > 500000 ? 30 : 200);
-    for (int th : {1, all}) {
+    for (std::size_t k = 0; k < thread_counts.size(); ++k) {
+      const int th = thread_counts[k];
       for (bool silent : {false, true})
         for (ShapeKind shape : shapes) {
           const double r = rate(h, silent, th, steps, shape);
           const double gbs = r * per_update / 1e9;
           std::printf("%10zu %9s %8d %8d %14.3e %9s %8.0f %8.1f %8.0f%%\n", n,
                       silent ? "silent" : "free", th, steps, r, shape_name(shape), per_update, gbs,
-                      100 * gbs / (th == 1 ? triad1 : triad_all));
+                      100 * gbs / triad[k]);
           std::fflush(stdout);
         }
-      if (all == 1) break;
     }
   }
   return 0;
