@@ -13,10 +13,13 @@
 // from the limit. Where the problem fits in the last-level cache the fraction can pass 1.
 //
 //   build/bench [--quick] [--shape bilinear|gimp|bspline|all] [--threads N,M,...]
+//               [--sizes N,M,...] [--rounds R]
 //     --quick: only the 1e5 size, fewer steps; --shape: the grid shape functions (default
 //     bilinear; all: the three, alternating per size and thread count; the byte count is that of
 //     the bilinear step); --threads: the thread counts to run (default 1 and all; the triad is
-//     measured on each)
+//     measured on each); --sizes: about how many particles (default 1e5, 1e6, 4e6; from 1e3 to
+//     1e8); --rounds: how many times each free and silent pair runs, alternating (default 1).
+//     Steps per rate: 200, 30 or 10 by size, times half the thread count from 4 threads on.
 #include <omp.h>
 
 #include <algorithm>
@@ -101,6 +104,8 @@ double rate(double h, bool silent, int threads, int steps, ShapeKind shape) {
 int main(int argc, char** argv) {
   bool quick = false;
   std::vector<int> thread_counts;
+  std::vector<double> sizes = {1e5, 1e6, 4e6};
+  int rounds = 1;
   std::vector<ShapeKind> shapes = {ShapeKind::Bilinear};
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) {
@@ -116,25 +121,35 @@ int main(int argc, char** argv) {
                      v.c_str());
         return 1;
       }
-    } else if (std::strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
-      const std::string v = argv[++i];
-      std::size_t at = 0;
-      while (at <= v.size()) {
+    } else if ((std::strcmp(argv[i], "--threads") == 0 || std::strcmp(argv[i], "--sizes") == 0 ||
+                std::strcmp(argv[i], "--rounds") == 0) && i + 1 < argc) {
+      // A comma-separated list of numbers, each in [lo, hi].
+      const bool threads = argv[i][2] == 't', rounds_arg = argv[i][2] == 'r';
+      const double lo = threads || rounds_arg ? 1 : 1e3, hi = threads ? 4096 : rounds_arg ? 100 : 1e8;
+      const std::string opt = argv[i], v = argv[++i];
+      std::vector<double> list;
+      for (std::size_t at = 0; at <= v.size();) {
         const std::size_t comma = std::min(v.find(',', at), v.size());
         const std::string item = v.substr(at, comma - at);
         char* end = nullptr;
-        const long n = std::strtol(item.c_str(), &end, 10);
-        if (item.empty() || *end != '\0' || n < 1 || n > 4096) {
-          std::fprintf(stderr, "bench: --threads: \"%s\" is not a thread count (1 to 4096) in "
-                               "\"%s\"\n", item.c_str(), v.c_str());
+        const double x = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end != '\0' || !(x >= lo && x <= hi) ||
+            ((threads || rounds_arg) && x != std::floor(x)) || (rounds_arg && !list.empty())) {
+          std::fprintf(stderr, "bench: %s: \"%s\" is not %s from %g to %g (in \"%s\")\n",
+                       opt.c_str(), item.c_str(), rounds_arg ? "one whole number" : "a number",
+                       lo, hi, v.c_str());
           return 1;
         }
-        thread_counts.push_back(static_cast<int>(n));
+        list.push_back(x);
         at = comma + 1;
       }
+      if (threads) thread_counts.assign(list.begin(), list.end());
+      else if (rounds_arg) rounds = static_cast<int>(list[0]);
+      else sizes = list;
     } else {
       std::fprintf(stderr, "bench: unknown argument \"%s\"; usage: bench [--quick] "
-                           "[--shape bilinear|gimp|bspline|all] [--threads N,M,...]\n", argv[i]);
+                           "[--shape bilinear|gimp|bspline|all] [--threads N,M,...] [--sizes N,M,...] "
+                           "[--rounds R]\n", argv[i]);
       return 1;
     }
   }
@@ -154,8 +169,9 @@ int main(int argc, char** argv) {
   }
   std::printf("%10s %9s %8s %8s %14s %9s %8s %8s %9s\n", "particles", "boundary", "threads",
               "steps", "updates/s", "shape", "B/update", "GB/s", "of triad");
-  for (double h : {1e-4 * std::sqrt(10.0), 1e-4, 5e-5}) {
-    if (quick && h < 2e-4) continue;
+  if (quick) sizes = {1e5};
+  for (double size : sizes) {
+    const double h = 1e-4 * std::sqrt(1e6 / size);  // 1e6 particles at 0.1 mm
     auto probe = pulse_plate(h, false, 1);
     const std::size_t n = probe->p.size();
     const std::size_t grid_bytes = probe->grid.nodes() * (14 * sizeof(double) + 1);
@@ -165,18 +181,20 @@ int main(int argc, char** argv) {
                 Particles::bytes_per_particle() + double(grid_bytes) / n,
                 (Particles::bytes_per_particle() * double(n) + grid_bytes) / 1e6);
     probe.reset();
-    const int steps = quick ? 20 : (n > 2000000 ? 10 : n > 500000 ? 30 : 200);
+    const int base = quick ? 20 : (n > 2000000 ? 10 : n > 500000 ? 30 : 200);
     for (std::size_t k = 0; k < thread_counts.size(); ++k) {
       const int th = thread_counts[k];
-      for (bool silent : {false, true})
-        for (ShapeKind shape : shapes) {
-          const double r = rate(h, silent, th, steps, shape);
-          const double gbs = r * per_update / 1e9;
-          std::printf("%10zu %9s %8d %8d %14.3e %9s %8.0f %8.1f %8.0f%%\n", n,
-                      silent ? "silent" : "free", th, steps, r, shape_name(shape), per_update, gbs,
-                      100 * gbs / triad[k]);
-          std::fflush(stdout);
-        }
+      const int steps = base * std::max(1, th / 2);
+      for (int round = 0; round < rounds; ++round)
+        for (bool silent : {false, true})
+          for (ShapeKind shape : shapes) {
+            const double r = rate(h, silent, th, steps, shape);
+            const double gbs = r * per_update / 1e9;
+            std::printf("%10zu %9s %8d %8d %14.3e %9s %8.0f %8.1f %8.0f%%\n", n,
+                        silent ? "silent" : "free", th, steps, r, shape_name(shape), per_update,
+                        gbs, 100 * gbs / triad[k]);
+            std::fflush(stdout);
+          }
     }
   }
   return 0;

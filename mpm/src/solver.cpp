@@ -820,33 +820,41 @@ void Solver::pml_shapes() {
   }
 }
 
-// Tractions and silent-layer dashpots carried by boundary particles (Eq. 16, 20, 21).
+template <class S, class Skip>
+void Solver::layer_weights(const BoundaryLayer& L, Anchor anchor, std::vector<long>& wn,
+                           std::vector<double>& wN, Skip&& skip) {
+  constexpr int K = S::kNodes;
+  const long n = static_cast<long>(L.idx.size());
+  wn.resize(K * n);
+  wN.resize(K * n);
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+  for (long q = 0; q < n; ++q) {
+    if (skip(q)) continue;
+    S sf;
+    load_weights(L, q, anchor, sf, wn.data() + K * q);
+    std::copy(sf.N, sf.N + K, wN.data() + K * q);
+  }
+}
+
+// Tractions and silent-layer dashpots carried by boundary particles (Eq. 16, 20, 21). Each
+// layer's per-entry part (weights, tractions, blocks: the particles' and grid's data read at
+// the entries) runs in parallel; the sums into the nodes then go in entry order, as one pass.
 template <class S>
 void Solver::apply_loads() {
-  S sf;
   constexpr int K = S::kNodes;
-  // Each entry's weights (nodes into wn, shape values into wN, sized by the caller), kept so
-  // that boundary_work takes the work of this step's forces with the weights they were mapped
-  // with instead of mapping them again.
-  auto weights = [&](const BoundaryLayer& L, std::size_t q, Anchor anchor, std::vector<long>& wn,
-                     std::vector<double>& wN) -> long* {
-    long* nodes = wn.data() + K * q;
-    load_weights(L, q, anchor, sf, nodes);
-    std::copy(sf.N, sf.N + K, wN.data() + K * q);
-    return nodes;
-  };
+  const auto none = [](long) { return false; };
   for (auto& tl : tractions) {
     const double f = tl.fn(t);
     if (f == 0.0) continue;
-    tl.nodes.resize(K * tl.layer.idx.size());
-    tl.N.resize(K * tl.layer.idx.size());
+    layer_weights<S>(tl.layer, tl.anchor, tl.nodes, tl.N, none);
     for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
       double tx, ty;
       traction_of(tl, q, f, tx, ty);
-      const long* nodes = weights(tl.layer, q, tl.anchor, tl.nodes, tl.N);
+      const long* nodes = tl.nodes.data() + K * q;
+      const double* N = tl.N.data() + K * q;
       for (int a = 0; a < K; ++a) {
-        grid.fx[nodes[a]] += tx * tl.layer.w[q] * sf.N[a];
-        grid.fy[nodes[a]] += ty * tl.layer.w[q] * sf.N[a];
+        grid.fx[nodes[a]] += tx * tl.layer.w[q] * N[a];
+        grid.fy[nodes[a]] += ty * tl.layer.w[q] * N[a];
       }
     }
   }
@@ -863,42 +871,55 @@ void Solver::apply_loads() {
   has_nodal_dashpot_ = false;
   for (auto& sl : silents) {
     const auto& L = sl.layer;
-    sl.nodes.resize(K * L.idx.size());
-    sl.N.resize(K * L.idx.size());
-    for (std::size_t q = 0; q < L.idx.size(); ++q) {
-      const long* nodes = weights(L, q, sl.anchor, sl.nodes, sl.N);
+    const long n = static_cast<long>(L.idx.size());
+    layer_weights<S>(L, sl.anchor, sl.nodes, sl.N, none);
+    // Per entry: the spring's traction (2), then the particle form's dashpot traction (2) or
+    // the nodal form's block (3) and rho c_d (1).
+    layer_scratch_.resize(6 * static_cast<std::size_t>(n));
+    double* sc = layer_scratch_.data();
+    const bool usf = opt.scheme == Scheme::USF;
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+    for (long q = 0; q < n; ++q) {
+      const long* nodes = sl.nodes.data() + K * q;
+      double* o = sc + 6 * q;
       if (sl.springs()) {  // explicit: the displacement at the start of the step
         // USF strains the particles with the start-of-step velocity before the forces: the
         // springs do the same.
-        if (opt.scheme == Scheme::USF)
-          advance_spring<K>(sl, q, sf.N, nodes, grid.vx, grid.vy, dt);
-        double tx, ty;
-        spring_of(sl, q, sl.ux[q], sl.uy[q], tx, ty);
-        for (int a = 0; a < S::kNodes; ++a) {
-          grid.fx[nodes[a]] += tx * L.w[q] * sf.N[a];
-          grid.fy[nodes[a]] += ty * L.w[q] * sf.N[a];
-        }
+        if (usf) advance_spring<K>(sl, q, sl.N.data() + K * q, nodes, grid.vx, grid.vy, dt);
+        spring_of(sl, q, sl.ux[q], sl.uy[q], o[0], o[1]);
       }
       if (sl.form == SilentForm::Particle) {  // lagged: the particle velocity of the last step
-        double tx, ty;
-        dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
-        for (int a = 0; a < S::kNodes; ++a) {
-          grid.fx[nodes[a]] += tx * L.w[q] * sf.N[a];
-          grid.fy[nodes[a]] += ty * L.w[q] * sf.N[a];
+        dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], o[2], o[3]);
+      } else {
+        lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], o[2], o[3], o[4]);
+        const Material& mq = materials[p.group[L.idx[q]]];
+        o[5] = mq.rho * mq.cd;
+      }
+    }
+    const bool updated = !updated_weight_.empty() && sl.updated_velocity;
+    for (long q = 0; q < n; ++q) {
+      const long* nodes = sl.nodes.data() + K * q;
+      const double* N = sl.N.data() + K * q;
+      const double* o = sc + 6 * q;
+      if (sl.springs())
+        for (int a = 0; a < K; ++a) {
+          grid.fx[nodes[a]] += o[0] * L.w[q] * N[a];
+          grid.fy[nodes[a]] += o[1] * L.w[q] * N[a];
+        }
+      if (sl.form == SilentForm::Particle) {
+        for (int a = 0; a < K; ++a) {
+          grid.fx[nodes[a]] += o[2] * L.w[q] * N[a];
+          grid.fy[nodes[a]] += o[3] * L.w[q] * N[a];
         }
         continue;
       }
       has_nodal_dashpot_ = true;
-      double bxx, bxy, byy;
-      lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], bxx, bxy, byy);
-      const bool updated = !updated_weight_.empty() && sl.updated_velocity;
-      const Material& mq = materials[p.group[L.idx[q]]];
-      for (int a = 0; a < S::kNodes; ++a) {
-        const double wn = L.w[q] * sf.N[a];
-        grid.cxx[nodes[a]] += wn * bxx;
-        grid.cxy[nodes[a]] += wn * bxy;
-        grid.cyy[nodes[a]] += wn * byy;
-        if (updated) updated_weight_[nodes[a]] += wn * mq.rho * mq.cd;
+      for (int a = 0; a < K; ++a) {
+        const double wn = L.w[q] * N[a];
+        grid.cxx[nodes[a]] += wn * o[2];
+        grid.cxy[nodes[a]] += wn * o[3];
+        grid.cyy[nodes[a]] += wn * o[4];
+        if (updated) updated_weight_[nodes[a]] += wn * o[5];
         add_dashpot_node(nodes[a]);
       }
     }
@@ -906,37 +927,46 @@ void Solver::apply_loads() {
   // Damping layers: C_i += alpha_q m_q N_i(x_q) I, at the particle (a volume term).
   for (auto& dl : dampers) {
     const auto& L = dl.layer;
-    dl.nodes.resize(K * L.idx.size());
-    dl.N.resize(K * L.idx.size());
+    layer_weights<S>(L, Anchor::Particle, dl.nodes, dl.N,
+                     [&](long q) { return dl.alpha[q] == 0; });
     for (std::size_t q = 0; q < L.idx.size(); ++q) {
       if (dl.alpha[q] == 0) continue;
-      const long* dn = weights(L, q, Anchor::Particle, dl.nodes, dl.N);
+      const long* dn = dl.nodes.data() + K * q;
+      const double* N = dl.N.data() + K * q;
       has_nodal_dashpot_ = true;
       const double c = dl.alpha[q] * p.mass[L.idx[q]];
       for (int a = 0; a < K; ++a) {
-        grid.cxx[dn[a]] += c * sf.N[a];
-        grid.cyy[dn[a]] += c * sf.N[a];
+        grid.cxx[dn[a]] += c * N[a];
+        grid.cyy[dn[a]] += c * N[a];
         add_dashpot_node(dn[a]);
       }
     }
     // The stiffness-proportional part: the last step's viscous stress, -V sigma_v grad N_i,
     // with the gradients at the step's start kept for boundary_work.
     if (dl.beta0 > 0) {
-      dl.gnodes.resize(K * L.idx.size());
-      dl.dNx.resize(K * L.idx.size());
-      dl.dNy.resize(K * L.idx.size());
-      for (std::size_t q = 0; q < L.idx.size(); ++q) {
+      const long n = static_cast<long>(L.idx.size());
+      dl.gnodes.resize(K * n);
+      dl.dNx.resize(K * n);
+      dl.dNy.resize(K * n);
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+      for (long q = 0; q < n; ++q) {
         if (dl.beta[q] == 0) continue;
-        long* dn = dl.gnodes.data() + K * q;
-        layer_shape(L, q, Anchor::Particle, sf, dn);
+        S sf;
+        layer_shape(L, q, Anchor::Particle, sf, dl.gnodes.data() + K * q);
         std::copy(sf.dNx, sf.dNx + K, dl.dNx.data() + K * q);
         std::copy(sf.dNy, sf.dNy + K, dl.dNy.data() + K * q);
+      }
+      for (long q = 0; q < n; ++q) {
+        if (dl.beta[q] == 0) continue;
         const double* sv = dl.sv.data() + 3 * q;
         if (sv[0] == 0 && sv[1] == 0 && sv[2] == 0) continue;
+        const long* dn = dl.gnodes.data() + K * q;
+        const double* dNx = dl.dNx.data() + K * q;
+        const double* dNy = dl.dNy.data() + K * q;
         const double V = p.vol[L.idx[q]];
         for (int a = 0; a < K; ++a) {
-          grid.fx[dn[a]] -= V * (sv[0] * sf.dNx[a] + sv[2] * sf.dNy[a]);
-          grid.fy[dn[a]] -= V * (sv[2] * sf.dNx[a] + sv[1] * sf.dNy[a]);
+          grid.fx[dn[a]] -= V * (sv[0] * dNx[a] + sv[2] * dNy[a]);
+          grid.fy[dn[a]] -= V * (sv[2] * dNx[a] + sv[1] * dNy[a]);
         }
       }
     }
@@ -1025,19 +1055,26 @@ void Solver::boundary_work(bool remapped) {
     ax = 0.5 * (grid.vx[i] + ux[i]);
     ay = 0.5 * (grid.vy[i] + uy[i]);
   };
+  // Each layer's terms are computed per entry in parallel into the scratch array, then added
+  // to the account in entry order: the sums of one pass in order, bit for bit.
+  std::vector<double>& T = layer_scratch_;
   for (const auto& tl : tractions) {
     const double f = tl.fn(t);
     if (f == 0.0) continue;
-    for (std::size_t q = 0; q < tl.layer.idx.size(); ++q) {
+    const long n = static_cast<long>(tl.layer.idx.size());
+    T.resize(K * static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+    for (long q = 0; q < n; ++q) {
       double tx, ty, ax, ay;
       traction_of(tl, q, f, tx, ty);
       const long* tn = tl.nodes.data() + K * q;  // the weights apply_loads mapped with
       const double* N = tl.N.data() + K * q;
       for (int a = 0; a < K; ++a) {
         wbar(tn[a], ax, ay);
-        energy.external_work += dt * tl.layer.w[q] * N[a] * (tx * ax + ty * ay);
+        T[K * q + a] = dt * tl.layer.w[q] * N[a] * (tx * ax + ty * ay);
       }
     }
+    for (long i = 0; i < K * n; ++i) energy.external_work += T[i];
   }
   // Gravity's work with the same velocity as the tractions' (void nodes have m = 0).
   if (opt.gravity_x != 0 || opt.gravity_y != 0) {
@@ -1068,10 +1105,14 @@ void Solver::boundary_work(bool remapped) {
   }
   for (auto& sl : silents) {
     const auto& L = sl.layer;
-    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+    const long n = static_cast<long>(L.idx.size());
+    T.resize(K * static_cast<std::size_t>(n));
+    const bool advance = sl.springs() && opt.scheme != Scheme::USF;
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+    for (long q = 0; q < n; ++q) {
       const long* sn = sl.nodes.data() + K * q;  // the weights apply_loads mapped with
       const double* N = sl.N.data() + K * q;
-      if (sl.springs() && opt.scheme != Scheme::USF) advance_spring<K>(sl, q, N, sn, ux, uy, dt);
+      if (advance) advance_spring<K>(sl, q, N, sn, ux, uy, dt);
       for (int a = 0; a < K; ++a) {
         double ax, ay, tx, ty, bx, by;
         vbar(sn[a], ax, ay);
@@ -1079,14 +1120,18 @@ void Solver::boundary_work(bool remapped) {
         // The dashpot acts on the particle velocity (paper form) or on each node's mid-step one.
         if (sl.form == SilentForm::Particle) dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
         else dashpot_of(sl, q, ax, ay, tx, ty);
-        energy.absorbed -= dt * L.w[q] * N[a] * (tx * bx + ty * by);
+        T[K * q + a] = dt * L.w[q] * N[a] * (tx * bx + ty * by);
       }
     }
+    for (long i = 0; i < K * n; ++i) energy.absorbed -= T[i];
   }
   // Perfectly matched layers: the damping force's power, and that of the explicit loads; then
   // the particles' displacements advance (USF: in pml_loads).
   if (pml.active()) {
-    for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
+    const long n = static_cast<long>(pml.layer.idx.size());
+    T.resize(K * static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+    for (long q = 0; q < n; ++q) {
       const long* pn = pml.nodes.data() + K * q;
       const double* N = pml.N.data() + K * q;
       const double* dNx = pml.dNx.data() + K * q;
@@ -1099,16 +1144,20 @@ void Solver::boundary_work(bool remapped) {
         wbar(pn[a], bx, by);
         const double fx = f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
         const double fy = f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
-        energy.absorbed += dt * (cm * N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
+        T[K * q + a] = dt * (cm * N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
       }
     }
+    for (long i = 0; i < K * n; ++i) energy.absorbed += T[i];
     if (opt.scheme != Scheme::USF) pml_advance<S>(ux, uy);
   }
   // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i, with the
   // weights the blocks were assembled with.
   for (auto& dl : dampers) {
     const auto& L = dl.layer;
-    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+    const long n = static_cast<long>(L.idx.size());
+    T.resize(K * static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+    for (long q = 0; q < n; ++q) {
       if (dl.alpha[q] == 0) continue;
       const long* dn = dl.nodes.data() + K * q;
       const double* N = dl.N.data() + K * q;
@@ -1117,9 +1166,12 @@ void Solver::boundary_work(bool remapped) {
         double ax, ay, bx, by;
         vbar(dn[a], ax, ay);
         wbar(dn[a], bx, by);
-        energy.absorbed += dt * c * N[a] * (ax * bx + ay * by);
+        T[K * q + a] = dt * c * N[a] * (ax * bx + ay * by);
       }
     }
+    for (long q = 0; q < n; ++q)
+      if (dl.alpha[q] != 0)
+        for (int a = 0; a < K; ++a) energy.absorbed += T[K * q + a];
     if (!(dl.beta0 > 0)) continue;
     // The stiffness-proportional part: the work of the viscous force this step applied (with
     // the power's velocity), then the viscous stress beta C : D for the next, all with the
@@ -1129,7 +1181,8 @@ void Solver::boundary_work(bool remapped) {
     // magnifies the force and broke the explicit limit (docs/physics.md section 9.2).
     const std::vector<double>& sx = opt.scheme == Scheme::USL ? grid.vx : ux;
     const std::vector<double>& sy = opt.scheme == Scheme::USL ? grid.vy : uy;
-    for (std::size_t q = 0; q < L.idx.size(); ++q) {
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+    for (long q = 0; q < n; ++q) {
       if (dl.beta[q] == 0) continue;
       const std::uint32_t k = L.idx[q];
       const long* gn = dl.gnodes.data() + K * q;
@@ -1141,8 +1194,8 @@ void Solver::boundary_work(bool remapped) {
       for (int a = 0; a < K; ++a) {
         double bx, by;
         wbar(gn[a], bx, by);
-        energy.absorbed += dt * V * ((sv[0] * dNx[a] + sv[2] * dNy[a]) * bx +
-                                     (sv[2] * dNx[a] + sv[1] * dNy[a]) * by);
+        T[K * q + a] = dt * V * ((sv[0] * dNx[a] + sv[2] * dNy[a]) * bx +
+                                 (sv[2] * dNx[a] + sv[1] * dNy[a]) * by);
         lxx += sx[gn[a]] * dNx[a];
         lxy += sx[gn[a]] * dNy[a];
         lyx += sy[gn[a]] * dNx[a];
@@ -1154,6 +1207,9 @@ void Solver::boundary_work(bool remapped) {
       sv[1] = b * (m.lambda * tr + 2 * m.mu * lyy);
       sv[2] = b * m.mu * (lxy + lyx);
     }
+    for (long q = 0; q < n; ++q)
+      if (dl.beta[q] != 0)
+        for (int a = 0; a < K; ++a) energy.absorbed += T[K * q + a];
   }
 }
 

@@ -311,6 +311,14 @@ class Solver {
   template <class S> void p2g(unsigned what);
   void start_velocities();
   template <class S> void apply_loads();
+  // Every entry's weights of layer L (into wn, wN; K per entry), each entry its own: in
+  // parallel, the same values as in order. Entries with skip(q) keep what they held.
+  template <class S, class Skip>
+  void layer_weights(const BoundaryLayer& L, Anchor anchor, std::vector<long>& wn,
+                     std::vector<double>& wN, Skip&& skip);
+  // Per-entry scratch of the layers' loads and work (computed in parallel, then summed or
+  // scattered in entry order, so the sums are those of one pass in order).
+  std::vector<double> layer_scratch_;
   template <class S> void pml_shapes();
   template <class S> void pml_loads();
   template <class S> void pml_pic();
