@@ -36,6 +36,16 @@ namespace fs = std::filesystem;
 
 fs::path folder(const std::string& name) { return mpi_testing::scratch_folder("state_ranks", name); }
 
+// The error of a write on every rank ("" if none).
+std::string write_error(const StateWriter& w, const fs::path& file) {
+  try {
+    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 std::string read_bytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream s;
@@ -111,12 +121,7 @@ TEST(StateRanks, AFailedWriteIsOneErrorOnEveryRank) {
   const fs::path file = folder("fail") / "missing" / "state.smpm";
   StateWriter w;
   w.put_part("a", part_a(mpi_testing::world_rank()));
-  std::string what;
-  try {
-    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
-  } catch (const std::runtime_error& e) {
-    what = e.what();
-  }
+  const std::string what = write_error(w, file);
   EXPECT_NE(what.find(file.string() + ": cannot create state.smpm.tmp"), std::string::npos) << what;
   EXPECT_EQ(what, mpi_testing::root_string(what)) << "the same message on every rank";
   EXPECT_FALSE(fs::exists(file));
@@ -130,12 +135,7 @@ TEST(StateRanks, AFullDiskIsOneErrorOnEveryRank) {
   MPI_Barrier(MPI_COMM_WORLD);
   StateWriter w;
   w.put_part("a", std::vector<double>(1000, 1.0));
-  std::string what;
-  try {
-    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
-  } catch (const std::runtime_error& e) {
-    what = e.what();
-  }
+  const std::string what = write_error(w, file);
   EXPECT_EQ(what.rfind(file.string() + ": cannot ", 0), 0u) << what;
   EXPECT_EQ(what, mpi_testing::root_string(what)) << "the same message on every rank";
   EXPECT_FALSE(fs::exists(file));
@@ -158,12 +158,7 @@ TEST(StateRanks, AnOpenFailingOnOneRankLeavesNothingOpen) {
   };
   const std::size_t before = descriptors();
   set_state_write_open_fault(P - 1);
-  std::string what;
-  try {
-    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
-  } catch (const std::runtime_error& e) {
-    what = e.what();
-  }
+  const std::string what = write_error(w, file);
   set_state_write_open_fault(-1);
   EXPECT_EQ(what, file.string() + ": cannot create state.smpm.tmp: a fault set by a test (rank " +
                       std::to_string(P - 1) + " of " + std::to_string(P) + ")");
@@ -196,12 +191,7 @@ TEST(StateRanks, AFileSystemWithoutFsyncIsNoError) {
   MPI_Barrier(MPI_COMM_WORLD);
   StateWriter w;
   w.put_part("a", part_a(mpi_testing::world_rank()));
-  std::string what;
-  try {
-    write_state_collectively(w, file.string(), MPI_COMM_WORLD);
-  } catch (const std::runtime_error& e) {
-    what = e.what();
-  }
+  const std::string what = write_error(w, file);
   EXPECT_EQ(what, "") << "a device without fsync is not an error";
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(file)) && fs::read_symlink(file) == "/dev/null")
       << "the link renamed into place";
