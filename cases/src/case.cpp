@@ -631,8 +631,8 @@ class Builder {
   // a case with a geometry is read so first, and its mistakes are reported before the mesh is made.
   // On several MPI ranks (`scatter`) rank 0 builds the whole case and the others (`skeleton`) the
   // case without its particles, which rank 0 then sends them (docs/parallel.md "Set-up"); the
-  // checks that need the particles run on rank 0 only. Not with multi-field contact, whose
-  // material groups follow the particles: every rank then builds the whole case.
+  // checks that need the particles run on rank 0 only. With multi-field contact the material
+  // groups split by body on rank 0's whole body go to the others with the split.
   Builder(const Ctx& ctx, const ojson& doc, bool checking = false, bool scatter = false,
           bool skeleton = false)
       : ctx_(ctx), doc_(doc), checking_(checking), scatter_(scatter), skeleton_(skeleton) {}
@@ -672,7 +672,7 @@ class Builder {
       c.notes.push_back("gravity (" + fmt(g[0]) + ", " + fmt(g[1]) + ") m/s^2");
     }
     if (const ojson* ct = top.find("contact")) parse_contact(Obj(ctx_, *ct, "contact"), c);
-    c.scattered = scatter_ && !s_->contact.multi();
+    c.scattered = scatter_;
     scattered_ = c.scattered;
     skeleton_ = skeleton_ && c.scattered;
     s_->seed_nothing = skeleton_;

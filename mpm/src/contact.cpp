@@ -13,6 +13,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "silentmpm/kernels.hpp"
@@ -43,6 +45,8 @@ void Contact::setup(Solver& s) {
   // Split material groups so that each group holds one body: the first body met in a group keeps
   // the group, every further body of that group gets a copy of the material.
   const std::size_t G0 = s.materials.size();
+  groups_before_ = static_cast<int>(G0);
+  copied_from_.clear();
   std::vector<int> owner(G0, -1);
   std::map<std::pair<int, int>, int> split;  // (group, body) -> new group
   int bmax = -1;
@@ -54,6 +58,7 @@ void Contact::setup(Solver& s) {
     auto it = split.find({g, b});
     if (it == split.end()) {
       s.materials.push_back(s.materials[g]);
+      copied_from_.push_back(g);
       it = split.emplace(std::make_pair(g, b), static_cast<int>(s.materials.size() - 1)).first;
     }
     s.p.group[k] = static_cast<uint16_t>(it->second);
@@ -62,6 +67,37 @@ void Contact::setup(Solver& s) {
   body_of_group_.assign(s.materials.size(), 0);
   for (std::size_t g = 0; g < G0; ++g) body_of_group_[g] = std::max(owner[g], 0);
   for (const auto& [gb, g] : split) body_of_group_[g] = gb.second;
+  force.assign(nb_, {0.0, 0.0});
+  dissipated = 0;
+  resize(s);
+}
+
+std::vector<int> Contact::split_layout() const {
+  std::vector<int> v = {nb_, groups_before_, static_cast<int>(copied_from_.size())};
+  v.insert(v.end(), copied_from_.begin(), copied_from_.end());
+  v.insert(v.end(), body_of_group_.begin(), body_of_group_.end());
+  return v;
+}
+
+void Contact::adopt_split(Solver& s, const std::vector<int>& layout) {
+  const auto bad = [](const char* why) {
+    throw std::logic_error(std::string("contact: rank 0's split cannot be taken: ") + why);
+  };
+  if (layout.size() < 3) bad("too short");
+  const int nb = layout[0], G0 = layout[1], added = layout[2];
+  if (nb < 0 || G0 < 0 || added < 0 || layout.size() != 3u + added + (G0 + added))
+    bad("inconsistent sizes");
+  if (s.p.size() != 0 || static_cast<int>(s.materials.size()) != G0)
+    bad("this solver holds particles or other material groups");
+  for (int k = 0; k < added; ++k) {
+    const int from = layout[3 + k];
+    if (from < 0 || from >= G0) bad("a copy of a group that does not exist");
+    s.materials.push_back(s.materials[from]);
+  }
+  groups_before_ = G0;
+  copied_from_.assign(layout.begin() + 3, layout.begin() + 3 + added);
+  body_of_group_.assign(layout.begin() + 3 + added, layout.end());
+  nb_ = nb;
   force.assign(nb_, {0.0, 0.0});
   dissipated = 0;
   resize(s);

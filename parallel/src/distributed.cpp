@@ -251,6 +251,12 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
     std::array<double, 4> b = s.body_scalars();
     MPI_Bcast(b.data(), 4, MPI_DOUBLE, 0, comm);
     s.set_body_scalars(b);
+    if (s.contact.multi()) {  // the material groups split by body (the particles carry them)
+      std::vector<int> layout;
+      if (d.rank == 0) layout = s.contact.split_layout();
+      broadcast_all(layout, MPI_INT, comm);
+      if (d.rank != 0) s.contact.adopt_split(s, layout);
+    }
   }
   d.Cx = cuts(cx, d.m, d.w);
   d.Ry = cuts(cy, d.n, d.w);

@@ -366,14 +366,17 @@ TEST(Ranks, MigrationKeepsIdsCountsAndLayers) {
 // holds a sliver of mass, whose velocity p / m magnifies the order of the additions; measured
 // 1e-14 under MUSL and USF, 3e-12 to 4e-12 under USL, which strains the particles with those
 // nodes' updated velocities.
-std::unique_ptr<Solver> make_contact(Scheme sc) {
+// `shared`: both bodies of material 0, so that the contact set-up splits its group by body;
+// `skeleton`: the case without its particles (set-up from rank 0).
+std::unique_ptr<Solver> make_contact(Scheme sc, bool shared = false, bool skeleton = false) {
   const double h = 1e-3;
   auto s = std::make_unique<Solver>();
   s->materials.push_back(tungsten());
   s->materials.push_back(tungsten());
+  s->seed_nothing = skeleton;
   s->grid.init(-3 * h, -3 * h, h, 36, 36);
   s->seed_rectangle(0, 0, 30 * h, 12 * h, 2, 0, 0, 0, 0);
-  s->seed_rectangle(8 * h, 12.25 * h, 22 * h, 26 * h, 2, 1, 1, 20, -100);
+  s->seed_rectangle(8 * h, 12.25 * h, 22 * h, 26 * h, 2, shared ? 0 : 1, 1, 20, -100);
   s->contact.type = ContactType::Multi;
   s->contact.friction = 0.3;
   s->opt.scheme = sc;
@@ -479,6 +482,54 @@ TEST(Ranks, SetUpFromRankZeroAsTheWholeCaseSplit) {
         whole->step();
         sent->step();
       }
+      whole->update_energies();
+      sent->update_energies();
+      const Outcome a{gather(*whole), whole->total_energy(), 0, 0};
+      const Outcome b{gather(*sent), sent->total_energy(), 0, 0};
+      expect_agreement(b, a, "set-up from rank 0 against the split whole case, " + what, 0.0);
+    }
+}
+
+// Set-up from rank 0 with multi-field contact: rank 0's contact set-up splits the material
+// group both bodies share (one group per body); the other ranks, which built the case without
+// its particles, take that split with their particles. Each rank then holds the material groups
+// and the particles of the whole case split, every array bit for bit by id, and 250 steps on
+// the fields, the energies and the contact force on the block are the same bits.
+TEST(Ranks, SetUpFromRankZeroWithMultiFieldContact) {
+  for (Scheme sc : {Scheme::MUSL, Scheme::USL})
+    for (int l : layouts()) {
+      auto whole = make_contact(sc, true);
+      Distributed dw(*whole, MPI_COMM_WORLD, l);
+      auto sent = make_contact(sc, true, mpi_testing::world_rank() != 0);
+      Distributed ds(*sent, MPI_COMM_WORLD, l, true);
+      const std::string what = std::string("contact, ") + scheme_name(sc) + ", " + layout_name(l);
+      ASSERT_EQ(whole->materials.size(), 3u) << what << ": the shared group split by body";
+      ASSERT_EQ(sent->materials.size(), whole->materials.size()) << what;
+      ASSERT_EQ(sent->p.size(), whole->p.size()) << what;
+      std::map<std::uint32_t, std::size_t> at;
+      for (std::size_t q = 0; q < sent->p.size(); ++q) at[sent->p.id[q]] = q;
+      long same = 0;
+      for (std::size_t q = 0; q < whole->p.size(); ++q) {
+        const auto it = at.find(whole->p.id[q]);
+        if (it == at.end()) continue;
+        const std::size_t r = it->second;
+        const Particles &a = whole->p, &b = sent->p;
+        same += a.x[q] == b.x[r] && a.y[q] == b.y[r] && a.vx[q] == b.vx[r] &&
+                a.vy[q] == b.vy[r] && a.mass[q] == b.mass[r] && a.group[q] == b.group[r] &&
+                a.body[q] == b.body[r];
+      }
+      EXPECT_EQ(same, static_cast<long>(whole->p.size())) << what;
+      double fmax = 0, df = 0;
+      for (int n = 0; n < 250; ++n) {
+        whole->step();
+        sent->step();
+        const ProbeSample a = whole->region_mean(-1, -1, 1, 1, 1);
+        const ProbeSample b = sent->region_mean(-1, -1, 1, 1, 1);
+        fmax = std::max({fmax, std::abs(a.fcx), std::abs(a.fcy)});
+        df = std::max({df, std::abs(a.fcx - b.fcx), std::abs(a.fcy - b.fcy)});
+      }
+      EXPECT_GT(fmax, 0) << what << ": the bodies met";
+      EXPECT_EQ(df, 0.0) << what << ": contact force";
       whole->update_energies();
       sent->update_energies();
       const Outcome a{gather(*whole), whole->total_energy(), 0, 0};

@@ -87,6 +87,13 @@ class Contact : public StepHooks {
   // particles of one body (a body's particles then form contiguous ranges), sizes the fields and
   // hands them to the solver (Solver::use_body_fields).
   void setup(Solver& s);
+  // The split's outcome, for the ranks of a set-up from rank 0 that built the case without its
+  // particles (docs/parallel.md "Set-up"): the bodies, the groups before the split, the group
+  // each added group copies and the body of every group.
+  std::vector<int> split_layout() const;
+  // Rank 0's split (split_layout) on a rank whose solver holds no particles and has not split
+  // its groups: the same copies of materials, the same bodies, the fields sized.
+  void adopt_split(Solver& s, const std::vector<int>& layout);
   // Sizes the bodies' fields to the solver's grid and hands them to it: by setup, and again
   // when a decomposition replaced the grid by a window of it.
   void resize(Solver& s);
@@ -100,6 +107,8 @@ class Contact : public StepHooks {
  private:
   int nb_ = 0;                    // bodies
   std::vector<int> body_of_group_;
+  int groups_before_ = 0;          // material groups before the split
+  std::vector<int> copied_from_;  // per group the split added: the group it copies
   using Field = std::vector<std::vector<double>>;  // [body][node]
   Field m_, px_, py_, fx_, fy_, gx_, gy_, vx_, vy_, vnx_, vny_, qx_, qy_;
   Field xm_, ym_, sm_;  // sum m_p N x_p, sum m_p N y_p, sum m_p N sqrt(V_p): nodal centroid, size
