@@ -90,7 +90,7 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
   if (process_count() > 1 && c.scattered) {
     std::string error, rest;
     if (process_rank() == 0) try {
-        reader.emplace(read_whole(file), file);
+        reader.emplace(StateReader::open(file));
         rest = reader->without(Solver::particle_blocks("mpm."));
       } catch (const std::exception& e) {
         error = e.what();
@@ -100,7 +100,7 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
     detail::mpi()->broadcast(rest);
     if (process_rank() != 0) reader.emplace(std::move(rest), file);
   } else {
-    reader.emplace(read_whole(file), file);
+    reader.emplace(StateReader::open(file));
   }
   const StateReader& r = *reader;
   const std::string version = r.get_string("run.version");

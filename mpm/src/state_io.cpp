@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
+#include <filesystem>
 
 namespace smpm {
 
@@ -112,47 +114,92 @@ void StateReader::fail(const std::string& what) const {
 }
 
 StateReader::StateReader(std::string bytes, std::string file)
-    : data_(std::move(bytes)), file_(std::move(file)) {
+    : data_(std::move(bytes)), file_(std::move(file)), size_(data_.size()) {
+  parse();
+}
+
+StateReader StateReader::open(const std::string& path) {
+  StateReader r;
+  r.file_ = path;
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  std::FILE* f = ec ? nullptr : std::fopen(path.c_str(), "rb");
+  if (!f) throw std::runtime_error(path + ": cannot read it");
+  r.disk_.reset(f, std::fclose);
+  r.size_ = static_cast<std::size_t>(size);
+  r.parse();
+  return r;
+}
+
+void StateReader::read_at(std::size_t pos, std::size_t n, void* out) const {
+  if (!disk_) {
+    std::memcpy(out, data_.data() + pos, n);
+    return;
+  }
+  if (fseeko(disk_.get(), static_cast<off_t>(pos), SEEK_SET) != 0 ||
+      std::fread(out, 1, n, disk_.get()) != n)
+    fail("cannot read bytes " + std::to_string(pos) + " to " + std::to_string(pos + n) + " of " +
+         std::to_string(size_) + " (" + (std::ferror(disk_.get()) ? std::strerror(errno)
+                                                                    : "the file got shorter") +
+         ")");
+}
+
+void StateReader::parse() {
   const std::size_t head = sizeof kMagic + 8;
-  if (data_.size() < head || std::memcmp(data_.data(), kMagic, sizeof kMagic) != 0)
+  char magic[sizeof kMagic] = {};
+  if (size_ >= head) read_at(0, sizeof kMagic, magic);
+  if (size_ < head || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
     fail("not a silentmpm checkpoint (no SMPMSTATE header)");
   std::uint32_t layout, order;
-  std::memcpy(&layout, data_.data() + sizeof kMagic, 4);
-  std::memcpy(&order, data_.data() + sizeof kMagic + 4, 4);
+  read_at(sizeof kMagic, 4, &layout);
+  read_at(sizeof kMagic + 4, 4, &order);
   if (order != kOrderMark) fail("written on a machine of another byte order");
   if (layout != kLayout)
     fail("checkpoint layout " + std::to_string(layout) + ", this build reads layout " +
          std::to_string(kLayout) + " (written by another version: run the case from the start)");
   std::size_t pos = head;
   auto need = [&](std::size_t n) {
-    if (data_.size() - pos < n)
-      fail("truncated at byte " + std::to_string(pos) + " of " + std::to_string(data_.size()) +
+    if (size_ - pos < n)
+      fail("truncated at byte " + std::to_string(pos) + " of " + std::to_string(size_) +
            " (the file was cut short: an interrupted copy or a full disk)");
   };
   for (;;) {
     std::uint32_t len, elem;
     std::uint64_t count;
     need(4);
-    std::memcpy(&len, data_.data() + pos, 4);
+    read_at(pos, 4, &len);
     pos += 4;
     if (len > 256) fail("corrupt block table at byte " + std::to_string(pos - 4));
     need(len + 12);
-    const std::string name = data_.substr(pos, len);
+    std::string name(len, '\0');
+    read_at(pos, len, name.data());
     pos += len;
-    std::memcpy(&elem, data_.data() + pos, 4);
-    std::memcpy(&count, data_.data() + pos + 4, 8);
+    read_at(pos, 4, &elem);
+    read_at(pos + 4, 8, &count);
     pos += 12;
     if (name == "end") break;
-    if (elem == 0 || count > (data_.size() - pos) / elem)
+    if (elem == 0 || count > (size_ - pos) / elem)
       fail("truncated in block '" + name + "' (the file was cut short)");
     blocks_[name] = Block{elem, static_cast<std::size_t>(count), pos};
     pos += elem * count;
   }
   need(8);
   std::uint64_t sum;
-  std::memcpy(&sum, data_.data() + pos, 8);
-  if (sum != state_hash(data_.data(), pos)) fail("checksum mismatch (the file is corrupt)");
-  if (pos + 8 != data_.size()) fail("trailing bytes after the end mark (the file is corrupt)");
+  read_at(pos, 8, &sum);
+  std::uint64_t h = 0;
+  if (!disk_) {
+    h = state_hash(data_.data(), pos);
+  } else {  // in pieces: the hash continues across them
+    std::string piece(std::min<std::size_t>(pos, std::size_t{1} << 26), '\0');
+    for (std::size_t at = 0; at < pos;) {
+      const std::size_t n = std::min(piece.size(), pos - at);
+      read_at(at, n, piece.data());
+      h = state_hash(piece.data(), n, h);
+      at += n;
+    }
+  }
+  if (sum != h) fail("checksum mismatch (the file is corrupt)");
+  if (pos + 8 != size_) fail("trailing bytes after the end mark (the file is corrupt)");
 }
 
 const StateReader::Block& StateReader::find(const std::string& name, std::size_t elem) const {
@@ -178,16 +225,21 @@ std::string StateReader::without(const std::vector<std::string>& prefixes) const
   }
   std::sort(kept.begin(), kept.end());
   StateWriter w;
+  std::string block;
   for (const auto& [offset, name] : kept) {
     const Block& b = blocks_.at(name);
-    w.put_block(name, b.elem, b.count, data_.data() + b.offset);
+    block.resize(b.elem * b.count);
+    if (!block.empty()) read_at(b.offset, block.size(), block.data());
+    w.put_block(name, b.elem, b.count, block.data());
   }
   return w.bytes();
 }
 
 std::string StateReader::get_string(const std::string& name) const {
   const Block& b = find(name, 1);
-  return data_.substr(b.offset, b.count);
+  std::string s(b.count, '\0');
+  if (b.count) read_at(b.offset, b.count, s.data());
+  return s;
 }
 
 }  // namespace smpm

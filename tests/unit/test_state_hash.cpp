@@ -1,10 +1,15 @@
 // The checkpoint's checksum (state_io.hpp): pieces hashed apart join into the whole's hash, at
 // every split of a buffer and from any starting hash; a change of any one byte changes it; the
-// word-at-a-time loop equals the plain byte-by-byte definition.
+// word-at-a-time loop equals the plain byte-by-byte definition. A reader over the file on disk
+// (StateReader::open, which hashes the file in pieces) reads what the reader over its bytes
+// reads, and refuses what it refuses with the same message.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <functional>
+#include <fstream>
 #include <random>
 #include <string>
 
@@ -77,6 +82,58 @@ TEST(StateHash, IsTheFilesChecksum) {
   c[20] ^= 1;
   EXPECT_THROW(StateReader(c, "c"), StateError);
   EXPECT_NO_THROW(StateReader(b, "b"));
+}
+
+std::string reader_error(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(StateHash, ReaderOnTheDiskReadsAsOnTheBytes) {
+  std::mt19937_64 g(17);
+  std::vector<double> big(300000);
+  for (double& v : big) v = static_cast<double>(g() % 1000003) * 0.25;
+  StateWriter w;
+  w.put_string("run.note", "a checkpoint");
+  w.put("mpm.x", big);
+  w.put("mpm.count", std::int64_t{42});
+  w.put("empty", std::vector<float>{});
+  const std::string bytes = w.bytes();
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "smpm_state_open";
+  std::filesystem::create_directories(dir);
+  auto save = [&](const std::string& name, const std::string& b) {
+    std::ofstream(dir / name, std::ios::binary) << b;
+    return (dir / name).string();
+  };
+  const std::string file = save("state.smpm", bytes);
+  const StateReader disk = StateReader::open(file), mem(bytes, file);
+  std::vector<double> a, b;
+  disk.get("mpm.x", a);
+  mem.get("mpm.x", b);
+  EXPECT_TRUE(a == b && a == big);
+  EXPECT_EQ(disk.get<std::int64_t>("mpm.count"), 42);
+  EXPECT_EQ(disk.get_string("run.note"), "a checkpoint");
+  std::vector<float> e{1.0f};
+  disk.get("empty", e);
+  EXPECT_TRUE(e.empty());
+  EXPECT_EQ(disk.without({"mpm."}), mem.without({"mpm."}));
+  // Refused alike: a flipped byte in the middle, a cut, trailing bytes; a missing file.
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 4;
+  for (const std::string& bad :
+       {flipped, bytes.substr(0, bytes.size() / 3), bytes + "x", bytes.substr(0, 10)}) {
+    const std::string f = save("bad.smpm", bad);
+    const std::string want = reader_error([&] { StateReader(bad, f); });
+    EXPECT_FALSE(want.empty());
+    EXPECT_EQ(reader_error([&] { StateReader::open(f); }), want);
+  }
+  EXPECT_EQ(reader_error([&] { StateReader::open((dir / "none.smpm").string()); }),
+            (dir / "none.smpm").string() + ": cannot read it");
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

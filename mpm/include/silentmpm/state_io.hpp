@@ -18,8 +18,10 @@
 // rank 0 alone. The checksum is a hash that pieces hashed apart can join, so each rank hashes
 // what it writes.
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -101,6 +103,11 @@ class StateReader {
  public:
   // Parses and checks the whole file (header, block table, checksum); `file` names it in errors.
   StateReader(std::string bytes, std::string file);
+  // The file at `path`, read from the disk block by block as the getters ask, after the same
+  // checks (the checksum streamed over the file in pieces): no buffer the size of the file, so a
+  // restart holds one copy of the state, the solver's. An unreadable file is a
+  // std::runtime_error "PATH: cannot read it".
+  static StateReader open(const std::string& path);
   bool has(const std::string& name) const { return blocks_.count(name) != 0; }
   // An array block; `count` (when not npos) is the length the caller expects.
   template <class T>
@@ -108,14 +115,14 @@ class StateReader {
     const Block& b = find(name, sizeof(T));
     if (count != npos && b.count != count) mismatch(name, b.count, count);
     v.resize(b.count);
-    if (b.count) std::memcpy(v.data(), data_.data() + b.offset, b.count * sizeof(T));
+    if (b.count) read_at(b.offset, b.count * sizeof(T), v.data());
   }
   template <class T>
   T get(const std::string& name) const {
     const Block& b = find(name, sizeof(T));
     if (b.count != 1) mismatch(name, b.count, 1);
     T v;
-    std::memcpy(&v, data_.data() + b.offset, sizeof(T));
+    read_at(b.offset, sizeof(T), &v);
     return v;
   }
   std::string get_string(const std::string& name) const;
@@ -131,8 +138,13 @@ class StateReader {
   struct Block {
     std::size_t elem = 0, count = 0, offset = 0;
   };
+  StateReader() = default;
   std::string data_, file_;
+  std::shared_ptr<std::FILE> disk_;  // the open file (open()); else the bytes are data_
+  std::size_t size_ = 0;             // the file's bytes
   std::map<std::string, Block> blocks_;
+  void parse();
+  void read_at(std::size_t pos, std::size_t n, void* out) const;
   const Block& find(const std::string& name, std::size_t elem) const;
   [[noreturn]] void mismatch(const std::string& name, std::size_t got, std::size_t want) const;
 };
