@@ -94,6 +94,8 @@ void Contact::adopt_split(Solver& s, const std::vector<int>& layout) {
     if (from < 0 || from >= G0) bad("a copy of a group that does not exist");
     s.materials.push_back(s.materials[from]);
   }
+  for (std::size_t k = 3 + added; k < layout.size(); ++k)
+    if (layout[k] < 0 || layout[k] >= std::max(nb, 1)) bad("a group of a body that does not exist");
   groups_before_ = G0;
   copied_from_.assign(layout.begin() + 3, layout.begin() + 3 + added);
   body_of_group_.assign(layout.begin() + 3 + added, layout.end());

@@ -874,14 +874,14 @@ void Solver::apply_loads() {
     const long n = static_cast<long>(L.idx.size());
     layer_weights<S>(L, sl.anchor, sl.nodes, sl.N, none);
     // Per entry: the spring's traction (2), then the particle form's dashpot traction (2) or
-    // the nodal form's block (3) and rho c_d (1).
-    layer_scratch_.resize(6 * static_cast<std::size_t>(n));
+    // the nodal form's block (3), rho and c_d (2; their product is taken as (w N rho) c_d).
+    layer_scratch_.resize(7 * static_cast<std::size_t>(n));
     double* sc = layer_scratch_.data();
     const bool usf = opt.scheme == Scheme::USF;
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
     for (long q = 0; q < n; ++q) {
       const long* nodes = sl.nodes.data() + K * q;
-      double* o = sc + 6 * q;
+      double* o = sc + 7 * q;
       if (sl.springs()) {  // explicit: the displacement at the start of the step
         // USF strains the particles with the start-of-step velocity before the forces: the
         // springs do the same.
@@ -893,14 +893,15 @@ void Solver::apply_loads() {
       } else {
         lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], o[2], o[3], o[4]);
         const Material& mq = materials[p.group[L.idx[q]]];
-        o[5] = mq.rho * mq.cd;
+        o[5] = mq.rho;
+        o[6] = mq.cd;
       }
     }
     const bool updated = !updated_weight_.empty() && sl.updated_velocity;
     for (long q = 0; q < n; ++q) {
       const long* nodes = sl.nodes.data() + K * q;
       const double* N = sl.N.data() + K * q;
-      const double* o = sc + 6 * q;
+      const double* o = sc + 7 * q;
       if (sl.springs())
         for (int a = 0; a < K; ++a) {
           grid.fx[nodes[a]] += o[0] * L.w[q] * N[a];
@@ -919,7 +920,7 @@ void Solver::apply_loads() {
         grid.cxx[nodes[a]] += wn * o[2];
         grid.cxy[nodes[a]] += wn * o[3];
         grid.cyy[nodes[a]] += wn * o[4];
-        if (updated) updated_weight_[nodes[a]] += wn * o[5];
+        if (updated) updated_weight_[nodes[a]] += wn * o[5] * o[6];
         add_dashpot_node(nodes[a]);
       }
     }

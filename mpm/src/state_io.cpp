@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <filesystem>
 
+#include <unistd.h>
+
 namespace smpm {
 
 namespace {
@@ -136,12 +138,20 @@ void StateReader::read_at(std::size_t pos, std::size_t n, void* out) const {
     std::memcpy(out, data_.data() + pos, n);
     return;
   }
-  if (fseeko(disk_.get(), static_cast<off_t>(pos), SEEK_SET) != 0 ||
-      std::fread(out, 1, n, disk_.get()) != n)
+  // pread keeps no file position: the reader's getters may run on any thread.
+  auto* dst = static_cast<char*>(out);
+  for (std::size_t done = 0; done < n;) {
+    const ssize_t got = ::pread(::fileno(disk_.get()), dst + done, n - done,
+                                static_cast<off_t>(pos + done));
+    if (got > 0) {
+      done += static_cast<std::size_t>(got);
+      continue;
+    }
+    if (got < 0 && errno == EINTR) continue;
+    const std::string why = got < 0 ? std::strerror(errno) : "the file got shorter";
     fail("cannot read bytes " + std::to_string(pos) + " to " + std::to_string(pos + n) + " of " +
-         std::to_string(size_) + " (" + (std::ferror(disk_.get()) ? std::strerror(errno)
-                                                                    : "the file got shorter") +
-         ")");
+         std::to_string(size_) + " (" + why + ")");
+  }
 }
 
 void StateReader::parse() {

@@ -189,6 +189,16 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
     opened = check(MPI_File_open(MPI_COMM_SELF, tmp.c_str(), MPI_MODE_CREATE | MPI_MODE_WRONLY,
                                  MPI_INFO_NULL, &fh),
                    "cannot create " + tmp_name);
+  // A descriptor of the same file for fsync, which MPI_File_sync cannot do with one process's
+  // leniency (below), taken now so that the sync sees every write of this rank.
+  int fd = -1;
+  if (opened) {
+    fd = ::open(tmp.c_str(), O_WRONLY);
+    if (fd < 0) {
+      const int e = errno;
+      err = "cannot open " + tmp_name + " to sync it: " + std::strerror(e);
+    }
+  }
   int ok = opened;
   MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_LAND, comm);
   if (ok) {
@@ -239,20 +249,15 @@ void write_state_collectively(const StateWriter& w, const std::string& path, MPI
     if (err.empty()) check(MPI_File_write_at(fh, static_cast<MPI_Offset>(sum_at), &h, 8, MPI_BYTE, &st),
                            "cannot write");
   }
-  if (opened) check(MPI_File_close(&fh), "cannot close");
-  // Each rank's pieces to the disk: fsync on its own descriptor (flushing the file's dirty
-  // pages of this node), with one process's leniency: a file system or device with no fsync
-  // (EINVAL, EROFS) is not an error.
-  if (ok && err.empty()) {
-    const int fd = ::open(tmp.c_str(), O_WRONLY);
-    if (fd < 0) {
-      err = "cannot reopen " + tmp_name + " to sync it: " + std::strerror(errno);
-    } else {
-      if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
-        err = std::string("cannot sync: ") + std::strerror(errno);
-      ::close(fd);
-    }
+  // Each rank's pieces to the disk before the handles close: fsync on its own descriptor
+  // (flushing the file's dirty pages of this node), with one process's leniency: a file system
+  // or device with no fsync (EINVAL, EROFS) is not an error.
+  if (ok && err.empty() && fd >= 0 && ::fsync(fd) != 0) {
+    const int e = errno;
+    if (e != EINVAL && e != EROFS) err = std::string("cannot sync: ") + std::strerror(e);
   }
+  if (fd >= 0) ::close(fd);
+  if (opened) check(MPI_File_close(&fh), "cannot close");
   if (ok && rank == 0 && err.empty()) {
     std::error_code ec;
     if (std::filesystem::is_regular_file(tmp, ec) &&

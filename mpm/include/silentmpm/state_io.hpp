@@ -105,8 +105,10 @@ class StateReader {
   StateReader(std::string bytes, std::string file);
   // The file at `path`, read from the disk block by block as the getters ask, after the same
   // checks (the checksum streamed over the file in pieces): no buffer the size of the file, so a
-  // restart holds one copy of the state, the solver's. An unreadable file is a
-  // std::runtime_error "PATH: cannot read it".
+  // restart holds one copy of the state, the solver's. The getters read the bytes again (the
+  // checksum vouches for the file as it was when opened; a file changed on the disk meanwhile
+  // is not caught). An unreadable file is a std::runtime_error "PATH: cannot read it"; a read
+  // that fails later a StateError naming the bytes and the cause.
   static StateReader open(const std::string& path);
   bool has(const std::string& name) const { return blocks_.count(name) != 0; }
   // An array block; `count` (when not npos) is the length the caller expects.
