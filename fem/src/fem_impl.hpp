@@ -35,7 +35,8 @@ struct Solver::Impl {
   std::vector<double> u, v, ku, fext;
 
   // Stiffness, node-block CSR: row i has blocks k in [rowptr[i], rowptr[i+1]), column col[k],
-  // values val[4k..4k+3] = Kxx, Kxy, Kyx, Kyy.
+  // values val[4k..4k+3] = Kxx, Kyx, Kxy, Kyy (column by column: K u takes a block's two
+  // columns as pairs, times u_x and u_y).
   // Rows equal to another's bit for bit may share values (fem_setup.cpp, share_equal_rows): with
   // row_val non-empty, row i's values start at block row_val[i] of val, not at rowptr[i].
   std::vector<std::uint64_t> rowptr;

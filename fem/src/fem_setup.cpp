@@ -515,7 +515,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
           const std::uint32_t nj = static_cast<std::uint32_t>(ld[j] / 2);
           const std::size_t cj = ld[j] % 2;
           const std::size_t k = std::lower_bound(b, en, nj) - m.col.data();
-          m.val[4 * k + 2 * ci + cj] += e.K[i * dpc + j];
+          m.val[4 * k + ci + 2 * cj] += e.K[i * dpc + j];
         }
       }
     }
@@ -699,10 +699,10 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
       const std::uint32_t* b = m.col.data() + m.rowptr[node];
       const std::uint32_t* en = m.col.data() + m.rowptr[node + 1];
       const std::size_t j = std::lower_bound(b, en, node) - m.col.data();
-      m.val[4 * j] += k[0];
-      m.val[4 * j + 1] += k[1];
-      m.val[4 * j + 2] += k[1];
-      m.val[4 * j + 3] += k[2];
+      m.val[4 * j] += k[0];      // xx
+      m.val[4 * j + 1] += k[1];  // yx
+      m.val[4 * j + 2] += k[1];  // xy
+      m.val[4 * j + 3] += k[2];  // yy
       const double mean = 0.5 * (k[0] + k[2]), dev = 0.5 * (k[0] - k[2]);
       lam_springs = std::max(lam_springs, (mean + std::sqrt(dev * dev + k[1] * k[1])) / m.mass[node]);
     }
