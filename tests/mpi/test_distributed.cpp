@@ -419,6 +419,23 @@ TEST(Ranks, MultiFieldContactAgreesWithOneProcess) {
   }
 }
 
+// The particles of `a` whose every array (position, velocity, mass, volume, stress, group,
+// body) equals, bit for bit, that of the particle of `b` with the same id.
+long same_by_id(const Particles& a, const Particles& b) {
+  std::map<std::uint32_t, std::size_t> at;
+  for (std::size_t q = 0; q < b.size(); ++q) at[b.id[q]] = q;
+  long same = 0;
+  for (std::size_t q = 0; q < a.size(); ++q) {
+    const auto it = at.find(a.id[q]);
+    if (it == at.end()) continue;
+    const std::size_t r = it->second;
+    same += a.x[q] == b.x[r] && a.y[q] == b.y[r] && a.vx[q] == b.vx[r] && a.vy[q] == b.vy[r] &&
+            a.mass[q] == b.mass[r] && a.vol[q] == b.vol[r] && a.sxx[q] == b.sxx[r] &&
+            a.group[q] == b.group[r] && a.body[q] == b.body[r];
+  }
+  return same;
+}
+
 // Set-up from rank 0 (docs/parallel.md "Set-up"): rank 0 builds the whole plate, the others its
 // skeleton, and the split sends each rank its block. Each rank then holds what the split of the
 // plate built whole on every rank gives it: the same particles, every array bit for bit by id,
@@ -439,20 +456,7 @@ TEST(Ranks, SetUpFromRankZeroAsTheWholeCaseSplit) {
       const std::string what = std::string(other ? "band, PML, particle LK" : "LK, springs") +
                                ", " + layout_name(l);
       ASSERT_EQ(sent->p.size(), whole->p.size()) << what;
-      // Every particle array by id.
-      std::map<std::uint32_t, std::size_t> at;
-      for (std::size_t q = 0; q < sent->p.size(); ++q) at[sent->p.id[q]] = q;
-      long same = 0;
-      for (std::size_t q = 0; q < whole->p.size(); ++q) {
-        const auto it = at.find(whole->p.id[q]);
-        if (it == at.end()) continue;
-        const std::size_t r = it->second;
-        const Particles &a = whole->p, &b = sent->p;
-        same += a.x[q] == b.x[r] && a.y[q] == b.y[r] && a.vx[q] == b.vx[r] && a.vy[q] == b.vy[r] &&
-                a.mass[q] == b.mass[r] && a.vol[q] == b.vol[r] && a.sxx[q] == b.sxx[r] &&
-                a.group[q] == b.group[r] && a.body[q] == b.body[r];
-      }
-      EXPECT_EQ(same, static_cast<long>(whole->p.size())) << what;
+      EXPECT_EQ(same_by_id(whole->p, sent->p), static_cast<long>(whole->p.size())) << what;
       // Every layer entry by its particle's id, with its values.
       auto entries = [](const Solver& s) {
         std::map<std::pair<int, std::uint32_t>, std::vector<double>> e;
@@ -506,19 +510,7 @@ TEST(Ranks, SetUpFromRankZeroWithMultiFieldContact) {
       ASSERT_EQ(whole->materials.size(), 3u) << what << ": the shared group split by body";
       ASSERT_EQ(sent->materials.size(), whole->materials.size()) << what;
       ASSERT_EQ(sent->p.size(), whole->p.size()) << what;
-      std::map<std::uint32_t, std::size_t> at;
-      for (std::size_t q = 0; q < sent->p.size(); ++q) at[sent->p.id[q]] = q;
-      long same = 0;
-      for (std::size_t q = 0; q < whole->p.size(); ++q) {
-        const auto it = at.find(whole->p.id[q]);
-        if (it == at.end()) continue;
-        const std::size_t r = it->second;
-        const Particles &a = whole->p, &b = sent->p;
-        same += a.x[q] == b.x[r] && a.y[q] == b.y[r] && a.vx[q] == b.vx[r] &&
-                a.vy[q] == b.vy[r] && a.mass[q] == b.mass[r] && a.group[q] == b.group[r] &&
-                a.body[q] == b.body[r];
-      }
-      EXPECT_EQ(same, static_cast<long>(whole->p.size())) << what;
+      EXPECT_EQ(same_by_id(whole->p, sent->p), static_cast<long>(whole->p.size())) << what;
       double fmax = 0, df = 0;
       for (int n = 0; n < 250; ++n) {
         whole->step();
