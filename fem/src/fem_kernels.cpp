@@ -194,40 +194,38 @@ inline void pml_cell(Solver::Impl::Pml& P, std::int64_t c, const double* __restr
   const int nb = NB ? NB : P.nb, nq = NQ ? NQ : P.nq;
   const std::uint32_t* cn = P.cell_nodes.data() + c * nb;
   const double* gs = P.grad.data() + static_cast<std::size_t>(P.shape[c]) * nq * nb * 2;
-  double ux[9], uy[9], fx[9] = {0}, fy[9] = {0};
+  // The x and y components as pairs (one SIMD register), each lane the scalar multiply-adds.
+  V2 U[9], F[9];
   for (int a = 0; a < nb; ++a) {
-    ux[a] = u[2 * cn[a]];
-    uy[a] = u[2 * cn[a] + 1];
+    std::memcpy(&U[a], u + 2 * cn[a], sizeof(V2));
+    F[a] = V2{0.0, 0.0};
   }
   for (int q = 0; q < nq; ++q) {
     const std::size_t k = c * nq + q;
     const double* g = gs + 2 * q * nb;
-    double gxx = 0, gxy = 0, gyx = 0, gyy = 0;  // du_x/dx, du_y/dx, du_x/dy, du_y/dy
+    V2 Gx = {0.0, 0.0}, Gy = {0.0, 0.0};  // (du_x/dx, du_y/dx), (du_x/dy, du_y/dy)
     for (int a = 0; a < nb; ++a) {
-      gxx += g[2 * a] * ux[a];
-      gxy += g[2 * a] * uy[a];
-      gyx += g[2 * a + 1] * ux[a];
-      gyy += g[2 * a + 1] * uy[a];
+      Gx += g[2 * a] * U[a];
+      Gy += g[2 * a + 1] * U[a];
     }
     double* xi = P.xi.data() + 4 * k;
     const double* t = P.packed.data() + 8 * P.kind[k];  // kl, km, cx, cy
     const double kl = t[0], km = t[1], *cx = t + 2, *cy = t + 5;
-    const double pxx = xi[0] + cx[2] * gxx, pxy = xi[1] + cx[2] * gxy;
-    const double pyx = xi[2] + cy[2] * gyx, pyy = xi[3] + cy[2] * gyy;
-    xi[0] = cx[0] * pxx + cx[1] * gxx;
-    xi[1] = cx[0] * pxy + cx[1] * gxy;
-    xi[2] = cy[0] * pyx + cy[1] * gyx;
-    xi[3] = cy[0] * pyy + cy[1] * gyy;
+    V2 Xx, Xy;  // the memories of the x and of the y derivatives
+    std::memcpy(&Xx, xi, sizeof(V2));
+    std::memcpy(&Xy, xi + 2, sizeof(V2));
+    const V2 Px = Xx + cx[2] * Gx, Py = Xy + cy[2] * Gy;
+    Xx = cx[0] * Px + cx[1] * Gx;
+    Xy = cy[0] * Py + cy[1] * Gy;
+    std::memcpy(xi, &Xx, sizeof(V2));
+    std::memcpy(xi + 2, &Xy, sizeof(V2));
     // The x part carries d_y - d_x, the y part d_x - d_y.
-    const double sxx = kl * pxx, sxy = km * pxy, syx = -km * pyx, syy = -kl * pyy;
-    for (int a = 0; a < nb; ++a) {
-      fx[a] -= sxx * g[2 * a] + syx * g[2 * a + 1];
-      fy[a] -= sxy * g[2 * a] + syy * g[2 * a + 1];
-    }
+    const V2 Sx = V2{kl, km} * Px, Sy = V2{-km, -kl} * Py;
+    for (int a = 0; a < nb; ++a) F[a] -= Sx * g[2 * a] + Sy * g[2 * a + 1];
   }
   for (int a = 0; a < nb; ++a) {
-    f[2 * dn[cn[a]]] += fx[a];
-    f[2 * dn[cn[a]] + 1] += fy[a];
+    f[2 * dn[cn[a]]] += F[a][0];
+    f[2 * dn[cn[a]] + 1] += F[a][1];
   }
 }
 
