@@ -123,10 +123,10 @@ int main(int argc, char** argv) {
       }
     } else if ((std::strcmp(argv[i], "--threads") == 0 || std::strcmp(argv[i], "--sizes") == 0 ||
                 std::strcmp(argv[i], "--rounds") == 0) && i + 1 < argc) {
-      // A comma-separated list of numbers, each in [lo, hi].
-      const bool threads = argv[i][2] == 't', rounds_arg = argv[i][2] == 'r';
-      const double lo = threads || rounds_arg ? 1 : 1e3, hi = threads ? 4096 : rounds_arg ? 100 : 1e8;
+      // A comma-separated list of numbers, each in [lo, hi] (--rounds: one whole number).
       const std::string opt = argv[i], v = argv[++i];
+      const bool threads = opt == "--threads", rounds_arg = opt == "--rounds";
+      const double lo = threads || rounds_arg ? 1 : 1e3, hi = threads ? 4096 : rounds_arg ? 100 : 1e8;
       std::vector<double> list;
       for (std::size_t at = 0; at <= v.size();) {
         const std::size_t comma = std::min(v.find(',', at), v.size());

@@ -58,7 +58,7 @@ class SignalGuard {
   struct sigaction old_int_ {}, old_term_ {};
 };
 
-// One buffer the size of the file (a checkpoint may be most of the memory: no stream copies).
+// A text file (the history so far) in one buffer the size of the file.
 std::string read_whole(const fs::path& p) {
   std::error_code ec;
   const auto size = fs::file_size(p, ec);

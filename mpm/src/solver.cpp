@@ -1056,26 +1056,36 @@ void Solver::boundary_work(bool remapped) {
     ax = 0.5 * (grid.vx[i] + ux[i]);
     ay = 0.5 * (grid.vy[i] + uy[i]);
   };
-  // Each layer's terms are computed per entry in parallel into the scratch array, then added
-  // to the account in entry order: the sums of one pass in order, bit for bit.
-  std::vector<double>& T = layer_scratch_;
+  // A layer's terms: term(q, t) writes entry q's K terms into t (in parallel, each entry its
+  // own; none for an entry with skip(q)), then they are added to (or subtracted from) `acc` in
+  // entry order: the sums of one pass in order, bit for bit.
+  const auto none = [](long) { return false; };
+  auto entry_sums = [&](long n, const auto& skip, const auto& term, double& acc, bool subtract) {
+    layer_scratch_.resize(K * static_cast<std::size_t>(n));
+    double* T = layer_scratch_.data();
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+    for (long q = 0; q < n; ++q)
+      if (!skip(q)) term(q, T + K * q);
+    for (long q = 0; q < n; ++q)
+      if (!skip(q))
+        for (int a = 0; a < K; ++a) {
+          if (subtract) acc -= T[K * q + a];
+          else acc += T[K * q + a];
+        }
+  };
   for (const auto& tl : tractions) {
     const double f = tl.fn(t);
     if (f == 0.0) continue;
-    const long n = static_cast<long>(tl.layer.idx.size());
-    T.resize(K * static_cast<std::size_t>(n));
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
-    for (long q = 0; q < n; ++q) {
+    entry_sums(static_cast<long>(tl.layer.idx.size()), none, [&](long q, double* T) {
       double tx, ty, ax, ay;
       traction_of(tl, q, f, tx, ty);
       const long* tn = tl.nodes.data() + K * q;  // the weights apply_loads mapped with
       const double* N = tl.N.data() + K * q;
       for (int a = 0; a < K; ++a) {
         wbar(tn[a], ax, ay);
-        T[K * q + a] = dt * tl.layer.w[q] * N[a] * (tx * ax + ty * ay);
+        T[a] = dt * tl.layer.w[q] * N[a] * (tx * ax + ty * ay);
       }
-    }
-    for (long i = 0; i < K * n; ++i) energy.external_work += T[i];
+    }, energy.external_work, false);
   }
   // Gravity's work with the same velocity as the tractions' (void nodes have m = 0).
   if (opt.gravity_x != 0 || opt.gravity_y != 0) {
@@ -1106,11 +1116,8 @@ void Solver::boundary_work(bool remapped) {
   }
   for (auto& sl : silents) {
     const auto& L = sl.layer;
-    const long n = static_cast<long>(L.idx.size());
-    T.resize(K * static_cast<std::size_t>(n));
     const bool advance = sl.springs() && opt.scheme != Scheme::USF;
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
-    for (long q = 0; q < n; ++q) {
+    entry_sums(static_cast<long>(L.idx.size()), none, [&](long q, double* T) {
       const long* sn = sl.nodes.data() + K * q;  // the weights apply_loads mapped with
       const double* N = sl.N.data() + K * q;
       if (advance) advance_spring<K>(sl, q, N, sn, ux, uy, dt);
@@ -1121,18 +1128,14 @@ void Solver::boundary_work(bool remapped) {
         // The dashpot acts on the particle velocity (paper form) or on each node's mid-step one.
         if (sl.form == SilentForm::Particle) dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
         else dashpot_of(sl, q, ax, ay, tx, ty);
-        T[K * q + a] = dt * L.w[q] * N[a] * (tx * bx + ty * by);
+        T[a] = dt * L.w[q] * N[a] * (tx * bx + ty * by);
       }
-    }
-    for (long i = 0; i < K * n; ++i) energy.absorbed -= T[i];
+    }, energy.absorbed, true);
   }
   // Perfectly matched layers: the damping force's power, and that of the explicit loads; then
   // the particles' displacements advance (USF: in pml_loads).
   if (pml.active()) {
-    const long n = static_cast<long>(pml.layer.idx.size());
-    T.resize(K * static_cast<std::size_t>(n));
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
-    for (long q = 0; q < n; ++q) {
+    entry_sums(static_cast<long>(pml.layer.idx.size()), none, [&](long q, double* T) {
       const long* pn = pml.nodes.data() + K * q;
       const double* N = pml.N.data() + K * q;
       const double* dNx = pml.dNx.data() + K * q;
@@ -1145,10 +1148,9 @@ void Solver::boundary_work(bool remapped) {
         wbar(pn[a], bx, by);
         const double fx = f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
         const double fy = f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
-        T[K * q + a] = dt * (cm * N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
+        T[a] = dt * (cm * N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
       }
-    }
-    for (long i = 0; i < K * n; ++i) energy.absorbed += T[i];
+    }, energy.absorbed, false);
     if (opt.scheme != Scheme::USF) pml_advance<S>(ux, uy);
   }
   // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i, with the
@@ -1156,10 +1158,7 @@ void Solver::boundary_work(bool remapped) {
   for (auto& dl : dampers) {
     const auto& L = dl.layer;
     const long n = static_cast<long>(L.idx.size());
-    T.resize(K * static_cast<std::size_t>(n));
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
-    for (long q = 0; q < n; ++q) {
-      if (dl.alpha[q] == 0) continue;
+    entry_sums(n, [&](long q) { return dl.alpha[q] == 0; }, [&](long q, double* T) {
       const long* dn = dl.nodes.data() + K * q;
       const double* N = dl.N.data() + K * q;
       const double c = dl.alpha[q] * p.mass[L.idx[q]];
@@ -1167,12 +1166,9 @@ void Solver::boundary_work(bool remapped) {
         double ax, ay, bx, by;
         vbar(dn[a], ax, ay);
         wbar(dn[a], bx, by);
-        T[K * q + a] = dt * c * N[a] * (ax * bx + ay * by);
+        T[a] = dt * c * N[a] * (ax * bx + ay * by);
       }
-    }
-    for (long q = 0; q < n; ++q)
-      if (dl.alpha[q] != 0)
-        for (int a = 0; a < K; ++a) energy.absorbed += T[K * q + a];
+    }, energy.absorbed, false);
     if (!(dl.beta0 > 0)) continue;
     // The stiffness-proportional part: the work of the viscous force this step applied (with
     // the power's velocity), then the viscous stress beta C : D for the next, all with the
@@ -1182,9 +1178,7 @@ void Solver::boundary_work(bool remapped) {
     // magnifies the force and broke the explicit limit (docs/physics.md section 9.2).
     const std::vector<double>& sx = opt.scheme == Scheme::USL ? grid.vx : ux;
     const std::vector<double>& sy = opt.scheme == Scheme::USL ? grid.vy : uy;
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
-    for (long q = 0; q < n; ++q) {
-      if (dl.beta[q] == 0) continue;
+    entry_sums(n, [&](long q) { return dl.beta[q] == 0; }, [&](long q, double* T) {
       const std::uint32_t k = L.idx[q];
       const long* gn = dl.gnodes.data() + K * q;
       const double* dNx = dl.dNx.data() + K * q;
@@ -1195,8 +1189,8 @@ void Solver::boundary_work(bool remapped) {
       for (int a = 0; a < K; ++a) {
         double bx, by;
         wbar(gn[a], bx, by);
-        T[K * q + a] = dt * V * ((sv[0] * dNx[a] + sv[2] * dNy[a]) * bx +
-                                 (sv[2] * dNx[a] + sv[1] * dNy[a]) * by);
+        T[a] = dt * V * ((sv[0] * dNx[a] + sv[2] * dNy[a]) * bx +
+                         (sv[2] * dNx[a] + sv[1] * dNy[a]) * by);
         lxx += sx[gn[a]] * dNx[a];
         lxy += sx[gn[a]] * dNy[a];
         lyx += sy[gn[a]] * dNx[a];
@@ -1207,10 +1201,7 @@ void Solver::boundary_work(bool remapped) {
       sv[0] = b * (m.lambda * tr + 2 * m.mu * lxx);
       sv[1] = b * (m.lambda * tr + 2 * m.mu * lyy);
       sv[2] = b * m.mu * (lxy + lyx);
-    }
-    for (long q = 0; q < n; ++q)
-      if (dl.beta[q] != 0)
-        for (int a = 0; a < K; ++a) energy.absorbed += T[K * q + a];
+    }, energy.absorbed, false);
   }
 }
 
