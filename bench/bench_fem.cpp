@@ -8,13 +8,13 @@
 // traction on the left, LK dashpots on the right, rollers on top and bottom. Prints one line per
 // (degree, threads) and the speed-up, and how close the rate comes to the host's memory
 // bandwidth: the triad measured in the same run (bench/triad.hpp) against the bytes a step moves,
-// counted as bench counts them (each array a pass reads once, each it writes once more):
-//   K u      R rowptr (8 per node), the blocks (4 column per block; 32 values per stored block:
-//            every block, or where rows share their values (a structured mesh) each kind of row's
-//            once, and an offset of 4 per node), u (16 per node, its neighbours' entries from
-//            cache); W -K u (16 per node)
-//   advance  R -K u, f_ext (16 + 16), constraint mask (1), dashpot index (4), 1/m (8);
-//            RW v, u (32 + 32) per node
+// counted as bench counts them (each array a pass reads once, each it writes once more). The
+// step is one pass over the rows (K u and the nodal update together, u^{n+1} written to a second
+// buffer), per node:
+//   R rowptr (8), the blocks (4 column per block; 32 values per stored block: every block, or
+//   where rows share their values (a structured mesh) each kind of row's once, and an offset of
+//   4 per node), u^n (16, its neighbours' entries from cache), f_ext (16), constraint mask (1),
+//   dashpot index (4), 1/m (8); W -K u (16, kept for the energies), u^{n+1} (16); RW v (32)
 #include <omp.h>
 
 #include <chrono>
@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
         const double mv = static_cast<double>(s.dofs()) * steps / seconds(t1);
         if (th == threads.front()) base = rate;
         const double bytes = 4.0 * s.matrix_blocks() + 32.0 * s.stored_blocks() +
-                             (8 + 16 + 16 + 109.0 + (s.rows_shared() ? 4 : 0)) * s.nodes();
+                             (8 + 16 + 16 + 16 + 1 + 4 + 8 + 16 + 32.0 + (s.rows_shared() ? 4 : 0)) * s.nodes();
         const double per_dof = bytes / s.dofs();
         const double gbs = rate * per_dof / 1e9;
         const std::size_t k = static_cast<std::size_t>(&th - threads.data());

@@ -33,6 +33,8 @@ struct Solver::Impl {
 
   // Per dof (2 per node, interleaved).
   std::vector<double> u, v, ku, fext;
+  // The displacement step() writes u^{n+1} into while it reads u^n from u (then the two swap).
+  std::vector<double> u_next;
 
   // Stiffness, node-block CSR: row i has blocks k in [rowptr[i], rowptr[i+1]), column col[k],
   // values val[4k..4k+3] = Kxx, Kyx, Kxy, Kyy (column by column: K u takes a block's two

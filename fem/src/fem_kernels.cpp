@@ -104,18 +104,17 @@ std::vector<std::uint32_t> Solver::boundary_nodes(const std::vector<int>& curves
 namespace {
 using V2 = double __attribute__((vector_size(16)));  // two doubles, one SIMD register
 
-// f = -K u on the rows list[0 .. n) (LIST), or on rows 0 .. n; SHARED: rows share values
-// (Impl::row_val).
-template <bool LIST, bool SHARED>
-void minus_ku(const Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
-              const double* __restrict u, double* __restrict f) {
-  const std::uint64_t* __restrict rp = m.rowptr.data();
-  const std::uint32_t* __restrict cl = m.col.data();
-  const double* __restrict kv = m.val.data();
-  const std::uint32_t* __restrict rv = m.row_val.data();
-#pragma omp parallel for schedule(static) num_threads(m.threads) if (n >= kParallelMinimum)
-  for (std::int64_t r = 0; r < n; ++r) {
-    const std::int64_t i = LIST ? list[r] : r;
+// The stiffness's rows (Impl's node-block CSR), read one at a time.
+struct Rows {
+  const std::uint64_t* __restrict rp;
+  const std::uint32_t* __restrict cl;
+  const double* __restrict kv;
+  const std::uint32_t* __restrict rv;
+  explicit Rows(const Solver::Impl& m)
+      : rp(m.rowptr.data()), cl(m.col.data()), kv(m.val.data()), rv(m.row_val.data()) {}
+  // (K u)_i as the pair (x, y); SHARED: rows share values (Impl::row_val).
+  template <bool SHARED>
+  inline V2 times(std::int64_t i, const double* __restrict u) const {
     const double* __restrict row = kv + 4 * (SHARED ? std::uint64_t{rv[i]} : rp[i]);
     // (fx, fy) += (Kxx, Kyx) u_x + (Kxy, Kyy) u_y: each lane the scalar sum
     // f += K_0 u_x + K_1 u_y, with the same multiply-adds, two at a time.
@@ -128,6 +127,19 @@ void minus_ku(const Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
       std::memcpy(&c1, b + 2, sizeof c1);
       acc += c0 * ux + c1 * uy;
     }
+    return acc;
+  }
+};
+
+// f = -K u on the rows list[0 .. n) (LIST), or on rows 0 .. n; SHARED: rows share values.
+template <bool LIST, bool SHARED>
+void minus_ku(const Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
+              const double* __restrict u, double* __restrict f) {
+  const Rows K(m);
+#pragma omp parallel for schedule(static) num_threads(m.threads) if (n >= kParallelMinimum)
+  for (std::int64_t r = 0; r < n; ++r) {
+    const std::int64_t i = LIST ? list[r] : r;
+    const V2 acc = K.times<SHARED>(i, u);
     f[2 * i] = -acc[0];
     f[2 * i + 1] = -acc[1];
   }
@@ -281,32 +293,28 @@ void pml_forces(Solver::Impl& m, double dt) {
   }
 }
 
-// The explicit update of every node with skip == nullptr or skip[i] < 0: v+ = v + dt f / m, the
-// trapezoidal solve at a node with a dashpot block (dashpot.hpp), constraints; then u += dt v+.
-// Adds the work of f_ext (with the mid-step velocity) and the energy the dashpots absorb.
-// Several ranks: this rank's own nodes only (Part::own).
-template <bool LIST>
-void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
-                      const std::int64_t* skip, const double* __restrict f_int,
-                      const double* __restrict f_ext, double dt, bool parallel, double& work_out,
-                      double& absorbed_out) {
-  const std::uint8_t* __restrict mask = m.mask.data();
-  const std::int32_t* __restrict dn = m.dash_of_node.data();
-  const double* __restrict im = m.inv_mass.data();
-  const double* __restrict ms = m.mass.data();
-  const auto& D = m.dash;
-  double* __restrict u = m.u.data();
-  double* __restrict v = m.v.data();
-  const double gx = m.spec.gravity_x, gy = m.spec.gravity_y;
-  const bool gravity = gx != 0 || gy != 0;
-  double work = 0, absorbed = 0;
-  const double* __restrict pf = m.dash_force.data();
-#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
-    if (parallel)
-  for (std::int64_t r = 0; r < n; ++r) {
-    const std::int64_t i = LIST ? list[r] : r;
-    if (skip && skip[i] >= 0) continue;
-    double fx = f_int[2 * i] + f_ext[2 * i], fy = f_int[2 * i + 1] + f_ext[2 * i + 1];
+// One node's explicit update: v+ = v + dt f / m, the trapezoidal solve at a node with a dashpot
+// block (dashpot.hpp), constraints; then u_out = u_in + dt v+ (u_out may be u_in). Adds the
+// work of f_ext (with the mid-step velocity) and the energy the dashpots absorb.
+struct NodeUpdate {
+  const std::uint8_t* __restrict mask;
+  const std::int32_t* __restrict dn;
+  const double* __restrict im;
+  const double* __restrict ms;
+  const Solver::DashpotBlock* __restrict D;
+  const double* __restrict pf;  // a PML's or a damping layer's explicit forces per block (else 0)
+  double* __restrict v;
+  double dt, gx, gy;
+  bool gravity;
+  NodeUpdate(Solver::Impl& m, double dt)
+      : mask(m.mask.data()), dn(m.dash_of_node.data()), im(m.inv_mass.data()),
+        ms(m.mass.data()), D(m.dash.data()), pf(m.dash_force.data()), v(m.v.data()), dt(dt),
+        gx(m.spec.gravity_x), gy(m.spec.gravity_y), gravity(gx != 0 || gy != 0) {}
+  // f_int_x, f_int_y: node i's internal force; f_ext: 2 per node.
+  inline void operator()(std::int64_t i, double f_int_x, double f_int_y,
+                         const double* __restrict f_ext, const double* u_in, double* u_out,
+                         double& work, double& absorbed) const {
+    double fx = f_int_x + f_ext[2 * i], fy = f_int_y + f_ext[2 * i + 1];
     if (gravity) {  // the lumped body force m_i g
       fx += ms[i] * gx;
       fy += ms[i] * gy;
@@ -318,7 +326,7 @@ void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n
       vy = (mask[i] & 2) ? 0.0 : vy0 + dt * fy * im[i];
     } else {
       const Solver::DashpotBlock& c = D[dn[i]];
-      const double px = pf[2 * dn[i]], py = pf[2 * dn[i] + 1];  // a PML's forces (else 0)
+      const double px = pf[2 * dn[i]], py = pf[2 * dn[i] + 1];
       dashpot_velocity(ms[i], c.cxx, c.cxy, c.cyy, vx0, vy0, fx + px, fy + py, dt, mask[i], vx, vy);
       const double bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
       absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by) -
@@ -328,9 +336,59 @@ void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n
     if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
     v[2 * i] = vx;
     v[2 * i + 1] = vy;
-    u[2 * i] += dt * vx;
-    u[2 * i + 1] += dt * vy;
+    u_out[2 * i] = u_in[2 * i] + dt * vx;
+    u_out[2 * i + 1] = u_in[2 * i + 1] + dt * vy;
   }
+};
+
+// The explicit update (NodeUpdate) of every node with skip == nullptr or skip[i] < 0, from the
+// forces f_int and f_ext. Several ranks: this rank's own nodes only (Part::own).
+template <bool LIST>
+void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
+                      const std::int64_t* skip, const double* __restrict f_int,
+                      const double* __restrict f_ext, double dt, bool parallel, double& work_out,
+                      double& absorbed_out) {
+  const NodeUpdate node(m, dt);
+  double* u = m.u.data();
+  double work = 0, absorbed = 0;
+#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
+    if (parallel)
+  for (std::int64_t r = 0; r < n; ++r) {
+    const std::int64_t i = LIST ? list[r] : r;
+    if (skip && skip[i] >= 0) continue;
+    node(i, f_int[2 * i], f_int[2 * i + 1], f_ext, u, u, work, absorbed);
+  }
+  work_out += work;
+  absorbed_out += absorbed;
+  m.ku_valid = false;
+}
+
+// The whole step's nodal pass in one: per row -K u^n (kept in m.ku for the energies) and the
+// node's update (NodeUpdate) into the other displacement buffer, which then becomes m.u; u^n is
+// read from the buffer that no row writes, so the rows' order does not matter. The same sums
+// and products as minus_ku and then advance_nodes_on, so the same bits; the nodal pass then
+// moves neither -K u nor u a second time. Several ranks: this rank's own rows.
+template <bool LIST, bool SHARED>
+void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
+                   const double* __restrict f_ext, double dt, bool parallel, double& work_out,
+                   double& absorbed_out) {
+  const Rows K(m);
+  const NodeUpdate node(m, dt);
+  if (m.u_next.size() != m.u.size()) m.u_next.assign(m.u.size(), 0.0);
+  const double* __restrict u = m.u.data();
+  double* __restrict un = m.u_next.data();
+  double* __restrict f = m.ku.data();
+  double work = 0, absorbed = 0;
+#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
+    if (parallel)
+  for (std::int64_t r = 0; r < n; ++r) {
+    const std::int64_t i = LIST ? list[r] : r;
+    const V2 acc = K.times<SHARED>(i, u);
+    f[2 * i] = -acc[0];
+    f[2 * i + 1] = -acc[1];
+    node(i, -acc[0], -acc[1], f_ext, u, un, work, absorbed);
+  }
+  m.u.swap(m.u_next);
   work_out += work;
   absorbed_out += absorbed;
   m.ku_valid = false;
@@ -360,14 +418,20 @@ void viscous_forces(Solver::Impl& m) {
   }
 }
 
-void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* f_int,
-                   const double* f_ext, double dt, bool parallel, double& work_out,
-                   double& absorbed_out) {
+// The explicit forces of the layers (into m.dash_force) from u^n and v^{n-1/2}, before the nodes
+// move.
+void explicit_forces(Solver::Impl& m, double dt) {
   if (m.visc.active())  // these nodes' explicit forces start from zero (the PML's zeroes its own)
     for (const std::uint32_t i : m.visc.node)
       m.dash_force[2 * m.dash_of_node[i]] = m.dash_force[2 * m.dash_of_node[i] + 1] = 0.0;
   if (m.pml.active()) pml_forces(m, dt);
   if (m.visc.active()) viscous_forces(m);
+}
+
+void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* f_int,
+                   const double* f_ext, double dt, bool parallel, double& work_out,
+                   double& absorbed_out) {
+  explicit_forces(m, dt);
   if (m.part)
     advance_nodes_on<true>(m, m.part->own.data(), static_cast<std::int64_t>(m.part->own.size()),
                            skip, f_int, f_ext, dt, parallel, work_out, absorbed_out);
@@ -380,20 +444,24 @@ void advance_nodes(Solver::Impl& m, const std::int64_t* skip, const double* f_in
 void Solver::step() {
   Impl& m = *impl_;
   if (!(dt > 0) || dt > m.crit_dt * (1 + 1e-12)) set_dt(dt);  // throws with the reason
-  // Internal force at u^n (reused from update_energies when still valid).
-  if (!m.ku_valid) internal_force(m.u.data(), m.ku.data());
-  // m.ku holds -K u^n.
   // f_ext is zero away from the loaded nodes (fext is zero-initialised and only these entries
   // are ever written): refresh just those, not the whole vector (a serial pass over every dof
   // would cap the two-thread speed-up).
   refresh_external_force(t, m.fext.data());
-  const std::size_t rows = m.part ? m.part->own.size() : m.x.size();
-  const bool parallel = static_cast<std::int64_t>(rows) >= kParallelMinimum;
-  // Several ranks: each books its own nodes' work (update_energies adds them up), and then
+  explicit_forces(m, dt);
+  // One pass over the rows: -K u^n into m.ku (update_energies reads it) and the nodes' update.
+  // Several ranks: each steps and books its own nodes (update_energies adds them up), and then
   // receives the nodes it reads from their owners.
-  advance_nodes(m, nullptr, m.ku.data(), m.fext.data(), dt, parallel,
-                m.part ? m.part->work : energy.external_work,
-                m.part ? m.part->absorbed : energy.absorbed);
+  const bool shared = !m.row_val.empty();
+  const std::uint32_t* own = m.part ? m.part->own.data() : nullptr;
+  const auto rows = static_cast<std::int64_t>(m.part ? m.part->own.size() : m.x.size());
+  const bool parallel = rows >= kParallelMinimum;
+  double& work = m.part ? m.part->work : energy.external_work;
+  double& absorbed = m.part ? m.part->absorbed : energy.absorbed;
+  if (own && shared) fused_step_on<true, true>(m, own, rows, m.fext.data(), dt, parallel, work, absorbed);
+  else if (own) fused_step_on<true, false>(m, own, rows, m.fext.data(), dt, parallel, work, absorbed);
+  else if (shared) fused_step_on<false, true>(m, nullptr, rows, m.fext.data(), dt, parallel, work, absorbed);
+  else fused_step_on<false, false>(m, nullptr, rows, m.fext.data(), dt, parallel, work, absorbed);
   if (m.part) exchange_ghosts(m);
   t += dt;
   ++steps;
