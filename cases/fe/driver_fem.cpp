@@ -18,7 +18,7 @@ nlohmann::ordered_json fem_json(const fem::Solver& s) {
                                 {"cells", s.cells()},
                                 {"degree", s.degree()},
                                 {"critical_dt", s.critical_dt()},
-                                {"dashpot_nodes", s.dashpots().size()}};
+                                {"dashpot_nodes", s.dashpot_count()}};
 }
 
 nlohmann::ordered_json fem_traffic_json(const fem::Solver& s) {
@@ -28,7 +28,8 @@ nlohmann::ordered_json fem_traffic_json(const fem::Solver& s) {
           {"ghost_bytes_per_step", t.bytes / steps},
           {"neighbours_most", t.neighbours},
           {"own_nodes_most", t.own_nodes},
-          {"ghost_nodes_most", t.ghost_nodes}};
+          {"ghost_nodes_most", t.ghost_nodes},
+          {"held_nodes_most", t.held_nodes}};
 }
 
 }  // namespace smpm::detail

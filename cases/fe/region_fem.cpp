@@ -1,7 +1,7 @@
 // The FEM region of the run loop (a case with an FEM region and no MPM bodies): probes sampled
 // from the FE field, HDF5 + XDMF snapshots (fem.h5 + fem.xdmf). Under an MPI launcher the far
-// field is split over the ranks (fem::Solver::distribute; docs/parallel.md): every rank calls
-// the same functions, rank 0 writes.
+// field is split over the ranks (fem::Solver::distribute, localize; docs/parallel.md): every
+// rank calls the same functions, rank 0 writes.
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
@@ -17,7 +17,10 @@ namespace {
 class FemRegion final : public Region {
  public:
   explicit FemRegion(Case& c) : c_(c), s_(*c.fem) {
-    if (mpi()) s_.distribute();
+    if (mpi()) {  // each rank then keeps only what it steps (but with a PML or a beta band)
+      s_.distribute();
+      s_.localize();
+    }
   }
 
   double dt() const override { return s_.dt; }

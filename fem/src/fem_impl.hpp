@@ -122,6 +122,7 @@ struct Solver::Impl {
   struct Probe {
     double x, y;
     std::vector<ProbePart> parts;
+    double w = 0;  // each part's weight: 1 / the number of cells around the point
   };
   std::vector<Probe> probes;
 
@@ -149,6 +150,17 @@ struct Solver::Impl {
   };
   std::unique_ptr<Part> part;
 
+  // A local model (Solver::localize, fem_local.cpp): the arrays hold this rank's nodes only
+  // (its own and those it receives), numbered in the mesh's order, glob[i] the mesh node of
+  // local node i; the rows of K are its own nodes' (the others' rows empty); cell_nodes lists
+  // the cells it steps; the probes keep the parts of its cells. Empty glob: the whole mesh.
+  std::vector<std::uint32_t> glob;
+  std::size_t mesh_nodes = 0, mesh_dashpots = 0;  // the whole mesh's counts (a local model)
+  std::vector<std::string> described;             // describe() of the whole model (a local model)
+  // Rank 0 of a local model: the whole mesh as it was built (nodes, cells, deal.II's mesh), which
+  // the snapshots are written on; its other arrays are released.
+  std::unique_ptr<Impl> whole;
+
   std::unique_ptr<Deal> deal;
   int snapshots = 0;
   std::vector<double> snapshot_times;  // every snapshot's time (a restart's earlier ones too)
@@ -168,6 +180,13 @@ void sum_over_ranks(const Solver::Impl& m, double* v, int n);
 void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& owner,
                     const std::vector<const std::vector<double>*>& fields, int width,
                     std::vector<std::vector<double>>& out);
+
+// A local model's per-node arrays (`width` values a node, each of `fields`) on rank 0 as the
+// whole mesh's, each node's from its owner (collective: the other ranks get `out` empty;
+// fem_local.cpp). Messages of at most gather_piece() values (fem_parallel.cpp).
+void gather_local(const Solver::Impl& m, const std::vector<const std::vector<double>*>& fields,
+                  std::size_t width, std::vector<std::vector<double>>& out);
+long long gather_piece();
 
 // Largest eigenvalue of the symmetric n x n matrix a (row-major; destroyed), cyclic Jacobi.
 double symmetric_max_eigenvalue(std::vector<double>& a, int n);

@@ -55,7 +55,9 @@ double symmetric_max_eigenvalue(std::vector<double>& a, int n) {
   return m;
 }
 
-std::size_t Solver::nodes() const { return impl_->x.size(); }
+std::size_t Solver::nodes() const {
+  return impl_->glob.empty() ? impl_->x.size() : impl_->mesh_nodes;
+}
 std::size_t Solver::matrix_blocks() const { return impl_->col.size(); }
 std::size_t Solver::stored_blocks() const { return impl_->val.size() / 4; }
 bool Solver::rows_shared() const { return !impl_->row_val.empty(); }
@@ -507,10 +509,13 @@ std::vector<Sample> Solver::sample() const {
   std::vector<Sample> out(m.probes.size());
   for (std::size_t p = 0; p < m.probes.size(); ++p) {
     Sample s;
-    const double w = 1.0 / static_cast<double>(m.probes[p].parts.size());
+    const double w = m.probes[p].w;
     for (const auto& pr : m.probes[p].parts) {
-      // Several ranks: each part is read by the rank of its cell (which holds its nodes).
-      if (m.part && m.part->cell_rank[pr.cell] != static_cast<std::uint32_t>(m.part->rank)) continue;
+      // Several ranks: each part is read by the rank of its cell (which holds its nodes; a
+      // local model keeps only those).
+      if (m.part && m.glob.empty() &&
+          m.part->cell_rank[pr.cell] != static_cast<std::uint32_t>(m.part->rank))
+        continue;
       double g[2][2] = {{0, 0}, {0, 0}}, vel[2] = {0, 0};
       for (std::size_t k = 0; k < pr.dofs.size(); ++k) {
         const int c = pr.comp[k];
@@ -603,7 +608,18 @@ void Solver::put_nodes(StateWriter& w, const std::string& name,
 
 void Solver::get_nodes(const StateReader& r, const std::string& prefix, const std::string& name,
                        std::vector<double>& per_node) const {
-  get_items(r, name, prefix + "nodes", impl_->x.size(), 2, per_node);
+  const Impl& m = *impl_;
+  if (m.glob.empty()) {
+    get_items(r, name, prefix + "nodes", m.x.size(), 2, per_node);
+    return;
+  }
+  std::vector<double> whole;  // a local model: its nodes' values
+  get_items(r, name, prefix + "nodes", m.mesh_nodes, 2, whole);
+  per_node.resize(2 * m.glob.size());
+  for (std::size_t i = 0; i < m.glob.size(); ++i) {
+    per_node[2 * i] = whole[2 * m.glob[i]];
+    per_node[2 * i + 1] = whole[2 * m.glob[i] + 1];
+  }
 }
 
 void Solver::save_state(StateWriter& w, const std::string& pre) const {
@@ -620,7 +636,14 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   w.put(pre + "t", t);
   w.put(pre + "steps", static_cast<std::int64_t>(steps));
   w.put(pre + "energy", e);
-  if (m.part) w.put_part(pre + "nodes", m.part->own);
+  if (m.part && m.glob.empty()) {
+    w.put_part(pre + "nodes", m.part->own);
+  } else if (m.part) {  // a local model: its own nodes' mesh numbers
+    std::vector<std::uint32_t> numbers;
+    numbers.reserve(m.part->own.size());
+    for (const auto i : m.part->own) numbers.push_back(m.glob[i]);
+    w.put_part(pre + "nodes", numbers);
+  }
   put_nodes(w, pre + "u", m.u);
   put_nodes(w, pre + "v", m.v);
   put_nodes(w, pre + "ku", m.ku);

@@ -144,7 +144,8 @@ std::vector<double> Solver::gathered(const std::vector<double>& per_node) const 
   const Impl& m = *impl_;
   if (!m.part) return per_node;
   std::vector<std::vector<double>> out;
-  gather_on_root(m, m.part->node_rank, {&per_node}, 2, out);
+  if (!m.glob.empty()) gather_local(m, {&per_node}, 2, out);
+  else gather_on_root(m, m.part->node_rank, {&per_node}, 2, out);
   return out.empty() ? std::vector<double>() : std::move(out[0]);
 }
 
@@ -152,14 +153,14 @@ Solver::Traffic Solver::traffic() const {
   Traffic t;
   const Impl& m = *impl_;
   if (!m.part) {
-    t.own_nodes = m.x.size();
+    t.own_nodes = t.held_nodes = m.x.size();
     return t;
   }
   const Impl::Part& P = *m.part;
-  double most[4] = {P.seconds, static_cast<double>(P.own.size()), static_cast<double>(P.ghosts),
-                    static_cast<double>(P.links.size())};
+  double most[5] = {P.seconds, static_cast<double>(P.own.size()), static_cast<double>(P.ghosts),
+                    static_cast<double>(P.links.size()), static_cast<double>(m.x.size())};
   double bytes = P.bytes;
-  MPI_Allreduce(MPI_IN_PLACE, most, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, most, 5, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   MPI_Allreduce(MPI_IN_PLACE, &bytes, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   t.seconds = most[0];
   t.bytes = bytes;
@@ -167,6 +168,7 @@ Solver::Traffic Solver::traffic() const {
   t.own_nodes = static_cast<std::size_t>(most[1]);
   t.ghost_nodes = static_cast<std::size_t>(most[2]);
   t.neighbours = static_cast<std::size_t>(most[3]);
+  t.held_nodes = static_cast<std::size_t>(most[4]);
   return t;
 }
 
@@ -232,6 +234,7 @@ std::size_t gather_piece_ = std::size_t{1} << 30;
 }  // namespace
 
 void Solver::set_gather_piece(std::size_t n) { gather_piece_ = n > 0 ? n : 1; }
+long long gather_piece() { return static_cast<long long>(gather_piece_); }
 
 void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& owner,
                     const std::vector<const std::vector<double>*>& fields, int width,

@@ -768,6 +768,7 @@ std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts) {
 
 int Solver::add_probe(double x, double y) {
   Impl& m = *impl_;
+  if (localized()) throw FemError("FEM: probes are added before the model is localized");
   Deal& d = *m.deal;
   // Outside the mesh's bounding box: not in the mesh (deal.II's search below builds its vertex
   // maps on every call; a hybrid asks for every probe, most of them in the MPM region).
@@ -812,6 +813,7 @@ int Solver::add_probe(double x, double y) {
     part.mu = mat.mu;
     pr.parts.push_back(std::move(part));
   }
+  pr.w = 1.0 / static_cast<double>(pr.parts.size());
   m.probes.push_back(std::move(pr));
   return static_cast<int>(m.probes.size()) - 1;
 }
@@ -914,16 +916,19 @@ static void write_fields(Solver::Impl& m, const std::string& dir, const std::str
 void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
   if (m.part) {
-    // Several ranks: every node's u and v from its owner to rank 0, which writes; whether it
-    // could is told to every rank, so that a failure stops them all.
+    // Several ranks: every node's u and v from its owner to rank 0, which writes (a local
+    // model: on the whole mesh it keeps); whether it could is told to every rank, so that a
+    // failure stops them all.
     std::vector<std::vector<double>> all;
-    gather_on_root(m, m.part->node_rank, {&m.u, &m.v}, 2, all);
+    if (m.whole || !m.glob.empty()) gather_local(m, {&m.u, &m.v}, 2, all);
+    else gather_on_root(m, m.part->node_rank, {&m.u, &m.v}, 2, all);
     std::string why;
     if (m.part->rank == 0) {
-      m.u = std::move(all[0]);
-      m.v = std::move(all[1]);
+      Impl& w = m.whole ? *m.whole : m;
+      w.u = std::move(all[0]);
+      w.v = std::move(all[1]);
       try {
-        write_fields(m, dir, base, t);
+        write_fields(w, dir, base, t);
       } catch (const std::exception& e) {
         why = e.what();
       }
@@ -939,12 +944,20 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   ++m.snapshots;
 }
 
-void Solver::set_snapshot_compression(int level) { impl_->deal->snap.set_compression(level); }
+namespace {
+// The mesh the snapshots are written on: a local model's rank 0 keeps the whole one; null on the
+// other ranks of a local model (they do not write).
+Deal* writer_deal(Solver::Impl& m) { return m.whole ? m.whole->deal.get() : m.deal.get(); }
+}  // namespace
+
+void Solver::set_snapshot_compression(int level) {
+  if (Deal* d = writer_deal(*impl_)) d->snap.set_compression(level);
+}
 
 void Solver::close_snapshots() {
   if (impl_->part && impl_->part->rank != 0) return;
   try {
-    impl_->deal->snap.close();
+    writer_deal(*impl_)->snap.close();
   } catch (const std::exception& e) {
     throw FemError(std::string("cannot close the FEM snapshots: ") + e.what());
   }
@@ -956,7 +969,7 @@ int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
   const bool writer = !m.part || m.part->rank == 0;
   std::string why;
   try {
-    if (writer) found = m.deal->snap.resume(dir, base, m.snapshot_times);
+    if (writer) found = writer_deal(m)->snap.resume(dir, base, m.snapshot_times);
   } catch (const std::exception& e) {
     why = dir + ": cannot reopen the FEM snapshots: " + deal_message(e);
     found = -1;
@@ -982,6 +995,7 @@ int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
 
 std::vector<std::string> Solver::describe() const {
   const Impl& m = *impl_;
+  if (!m.glob.empty()) return m.described;
   std::vector<std::string> out;
   out.push_back("FEM mesh " + m.spec.mesh.file + ": " + std::to_string(m.n_cells) + " quads, Q" +
                 std::to_string(m.degree) + ", " + std::to_string(nodes()) + " nodes, " +

@@ -14,6 +14,11 @@
 //     cells) restarts the model on one process: 100 steps on, u and v on every node within
 //     1e-14 of the uninterrupted one-process run's maxima (measured 0), energies within 1e-14;
 //     a node list naming a node twice is refused.
+//   * A model without PMLs or stiffness-proportional bands, each rank keeping only what it steps
+//     (fem::Solver::localize), against the same model split whole, Q1 and Q2, 300 steps: the
+//     probes, the energies and u, v gathered on rank 0 bit for bit (bound 0); the largest rank
+//     holds at most 3/4 of the nodes on 2 ranks, 1/2 on 4; a model with a PML stays whole;
+//     localize() before distribute() and a probe added after it are refused.
 //   * The oblique study's measurement, P at 30 degrees on a 10-cell PML and on LK: the
 //     reflection coefficients as on one process (1e-12 relative), on 2 ranks.
 #include <gtest/gtest.h>
@@ -70,6 +75,21 @@ fem::Spec square(int degree, bool boundaries) {
   fem::Boundary kv = bc(fem::Boundary::Kind::Dashpot, 11, "kv");
   kv.delta = 40 * h;
   s.boundaries.push_back(kv);
+  return s;
+}
+
+// The square without its PMLs and the band's stiffness part: a traction pulse on the top, LK
+// dashpots on the right and the bottom, a mass-proportional band in front of Kelvin-Voigt springs
+// on the left, gravity.
+fem::Spec square_local(int degree) {
+  fem::Spec s = square(degree, true);
+  std::vector<fem::Boundary> keep;
+  for (fem::Boundary b : s.boundaries) {
+    if (b.kind == fem::Boundary::Kind::Pml) continue;
+    b.beta = 0;
+    keep.push_back(b);
+  }
+  s.boundaries = keep;
   return s;
 }
 
@@ -208,6 +228,67 @@ TEST(FemRanks, SquareWithEveryBoundaryAsOneProcess) {
   EXPECT_GT(e2.absorbed, 0.05 * big);  // the layers took part
   EXPECT_LE(energy_diff, 1e-14 * big);
   EXPECT_LE(std::fabs(balance), 1e-13 * big);
+}
+
+TEST(FemRanks, LocalModelStepsAsTheWholeSplit) {
+  for (const int degree : {1, 2}) {
+    fem::Solver whole(square_local(degree)), part(square_local(degree));
+    EXPECT_THROW(part.localize(), fem::FemError);  // not split yet
+    for (fem::Solver* s : {&whole, &part}) {
+      s->set_dt(0.5 * s->critical_dt());
+      ASSERT_EQ(s->add_probe(0.02, 0.02), 0);       // on a node: four cells' mean
+      ASSERT_EQ(s->add_probe(0.0335, 0.0065), 1);   // near the corner of two dashpot edges
+      ASSERT_EQ(s->add_probe(0.0105, 0.0395), 2);   // under the load
+      s->distribute();
+    }
+    const std::size_t nodes = part.nodes();
+    ASSERT_TRUE(part.localize());
+    EXPECT_TRUE(part.localized());
+    EXPECT_THROW(part.add_probe(0.01, 0.01), fem::FemError);
+    EXPECT_EQ(part.nodes(), nodes);
+    EXPECT_EQ(part.dashpot_count(), whole.dashpot_count());
+    EXPECT_EQ(part.describe(), whole.describe());
+    const double held = static_cast<double>(part.traffic().held_nodes);
+    bool same_probes = true;
+    for (int n = 0; n < 300; ++n) {
+      whole.step();
+      part.step();
+      const auto a = whole.sample(), b = part.sample();
+      for (std::size_t p = 0; p < a.size(); ++p)
+        same_probes = same_probes && a[p].sxx == b[p].sxx && a[p].syy == b[p].syy &&
+                      a[p].sxy == b[p].sxy && a[p].vx == b[p].vx && a[p].vy == b[p].vy;
+    }
+    whole.update_energies();
+    part.update_energies();
+    EXPECT_TRUE(same_probes) << "Q" << degree;
+    EXPECT_EQ(whole.energy.kinetic, part.energy.kinetic);
+    EXPECT_EQ(whole.energy.elastic, part.energy.elastic);
+    EXPECT_EQ(whole.energy.absorbed, part.energy.absorbed);
+    EXPECT_EQ(whole.energy.external_work, part.energy.external_work);
+    const std::vector<double> u1 = whole.gathered(whole.displacement()),
+                              u2 = part.gathered(part.displacement());
+    const std::vector<double> v1 = whole.gathered(whole.velocity()),
+                              v2 = part.gathered(part.velocity());
+    if (root()) {
+      EXPECT_EQ(u1, u2);
+      EXPECT_EQ(v1, v2);
+      EXPECT_GT(*std::max_element(u1.begin(), u1.end()), 0.0);
+      std::printf("  Q%d on %d rank(s): the largest rank holds %.0f of %zu nodes; absorbed %.3e, "
+                  "work %.3e\n", degree, world_size(), held, nodes, part.energy.absorbed,
+                  part.energy.external_work);
+    }
+    if (world_size() == 2) {
+      EXPECT_LE(held, 0.75 * static_cast<double>(nodes));
+    }
+    if (world_size() == 4) {
+      EXPECT_LE(held, 0.5 * static_cast<double>(nodes));
+    }
+    EXPECT_GT(part.energy.absorbed, 0.0);
+  }
+  fem::Solver layered(square(1, true));
+  layered.distribute();
+  EXPECT_FALSE(layered.localize());  // a PML: the whole mesh stays
+  EXPECT_FALSE(layered.localized());
 }
 
 TEST(FemRanks, CheckpointFromTheRanksRestartsOneProcess) {

@@ -212,6 +212,8 @@ class Solver {
     double cxx, cxy, cyy;
   };
   const std::vector<DashpotBlock>& dashpots() const;
+  // The mesh's nodes with a dashpot block (dashpots() holds a local model's own ones).
+  std::size_t dashpot_count() const;
   // Nodes of each cell, (degree + 1)^2 per cell in deal.II's FE_Q order (vertices first:
   // (0,0), (1,0), (0,1), (1,1) in the cell's reference frame).
   const std::vector<std::uint32_t>& cell_nodes() const;
@@ -253,6 +255,21 @@ class Solver {
   // a split model too: internal_force fills the own rows, advance_free_nodes advances the own
   // nodes and then receives the neighbours' (collective).
   void distribute();
+  // After distribute(): keeps only what this rank steps (collective). Its arrays then hold its
+  // own nodes and those it receives, numbered in the mesh's order (global_nodes() gives each
+  // local node's mesh number), K only its own rows, cell_nodes() its cells; ranks other than 0
+  // free deal.II's mesh, rank 0 keeps the mesh for the snapshots it writes. The step, probes,
+  // energies, snapshots and checkpoints give the same bits as the split whole model. nodes(),
+  // dofs(), cells(), dashpot_count() and describe() still tell the whole mesh's; own_nodes(),
+  // node_owner() and the per-node arrays (node_x(), displacement(), put_nodes ...) are local;
+  // gathered() takes a local array and gives rank 0 the whole mesh's. Probes are added before.
+  // A model with a PML or a damping band's stiffness-proportional part keeps the whole mesh
+  // (their layer cells cross the ranks' borders as the whole model's): then it returns false,
+  // else true. Throws FemError when the model is not split.
+  bool localize();
+  bool localized() const;
+  // The mesh number of each local node (every node on a model that holds the whole mesh).
+  std::vector<std::uint32_t> global_nodes() const;
   int ranks() const;  // 1 on one process
   // The nodes this rank steps, ascending (every node on one process).
   std::vector<std::uint32_t> own_nodes() const;
@@ -266,11 +283,12 @@ class Solver {
   // test sets it small.
   static void set_gather_piece(std::size_t n);
   // The ghost updates so far over all ranks (every rank calls it): the slowest rank's seconds,
-  // the bytes all ranks sent, and the largest rank's counts.
+  // the bytes all ranks sent, and the largest rank's counts; held_nodes: the nodes whose arrays
+  // a rank holds (the whole mesh's, or after localize() its own and received ones).
   struct Traffic {
     double seconds = 0, bytes = 0;
     long updates = 0;
-    std::size_t own_nodes = 0, ghost_nodes = 0, neighbours = 0;
+    std::size_t own_nodes = 0, ghost_nodes = 0, neighbours = 0, held_nodes = 0;
   };
   Traffic traffic() const;
 
