@@ -2,6 +2,9 @@
 // FE far field"): the own nodes and those received, K's own rows, the cells around them. Plain
 // arrays and MPI; no deal.II here.
 #include <mpi.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <limits>
@@ -206,7 +209,10 @@ bool Solver::localize() {
     W.spec.mesh.msh.shrink_to_fit();
     L.whole = std::move(impl_);
   }
-  impl_ = std::move(loc);
+  impl_ = std::move(loc);  // the whole model goes (on rank 0 but for what the snapshots need)
+#if defined(__GLIBC__)
+  malloc_trim(0);  // and its pages go back to the system
+#endif
   return true;
 }
 
