@@ -81,7 +81,7 @@ std::vector<std::string> fem_probe_fields(Obj& o, const std::vector<std::string>
   return fields;
 }
 
-Case build_fem_case(const Ctx& ctx, const ojson& doc) {
+Case build_fem_case(const Ctx& ctx, const ojson& doc, bool scatter, bool skeleton) {
   const std::string& source = ctx.source;
   Obj top(ctx, doc, "", kFem);
   if (top.has("bodies") || top.has("grid"))
@@ -162,7 +162,10 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   if (degree != 1 && degree != 2) f.fail("degree", "must be 1 or 2, got " + std::to_string(degree));
   spec.degree = static_cast<int>(degree);
   // probes: every key before meshing (solver null), then placed in the solver.
+  // On a rank set up from rank 0 (skeleton) the probes are listed unplaced: rank 0 places them
+  // and sends each rank its parts.
   auto read_probes = [&](const ojson& p, fem::Solver* solver) {
+    const bool place = solver && !solver->is_skeleton();
     if (!p.is_array()) top.fail("probes", "expected an array, got " + a_type(p));
     std::vector<std::string> names;
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -179,7 +182,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
       const auto at = o.nums("at", 2);
       pr.x = at[0];
       pr.y = at[1];
-      if (solver && solver->add_probe(pr.x, pr.y) < 0) {
+      if (place && solver->add_probe(pr.x, pr.y) < 0) {
         const auto bb = solver->bounds();
         o.fail("at", "outside the FEM mesh (bounding box [" + fmt(bb[0]) + ", " + fmt(bb[2]) +
                          "] x [" + fmt(bb[1]) + ", " + fmt(bb[3]) + "]): (" + fmt(pr.x) + ", " +
@@ -330,6 +333,18 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc) {
   }
 
   read_model(spec, &spec.mesh);
+  // Several ranks: a far field whose parts each rank can hold alone (no PML, no stiffness-
+  // proportional band) is built whole on rank 0 only, which sends each rank its part
+  // (fem::Solver::distribute_from_root); rank 0 runs every check. Else every rank builds it.
+  bool layered = false;
+  for (const auto& bc : spec.boundaries)
+    layered = layered || bc.kind == fem::Boundary::Kind::Pml || bc.beta > 0;
+  c.scattered = scatter && !layered;
+  if (c.scattered && skeleton) {
+    c.fem = std::make_unique<fem::Solver>(spec, fem::Solver::Skeleton{});
+    if (const ojson* p = top.find("probes")) read_probes(*p, c.fem.get());
+    return c;
+  }
   try {
     c.fem = std::make_unique<fem::Solver>(spec);
   } catch (const fem::FemError& e) {

@@ -17,8 +17,10 @@ namespace {
 class FemRegion final : public Region {
  public:
   explicit FemRegion(Case& c) : c_(c), s_(*c.fem) {
-    if (mpi()) {  // each rank then keeps only what it steps (but with a PML or a beta band)
-      s_.distribute();
+    if (mpi() && c.scattered) {  // built on rank 0, which sends each rank its part
+      s_.distribute_from_root();
+    } else if (mpi()) {  // built on every rank: each then keeps only what it steps (but with a
+      s_.distribute();   // PML or a beta band)
       s_.localize();
     }
   }

@@ -650,7 +650,7 @@ class Builder {
       }
       return doc_.contains("bodies") || doc_.contains("grid")
                  ? fe->build_hybrid_case(ctx_, doc_)  // cases/fe/case_hybrid.cpp
-                 : fe->build_fem_case(ctx_, doc_);    // cases/fe/case_fem.cpp
+                 : fe->build_fem_case(ctx_, doc_, scatter_, skeleton_);  // cases/fe/case_fem.cpp
     }
     if (!checking_ && doc_.contains("geometry")) Builder(ctx_, doc_, true).build();
     Obj top(ctx_, doc_, "");

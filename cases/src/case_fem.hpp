@@ -15,7 +15,7 @@ Material parse_material_at(const Ctx& ctx, const std::string& name, const ojson&
 TimeFunction parse_time_function_at(const Ctx& ctx, const ojson& j, const std::string& path);
 
 // Defined in case_fem.cpp: builds a case whose top level has "fem" (an FEM region).
-Case build_fem_case(const Ctx& ctx, const ojson& doc);
+Case build_fem_case(const Ctx& ctx, const ojson& doc, bool scatter = false, bool skeleton = false);
 // The "fields" of an FEM probe (an FEM case's, or a hybrid's probe in the FEM region): the
 // names listed, or `all` when the key is absent.
 std::vector<std::string> fem_probe_fields(Obj& o, const std::vector<std::string>& all);

@@ -31,11 +31,12 @@
 namespace smpm::detail {
 
 // Bumped whenever the table or a signature in it changes (as kGmshModuleApi).
-inline constexpr int kFarFieldModuleApi = 2;
+inline constexpr int kFarFieldModuleApi = 3;
 
 struct FarFieldModule {
   int api;
-  Case (*build_fem_case)(const Ctx& ctx, const ojson& doc);     // cases/fe/case_fem.cpp
+  // scatter, skeleton: as load_case_on_ranks passes them (several ranks; a rank other than 0).
+  Case (*build_fem_case)(const Ctx& ctx, const ojson& doc, bool scatter, bool skeleton);  // case_fem.cpp
   Case (*build_hybrid_case)(const Ctx& ctx, const ojson& doc);  // cases/fe/case_hybrid.cpp
   std::unique_ptr<Region> (*fem_region)(Case& c);               // cases/fe/region_fem.cpp
   std::unique_ptr<Region> (*hybrid_region)(Case& c, int across, bool resuming);  // region_hybrid.cpp

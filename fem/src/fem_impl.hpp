@@ -170,8 +170,13 @@ struct Solver::Impl {
 // (fem_setup.cpp).
 std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts);
 
-// Several processes (fem_parallel.cpp): copies the owners' u and v to the nodes this rank
-// receives; sums n values over the ranks, in place.
+// Several processes (fem_parallel.cpp). A part METIS leaves empty is an error (FemError).
+void check_parts(const std::vector<std::uint32_t>& cell_rank, int size, std::size_t nc);
+// Rank me's share of the whole model m under the cut P.cell_rank (P.size ranks): the nodes'
+// owners, its own nodes, its links to the others, its PML cells and nodes.
+void make_part(const Solver::Impl& m, Solver::Impl::Part& P, std::uint32_t me);
+// Copies the owners' u and v to the nodes this rank receives; sums n values over the ranks, in
+// place.
 void exchange_ghosts(Solver::Impl& m);
 void sum_over_ranks(const Solver::Impl& m, double* v, int n);
 // Items (nodes, layer cells ...) with an owning rank each: rank 0 receives every item's `width`

@@ -2,6 +2,7 @@
 // FE far field"): the own nodes and those received, K's own rows, the cells around them. Plain
 // arrays and MPI; no deal.II here.
 #include <mpi.h>
+#include <omp.h>
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -37,19 +38,37 @@ std::size_t Solver::dashpot_count() const {
   return localized() ? impl_->mesh_dashpots : impl_->dash.size();
 }
 
-bool Solver::localize() {
-  Impl& m = *impl_;
-  if (!m.part) throw FemError("FEM: localize() needs a model split over the ranks (distribute())");
-  if (localized()) return true;
-  if (m.pml.active() || m.visc.active()) return false;
-  const Impl::Part& P = *m.part;
+// Rank 0 of a local model keeps the whole mesh for the snapshots (nodes, cells, deal.II's mesh)
+// and frees the rest of the whole model.
+static void keep_for_snapshots(std::unique_ptr<Solver::Impl> whole, Solver::Impl& L) {
+  Solver::Impl& W = *whole;
+  W.part.reset();
+  for (auto* v : {&W.mass, &W.inv_mass, &W.ku, &W.fext, &W.val, &W.dash_force}) release(*v);
+  release(W.rowptr);
+  release(W.col);
+  release(W.row_val);
+  release(W.mask);
+  release(W.dash_of_node);
+  release(W.dash);
+  W.loads.clear();
+  W.probes.clear();
+  W.curve_nodes.clear();
+  W.spec.mesh.msh.clear();
+  W.spec.mesh.msh.shrink_to_fit();
+  L.whole = std::move(whole);
+}
+
+// Rank P.rank's local model (Solver::localize) of the whole model m split by P.
+static std::unique_ptr<Solver::Impl> local_model(const Solver::Impl& m, const Solver::Impl::Part& P,
+                                          std::vector<std::string> described) {
+  using Impl = Solver::Impl;
   const auto me = static_cast<std::uint32_t>(P.rank);
   const std::size_t nn = m.x.size(), nc = m.n_cells;
   const std::size_t nb = static_cast<std::size_t>((m.degree + 1) * (m.degree + 1));
 
   auto loc = std::make_unique<Impl>();
   Impl& L = *loc;
-  L.described = describe();
+  L.described = std::move(described);
   L.mesh_nodes = nn;
   L.mesh_dashpots = m.dash.size();
 
@@ -190,25 +209,16 @@ bool Solver::localize() {
   }
   L.part = std::move(part);
 
-  // Rank 0 keeps the whole mesh for the snapshots; the others free it with the rest.
-  if (P.rank == 0) {
-    Impl& W = m;
-    W.part.reset();
-    for (auto* v : {&W.mass, &W.inv_mass, &W.ku, &W.fext, &W.val, &W.dash_force})
-      release(*v);
-    release(W.rowptr);
-    release(W.col);
-    release(W.row_val);
-    release(W.mask);
-    release(W.dash_of_node);
-    release(W.dash);
-    W.loads.clear();
-    W.probes.clear();
-    W.curve_nodes.clear();
-    W.spec.mesh.msh.clear();
-    W.spec.mesh.msh.shrink_to_fit();
-    L.whole = std::move(impl_);
-  }
+  return loc;
+}
+
+bool Solver::localize() {
+  Impl& m = *impl_;
+  if (!m.part) throw FemError("FEM: localize() needs a model split over the ranks (distribute())");
+  if (localized()) return true;
+  if (m.pml.active() || m.visc.active()) return false;
+  std::unique_ptr<Impl> loc = local_model(m, *m.part, describe());
+  if (m.part->rank == 0) keep_for_snapshots(std::move(impl_), *loc);
   impl_ = std::move(loc);  // the whole model goes (on rank 0 but for what the snapshots need)
 #if defined(__GLIBC__)
   malloc_trim(0);  // and its pages go back to the system
@@ -237,6 +247,268 @@ void gather_local(const Solver::Impl& m, const std::vector<const std::vector<dou
       std::copy_n(all.begin() + static_cast<std::ptrdiff_t>(k + 1 + width * f), width,
                   out[f].begin() + static_cast<std::ptrdiff_t>(width * n));
   }
+}
+
+}  // namespace smpm::fem
+
+// ---- the parts built on rank 0 and sent (Solver::distribute_from_root) -------------------------
+
+namespace smpm::fem {
+
+namespace {
+constexpr int kPartTag = 7302;
+constexpr std::size_t kPiece = std::size_t{1} << 30;
+
+void send_bytes(const std::string& b, int to) {
+  std::uint64_t n = b.size();
+  MPI_Send(&n, 1, MPI_UINT64_T, to, kPartTag, MPI_COMM_WORLD);
+  for (std::size_t o = 0; o < b.size(); o += kPiece)
+    MPI_Send(b.data() + o, static_cast<int>(std::min(kPiece, b.size() - o)), MPI_CHAR, to, kPartTag,
+             MPI_COMM_WORLD);
+}
+
+std::string recv_bytes(int from) {
+  std::uint64_t n = 0;
+  MPI_Recv(&n, 1, MPI_UINT64_T, from, kPartTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  std::string b(n, '\0');
+  for (std::size_t o = 0; o < b.size(); o += kPiece)
+    MPI_Recv(b.data() + o, static_cast<int>(std::min(kPiece, b.size() - o)), MPI_CHAR, from,
+             kPartTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  return b;
+}
+
+std::string key(const char* what, std::size_t k) { return std::string(what) + "." + std::to_string(k); }
+std::string key(const char* what, std::size_t k, std::size_t j) { return key(what, k) + "." + std::to_string(j); }
+
+// A local model's arrays (and the solver's clock), as a message. The spec is not in it: the
+// receiving rank read the same case.
+std::string pack(const Solver::Impl& L, double dt, double t, long steps, const Energies& e) {
+  StateWriter w;
+  w.put("dt", dt);
+  w.put("t", t);
+  w.put("steps", static_cast<std::int64_t>(steps));
+  w.put("energy", e);
+  w.put("sizes", std::vector<std::uint64_t>{L.mesh_nodes, L.mesh_dashpots, L.n_cells});
+  w.put("box", std::vector<double>(L.box.begin(), L.box.end()));
+  w.put("crit_dt", L.crit_dt);
+  w.put("ku_valid", static_cast<std::uint8_t>(L.ku_valid));
+  w.put("snapshot_times", L.snapshot_times);
+  for (const auto& [n, v] : {std::pair{"x", &L.x}, {"y", &L.y}, {"mass", &L.mass}, {"inv_mass", &L.inv_mass},
+                             {"u", &L.u}, {"v", &L.v}, {"ku", &L.ku}, {"fext", &L.fext}, {"val", &L.val},
+                             {"dash_force", &L.dash_force}})
+    w.put(n, *v);
+  w.put("mask", L.mask);
+  w.put("dash_of_node", L.dash_of_node);
+  w.put("rowptr", L.rowptr);
+  w.put("col", L.col);
+  w.put("row_val", L.row_val);
+  w.put("dash", L.dash);
+  w.put("cell_nodes", L.cell_nodes);
+  w.put("glob", L.glob);
+  w.put("loads", static_cast<std::uint64_t>(L.loads.size()));
+  for (std::size_t k = 0; k < L.loads.size(); ++k) {
+    w.put(key("load_nodes", k), L.loads[k].nodes);
+    w.put(key("load_f", k), L.loads[k].f);
+  }
+  std::vector<std::int32_t> tags;
+  for (const auto& [tag, nodes] : L.curve_nodes) {
+    w.put(key("curve", tags.size()), nodes);
+    tags.push_back(tag);
+  }
+  w.put("curves", tags);
+  w.put("probes", static_cast<std::uint64_t>(L.probes.size()));
+  for (std::size_t p = 0; p < L.probes.size(); ++p) {
+    const auto& pr = L.probes[p];
+    w.put(key("probe", p), std::vector<double>{pr.x, pr.y, pr.w});
+    w.put(key("probe_parts", p), static_cast<std::uint64_t>(pr.parts.size()));
+    for (std::size_t j = 0; j < pr.parts.size(); ++j) {
+      const auto& q = pr.parts[j];
+      w.put(key("part_cell", p, j), q.cell);
+      w.put(key("part_dofs", p, j), q.dofs);
+      w.put(key("part_comp", p, j), q.comp);
+      w.put(key("part_values", p, j), [&] {
+        std::vector<double> v{q.lambda, q.mu};
+        for (const auto* a : {&q.N, &q.dx, &q.dy}) v.insert(v.end(), a->begin(), a->end());
+        return v;
+      }());
+    }
+  }
+  w.put("described", static_cast<std::uint64_t>(L.described.size()));
+  for (std::size_t k = 0; k < L.described.size(); ++k) w.put_string(key("line", k), L.described[k]);
+  const Solver::Impl::Part& P = *L.part;
+  w.put("part_ints", std::vector<std::int64_t>{P.rank, P.size, static_cast<std::int64_t>(P.ghosts)});
+  w.put("part_energy", std::vector<double>{P.work, P.absorbed});
+  w.put("own", P.own);
+  w.put("node_rank", P.node_rank);
+  w.put("links", static_cast<std::uint64_t>(P.links.size()));
+  for (std::size_t k = 0; k < P.links.size(); ++k) {
+    w.put(key("link_rank", k), static_cast<std::int32_t>(P.links[k].rank));
+    w.put(key("link_send", k), P.links[k].send);
+    w.put(key("link_recv", k), P.links[k].recv);
+  }
+  return w.bytes();
+}
+
+// The message of pack into L (whose spec this rank read), and the solver's clock.
+void unpack(const std::string& bytes, Solver::Impl& L, double& dt, double& t, long& steps, Energies& e) {
+  const StateReader r(bytes, "the far field's part from rank 0");
+  dt = r.get<double>("dt");
+  t = r.get<double>("t");
+  steps = static_cast<long>(r.get<std::int64_t>("steps"));
+  e = r.get<Energies>("energy");
+  std::vector<std::uint64_t> sizes;
+  r.get("sizes", sizes, 3);
+  L.mesh_nodes = sizes[0];
+  L.mesh_dashpots = sizes[1];
+  L.n_cells = sizes[2];
+  std::vector<double> box;
+  r.get("box", box, 4);
+  std::copy(box.begin(), box.end(), L.box.begin());
+  L.crit_dt = r.get<double>("crit_dt");
+  L.ku_valid = r.get<std::uint8_t>("ku_valid") != 0;
+  r.get("snapshot_times", L.snapshot_times);
+  L.snapshots = static_cast<int>(L.snapshot_times.size());
+  for (const auto& [n, v] : {std::pair{"x", &L.x}, {"y", &L.y}, {"mass", &L.mass}, {"inv_mass", &L.inv_mass},
+                             {"u", &L.u}, {"v", &L.v}, {"ku", &L.ku}, {"fext", &L.fext}, {"val", &L.val},
+                             {"dash_force", &L.dash_force}})
+    r.get(n, *v);
+  r.get("mask", L.mask);
+  r.get("dash_of_node", L.dash_of_node);
+  r.get("rowptr", L.rowptr);
+  r.get("col", L.col);
+  r.get("row_val", L.row_val);
+  r.get("dash", L.dash);
+  r.get("cell_nodes", L.cell_nodes);
+  r.get("glob", L.glob);
+  // One load per traction, in the order of the spec's boundaries (as the whole model has them).
+  std::vector<const TimeFunction*> fns;
+  for (const auto& b : L.spec.boundaries)
+    if (b.kind == Boundary::Kind::Traction) fns.push_back(&b.fn);
+  const auto loads = r.get<std::uint64_t>("loads");
+  if (loads != fns.size()) r.fail("its loads are not this case's tractions");
+  L.loads.resize(loads);
+  for (std::size_t k = 0; k < loads; ++k) {
+    L.loads[k].fn = *fns[k];
+    r.get(key("load_nodes", k), L.loads[k].nodes);
+    r.get(key("load_f", k), L.loads[k].f);
+  }
+  std::vector<std::int32_t> tags;
+  r.get("curves", tags);
+  for (std::size_t k = 0; k < tags.size(); ++k) r.get(key("curve", k), L.curve_nodes[tags[k]]);
+  L.probes.resize(r.get<std::uint64_t>("probes"));
+  for (std::size_t p = 0; p < L.probes.size(); ++p) {
+    auto& pr = L.probes[p];
+    std::vector<double> xyw;
+    r.get(key("probe", p), xyw, 3);
+    pr.x = xyw[0];
+    pr.y = xyw[1];
+    pr.w = xyw[2];
+    pr.parts.resize(r.get<std::uint64_t>(key("probe_parts", p)));
+    for (std::size_t j = 0; j < pr.parts.size(); ++j) {
+      auto& q = pr.parts[j];
+      q.cell = r.get<std::uint32_t>(key("part_cell", p, j));
+      r.get(key("part_dofs", p, j), q.dofs);
+      r.get(key("part_comp", p, j), q.comp, q.dofs.size());
+      std::vector<double> v;
+      r.get(key("part_values", p, j), v, 2 + 3 * q.dofs.size());
+      const auto n = static_cast<std::ptrdiff_t>(q.dofs.size());
+      q.lambda = v[0];
+      q.mu = v[1];
+      q.N.assign(v.begin() + 2, v.begin() + 2 + n);
+      q.dx.assign(v.begin() + 2 + n, v.begin() + 2 + 2 * n);
+      q.dy.assign(v.begin() + 2 + 2 * n, v.end());
+    }
+  }
+  L.described.resize(r.get<std::uint64_t>("described"));
+  for (std::size_t k = 0; k < L.described.size(); ++k) L.described[k] = r.get_string(key("line", k));
+  auto part = std::make_unique<Solver::Impl::Part>();
+  Solver::Impl::Part& P = *part;
+  std::vector<std::int64_t> ints;
+  r.get("part_ints", ints, 3);
+  P.rank = static_cast<int>(ints[0]);
+  P.size = static_cast<int>(ints[1]);
+  P.ghosts = static_cast<std::size_t>(ints[2]);
+  std::vector<double> pe;
+  r.get("part_energy", pe, 2);
+  P.work = pe[0];
+  P.absorbed = pe[1];
+  r.get("own", P.own);
+  r.get("node_rank", P.node_rank);
+  P.links.resize(r.get<std::uint64_t>("links"));
+  for (std::size_t k = 0; k < P.links.size(); ++k) {
+    P.links[k].rank = r.get<std::int32_t>(key("link_rank", k));
+    r.get(key("link_send", k), P.links[k].send);
+    r.get(key("link_recv", k), P.links[k].recv);
+  }
+  L.part = std::move(part);
+}
+}  // namespace
+
+Solver::Solver(const Spec& spec, Skeleton) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.spec = spec;
+  m.spec.mesh.msh.clear();
+  m.spec.mesh.msh.shrink_to_fit();
+  m.degree = spec.degree;
+  m.threads = spec.threads > 0 ? spec.threads : omp_get_max_threads();
+}
+
+bool Solver::is_skeleton() const { return !impl_->part && impl_->glob.empty() && impl_->x.empty(); }
+
+void Solver::distribute_from_root() {
+  Impl& m = *impl_;
+  if (m.part) throw FemError("FEM: the model is already split over the MPI ranks");
+  int running = 0;
+  MPI_Initialized(&running);
+  if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  // Rank 0 cuts the whole model and checks the cut; whether it could is every rank's to know
+  // before any part is sent.
+  Impl::Part P;
+  P.rank = 0;
+  P.size = size;
+  std::string why;
+  if (rank == 0) {
+    try {
+      if (m.pml.active() || m.visc.active())
+        throw FemError("FEM: a far field with a PML or a stiffness-proportional band is built whole on every rank");
+      if (m.n_cells < static_cast<std::size_t>(size))
+        throw FemError("FEM: fewer cells (" + std::to_string(m.n_cells) + ") than MPI ranks (" +
+                       std::to_string(size) + "): run it on fewer ranks or on a finer mesh");
+      P.cell_rank = partition_cells(m, static_cast<unsigned>(size));
+      check_parts(P.cell_rank, size, m.n_cells);
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+  }
+  int ok = why.empty() ? 1 : 0;
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!ok) throw FemError(rank == 0 ? why : "FEM: rank 0 could not cut the mesh");
+  if (rank != 0) {
+    unpack(recv_bytes(0), m, dt, t, steps, energy);
+    return;
+  }
+  // Rank 0: each other rank's part, built and sent one at a time, then its own.
+  const std::vector<std::string> described = describe();
+  for (int r = 1; r < size; ++r) {
+    P.rank = r;
+    make_part(m, P, static_cast<std::uint32_t>(r));
+    P.work = P.absorbed = 0;
+    const std::unique_ptr<Impl> part = local_model(m, P, described);
+    send_bytes(pack(*part, dt, t, steps, energy), r);
+  }
+  P.rank = 0;
+  make_part(m, P, 0);
+  P.work = energy.external_work;  // the booked energies stay with rank 0
+  P.absorbed = energy.absorbed;
+  std::unique_ptr<Impl> loc = local_model(m, P, described);
+  keep_for_snapshots(std::move(impl_), *loc);
+  impl_ = std::move(loc);
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
 }
 
 }  // namespace smpm::fem

@@ -17,44 +17,22 @@ namespace {
 constexpr int kGhostTag = 7301;
 }  // namespace
 
-void Solver::distribute() {
-  Impl& m = *impl_;
-  if (m.part) throw FemError("FEM: the model is already split over the MPI ranks");
-  int running = 0;
-  MPI_Initialized(&running);
-  if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
-  auto part = std::make_unique<Impl::Part>();
-  Impl::Part& P = *part;
-  MPI_Comm_rank(MPI_COMM_WORLD, &P.rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &P.size);
-  const std::size_t nc = m.n_cells, nn = m.x.size();
-  const auto ranks = static_cast<std::size_t>(P.size);
-  if (nc < ranks)
-    throw FemError("FEM: fewer cells (" + std::to_string(nc) + ") than MPI ranks (" +
-                   std::to_string(P.size) + "): run it on fewer ranks or on a finer mesh");
-  // Rank 0 cuts the mesh and sends the cut to the others, so that every rank holds the same one.
-  // It says first whether the cut worked, so that a failure stops every rank (with rank 0's
-  // reason printed by rank 0), not rank 0 alone while the others wait for the cut.
-  P.cell_rank.assign(nc, 0);
-  std::string why;
-  if (P.rank == 0) {
-    try {
-      P.cell_rank = partition_cells(m, static_cast<unsigned>(P.size));
-    } catch (const std::exception& e) {
-      why = e.what();
-    }
-  }
-  int cut = why.empty() ? 1 : 0;
-  MPI_Bcast(&cut, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!cut) throw FemError(P.rank == 0 ? why : "FEM: rank 0 could not cut the mesh");
-  MPI_Bcast(P.cell_rank.data(), static_cast<int>(nc), MPI_UINT32_T, 0, MPI_COMM_WORLD);
+void check_parts(const std::vector<std::uint32_t>& cell_rank, int size, std::size_t nc) {
+  const auto ranks = static_cast<std::size_t>(size);
   std::vector<std::size_t> cells_of(ranks, 0);
-  for (const auto r : P.cell_rank) ++cells_of[r];
+  for (const auto r : cell_rank) ++cells_of[r];
   for (std::size_t r = 0; r < ranks; ++r)
     if (cells_of[r] == 0)
-      throw FemError("FEM: METIS left rank " + std::to_string(r) + " of " + std::to_string(P.size) +
+      throw FemError("FEM: METIS left rank " + std::to_string(r) + " of " + std::to_string(size) +
                      " without cells (" + std::to_string(nc) + " cells): run it on fewer ranks");
+}
 
+void make_part(const Solver::Impl& m, Solver::Impl::Part& P, std::uint32_t me) {
+  const std::size_t nc = m.n_cells, nn = m.x.size();
+  const auto ranks = static_cast<std::size_t>(P.size);
+  P.own.clear();
+  P.links.clear();
+  P.ghosts = 0;
   const std::size_t nb = static_cast<std::size_t>((m.degree + 1) * (m.degree + 1));
   P.node_rank.assign(nn, std::numeric_limits<std::uint32_t>::max());
   for (std::size_t c = 0; c < nc; ++c)
@@ -62,7 +40,6 @@ void Solver::distribute() {
       auto& r = P.node_rank[m.cell_nodes[c * nb + a]];
       r = std::min(r, P.cell_rank[c]);
     }
-  const auto me = static_cast<std::uint32_t>(P.rank);
   for (std::size_t i = 0; i < nn; ++i)
     if (P.node_rank[i] == me) P.own.push_back(static_cast<std::uint32_t>(i));
 
@@ -100,7 +77,9 @@ void Solver::distribute() {
   // The perfectly matched layers: the layer cells this rank steps, colour by colour, and its
   // own nodes' memories.
   if (m.pml.active()) {
-    const Impl::Pml& L = m.pml;
+    const Solver::Impl::Pml& L = m.pml;
+    P.pml_cells.clear();
+    P.pml_nodes.clear();
     P.pml_colour_start.assign(1, 0);
     for (std::size_t k = 0; k + 1 < L.colour_start.size(); ++k) {
       for (std::uint32_t c = L.colour_start[k]; c < L.colour_start[k + 1]; ++c)
@@ -110,7 +89,40 @@ void Solver::distribute() {
     for (std::size_t j = 0; j < L.node.size(); ++j)
       if (P.node_rank[L.node[j]] == me) P.pml_nodes.push_back(static_cast<std::uint32_t>(j));
   }
+}
 
+void Solver::distribute() {
+  Impl& m = *impl_;
+  if (m.part) throw FemError("FEM: the model is already split over the MPI ranks");
+  int running = 0;
+  MPI_Initialized(&running);
+  if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
+  auto part = std::make_unique<Impl::Part>();
+  Impl::Part& P = *part;
+  MPI_Comm_rank(MPI_COMM_WORLD, &P.rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &P.size);
+  const std::size_t nc = m.n_cells;
+  if (nc < static_cast<std::size_t>(P.size))
+    throw FemError("FEM: fewer cells (" + std::to_string(nc) + ") than MPI ranks (" +
+                   std::to_string(P.size) + "): run it on fewer ranks or on a finer mesh");
+  // Rank 0 cuts the mesh and sends the cut to the others, so that every rank holds the same one.
+  // It says first whether the cut worked, so that a failure stops every rank (with rank 0's
+  // reason printed by rank 0), not rank 0 alone while the others wait for the cut.
+  P.cell_rank.assign(nc, 0);
+  std::string why;
+  if (P.rank == 0) {
+    try {
+      P.cell_rank = partition_cells(m, static_cast<unsigned>(P.size));
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+  }
+  int cut = why.empty() ? 1 : 0;
+  MPI_Bcast(&cut, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!cut) throw FemError(P.rank == 0 ? why : "FEM: rank 0 could not cut the mesh");
+  MPI_Bcast(P.cell_rank.data(), static_cast<int>(nc), MPI_UINT32_T, 0, MPI_COMM_WORLD);
+  check_parts(P.cell_rank, P.size, nc);
+  make_part(m, P, static_cast<std::uint32_t>(P.rank));
   // The booked energies stay with rank 0; every rank adds its own nodes' share from now on.
   // The damping layers' stiffness-proportional rows this rank steps: its own listed nodes.
   if (m.visc.active()) {

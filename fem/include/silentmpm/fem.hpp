@@ -128,6 +128,11 @@ class Solver {
   // Builds the mesh, the degrees of freedom, the lumped mass, K, the dashpot blocks and the
   // traction load vectors. Throws FemError on a bad model (unknown group, no material...).
   explicit Solver(const Spec& spec);
+  // On a rank other than 0 of a far field set up from rank 0 (distribute_from_root): the spec
+  // only (a mesh's text is dropped); the part arrives from rank 0. Nothing else may be called
+  // on it before distribute_from_root().
+  struct Skeleton {};
+  Solver(const Spec& spec, Skeleton);
   ~Solver();
   Solver(const Solver&) = delete;
   Solver& operator=(const Solver&) = delete;
@@ -268,6 +273,14 @@ class Solver {
   // else true. Throws FemError when the model is not split.
   bool localize();
   bool localized() const;
+  // The same parts, built on rank 0 alone: rank 0 holds the whole model (as built from the
+  // spec, its probes added and dt set), the other ranks a Skeleton of the same spec; rank 0 cuts
+  // it, builds each rank's local model (as localize() would) and sends it with the clock, and
+  // keeps its own. So only rank 0 ever holds the whole model. Collective; throws FemError on
+  // every rank when the cut fails, and for a model with a PML or a stiffness-proportional band
+  // (those are built whole on every rank, distribute() and localize()).
+  void distribute_from_root();
+  bool is_skeleton() const;
   // The mesh number of each local node (every node on a model that holds the whole mesh).
   std::vector<std::uint32_t> global_nodes() const;
   int ranks() const;  // 1 on one process
