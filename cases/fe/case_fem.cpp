@@ -319,27 +319,27 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc, bool scatter, bool skeleto
       }
     }
   };
+  // Several ranks: a far field whose parts each rank can hold alone (no PML, no stiffness-
+  // proportional band) is built whole on rank 0 only, which sends each rank its part
+  // (fem::Solver::distribute_from_root); rank 0 runs every check. Else every rank builds it.
+  bool layered = false;
   {
     fem::Spec keys_only;
     read_model(keys_only, nullptr);
+    for (const auto& bc : keys_only.boundaries)
+      layered = layered || bc.kind == fem::Boundary::Kind::Pml || bc.beta > 0;
   }
+  c.scattered = scatter && !layered;
   // probes: the same (read below, placed once the solver exists).
   if (const ojson* p = top.find("probes")) read_probes(*p, nullptr);
   try {
-    spec.mesh = fem::load_mesh(mesh_file, size, load_limits().mesh_cells, parameters);
+    spec.mesh = fem::load_mesh(mesh_file, size, load_limits().mesh_cells, parameters, !c.scattered);
   } catch (const fem::FemError& e) {
     f.fail(f.has("size") && std::string(e.what()).find("size") != std::string::npos ? "size" : "mesh",
            e.what());
   }
 
   read_model(spec, &spec.mesh);
-  // Several ranks: a far field whose parts each rank can hold alone (no PML, no stiffness-
-  // proportional band) is built whole on rank 0 only, which sends each rank its part
-  // (fem::Solver::distribute_from_root); rank 0 runs every check. Else every rank builds it.
-  bool layered = false;
-  for (const auto& bc : spec.boundaries)
-    layered = layered || bc.kind == fem::Boundary::Kind::Pml || bc.beta > 0;
-  c.scattered = scatter && !layered;
   if (c.scattered && skeleton) {
     c.fem = std::make_unique<fem::Solver>(spec, fem::Solver::Skeleton{});
     if (const ojson* p = top.find("probes")) read_probes(*p, c.fem.get());

@@ -488,6 +488,9 @@ void Solver::distribute_from_root() {
   if (!ok) throw FemError(rank == 0 ? why : "FEM: rank 0 could not cut the mesh");
   if (rank != 0) {
     unpack(recv_bytes(0), m, dt, t, steps, energy);
+#if defined(__GLIBC__)
+    malloc_trim(0);  // the message's pages
+#endif
     return;
   }
   // Rank 0: each other rank's part, built and sent one at a time, then its own.

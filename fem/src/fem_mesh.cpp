@@ -214,7 +214,7 @@ void broadcast(std::vector<PhysicalGroup>& groups) {
 }  // namespace
 
 Mesh load_mesh(const std::string& file, double size, double max_cells,
-               const std::vector<std::pair<std::string, double>>& parameters) {
+               const std::vector<std::pair<std::string, double>>& parameters, bool text_to_all) {
   int running = 0, finished = 0, ranks = 1, rank = 0;
   MPI_Initialized(&running);
   if (running) MPI_Finalized(&finished);
@@ -237,7 +237,9 @@ Mesh load_mesh(const std::string& file, double size, double max_cells,
   if (!why.empty()) throw FemError(why);
   broadcast(m.file);
   MPI_Bcast(&m.size, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  broadcast(m.msh);
+  int text = text_to_all ? 1 : 0;  // rank 0's word: whether the text goes to every rank
+  MPI_Bcast(&text, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (text) broadcast(m.msh);
   broadcast(m.surfaces);
   broadcast(m.curves);
   unsigned long long quads = m.quads;

@@ -66,9 +66,12 @@ struct Mesh {
 // cells (estimated before meshing) is refused. `parameters` set other numbers of a .geo before it
 // is read (its DefineConstant keeps them). Throws FemError naming the file. Under MPI with several
 // ranks every rank calls it at once: rank 0 alone reads or meshes its `file` and sends the mesh
-// to the others (their arguments are not read); rank 0's error is thrown on every rank.
+// to the others (their arguments are not read); rank 0's error is thrown on every rank. With
+// text_to_all false (rank 0's word counts) the others get the groups and counts but no `msh`
+// text: a far field set up from rank 0 (Solver::distribute_from_root) needs no more there.
 Mesh load_mesh(const std::string& file, double size, double max_cells = 1e7,
-               const std::vector<std::pair<std::string, double>>& parameters = {});
+               const std::vector<std::pair<std::string, double>>& parameters = {},
+               bool text_to_all = true);
 
 // ---- model -------------------------------------------------------------------------------------
 struct Boundary {
