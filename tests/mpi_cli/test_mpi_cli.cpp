@@ -207,6 +207,10 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
       {kCase + kShort + " --ranks-across 3",
        "2 MPI ranks cannot form blocks 3 ranks across"},
       {kFem + " --set fem.size=0.04", "FEM: fewer cells (1) than MPI ranks (2)"},
+      // A far field set up from rank 0: its checks are rank 0's, and every rank's error.
+      {kFemLocal + " --set fem.size=0.04", "FEM: fewer cells (1) than MPI ranks (2)"},
+      {kFemLocal + " --set probes.1.at=[0.5,0.5]", "outside the FEM mesh"},
+      {kFemLocal + " --set 'time={\"end\": 2e-5, \"dt\": 1e-5}'", "above the FEM stability limit"},
       {kFem + " --ranks-across 2", "--ranks-across 2 lays out the blocks of an MPM grid; an FE "
                                    "case's mesh is cut by METIS"}};
   int k = 0;
