@@ -319,17 +319,13 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc, bool scatter, bool skeleto
       }
     }
   };
-  // Several ranks: a far field whose parts each rank can hold alone (no PML, no stiffness-
-  // proportional band) is built whole on rank 0 only, which sends each rank its part
-  // (fem::Solver::distribute_from_root); rank 0 runs every check. Else every rank builds it.
-  bool layered = false;
   {
     fem::Spec keys_only;
     read_model(keys_only, nullptr);
-    for (const auto& bc : keys_only.boundaries)
-      layered = layered || bc.kind == fem::Boundary::Kind::Pml || bc.beta > 0;
   }
-  c.scattered = scatter && !layered;
+  // Several ranks: the far field is built whole on rank 0 only, which sends each rank its part
+  // (fem::Solver::distribute_from_root); rank 0 runs every check.
+  c.scattered = scatter;
   // probes: the same (read below, placed once the solver exists).
   if (const ojson* p = top.find("probes")) read_probes(*p, nullptr);
   try {

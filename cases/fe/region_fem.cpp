@@ -19,8 +19,8 @@ class FemRegion final : public Region {
   explicit FemRegion(Case& c) : c_(c), s_(*c.fem) {
     if (mpi() && c.scattered) {  // built on rank 0, which sends each rank its part
       s_.distribute_from_root();
-    } else if (mpi()) {  // built on every rank: each then keeps only what it steps (but with a
-      s_.distribute();   // PML or a beta band)
+    } else if (mpi()) {  // one rank: the same part, kept from the whole model
+      s_.distribute();
       s_.localize();
     }
   }

@@ -77,6 +77,11 @@ struct Solver::Impl {
     double dt_coef = 0;
     std::vector<double> packed;
     double e_a = 1, ca_a = 0, cb_a = 0;
+    // A local model (Solver::localize): each cell's and node's index in the whole model's lists,
+    // whether the cell is of this rank's part (its checkpoint share), and the whole lists' sizes.
+    std::vector<std::uint32_t> glob_cell, glob_node;
+    std::vector<std::uint8_t> own_cell;
+    std::size_t whole_cells = 0, whole_nodes = 0;
     bool active() const { return !touched.empty(); }
   };
   Pml pml;

@@ -655,6 +655,19 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
     w.put(pre + "pml_zeta", m.pml.zeta);
     return;
   }
+  if (!m.glob.empty()) {  // a local model: its part's cells and its own nodes, by their numbers
+    std::vector<std::uint32_t> cells, numbers;
+    for (std::size_t k = 0; k < m.pml.cell.size(); ++k)
+      if (m.pml.own_cell[k]) {
+        cells.push_back(static_cast<std::uint32_t>(k));
+        numbers.push_back(m.pml.glob_cell[k]);
+      }
+    w.put_part(pre + "pml_cells", numbers);
+    w.put_part(pre + "pml_xi", values_of(m.pml.xi, cells, 4 * m.pml.nq));
+    w.put_part(pre + "pml_nodes", m.pml.glob_node);
+    w.put_part(pre + "pml_zeta", m.pml.zeta);
+    return;
+  }
   const Impl::Part& P = *m.part;
   const auto me = static_cast<std::uint32_t>(P.rank);
   std::vector<std::uint32_t> cell_owner(m.pml.cell.size()), node_owner(m.pml.node.size());
@@ -682,9 +695,19 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   energy = r.get<Energies>(pre + "energy");
   r.get(pre + "snapshot_times", m.snapshot_times);
   m.snapshots = static_cast<int>(m.snapshot_times.size());
-  if (m.pml.active()) {
+  if (m.pml.active() && m.glob.empty()) {
     get_items(r, pre + "pml_xi", pre + "pml_cells", m.pml.cell.size(), 4 * m.pml.nq, m.pml.xi);
     get_items(r, pre + "pml_zeta", pre + "pml_nodes", m.pml.node.size(), 4, m.pml.zeta);
+  } else if (m.pml.active()) {  // a local model: its cells' and nodes' memories
+    Impl::Pml& P = m.pml;
+    const auto w = static_cast<std::size_t>(4 * P.nq);
+    std::vector<double> xi, zeta;
+    get_items(r, pre + "pml_xi", pre + "pml_cells", P.whole_cells, w, xi);
+    get_items(r, pre + "pml_zeta", pre + "pml_nodes", P.whole_nodes, 4, zeta);
+    for (std::size_t k = 0; k < P.cell.size(); ++k)
+      std::copy_n(xi.begin() + static_cast<std::ptrdiff_t>(w * P.glob_cell[k]), w, P.xi.begin() + static_cast<std::ptrdiff_t>(w * k));
+    for (std::size_t j = 0; j < P.node.size(); ++j)
+      std::copy_n(zeta.begin() + 4 * static_cast<std::ptrdiff_t>(P.glob_node[j]), 4, P.zeta.begin() + 4 * static_cast<std::ptrdiff_t>(j));
   }
   if (m.part) {  // several ranks: the booked energies stay with rank 0
     m.part->work = m.part->rank == 0 ? energy.external_work : 0.0;

@@ -116,11 +116,12 @@ static std::unique_ptr<Solver::Impl> local_model(const Solver::Impl& m, const So
   pick(m.ku, 2, L.ku);
   pick(m.fext, 2, L.fext);
 
-  // The own nodes' dashpot blocks (only own nodes are advanced) and explicit forces.
+  // The local nodes' dashpot blocks and explicit forces (own nodes are advanced with them; a
+  // PML cell or a damping band's row puts its forces on its received nodes' too).
   L.dash_of_node.assign(nl, -1);
   for (std::size_t k = 0; k < m.dash.size(); ++k) {
     const std::uint32_t n = m.dash[k].node;
-    if (P.node_rank[n] != me) continue;
+    if (to[n] == kNone) continue;
     Solver::DashpotBlock b = m.dash[k];
     b.node = local(n);
     L.dash_of_node[b.node] = static_cast<std::int32_t>(L.dash.size());
@@ -161,6 +162,66 @@ static std::unique_ptr<Solver::Impl> local_model(const Solver::Impl& m, const So
       if (to[n] != kNone) out.push_back(to[n]);
   }
 
+  // The perfectly matched layers: the layer cells this rank steps (P.pml_cells, by colour) and
+  // its own layer nodes' memories, in the whole model's order.
+  if (m.pml.active()) {
+    const Impl::Pml& W = m.pml;
+    Impl::Pml& Y = L.pml;
+    Y.alpha = W.alpha;
+    Y.nb = W.nb;
+    Y.nq = W.nq;
+    Y.grad = W.grad;
+    Y.kl = W.kl;
+    Y.km = W.km;
+    Y.dx = W.dx;
+    Y.dy = W.dy;
+    Y.dt_coef = W.dt_coef;
+    Y.packed = W.packed;
+    Y.e_a = W.e_a;
+    Y.ca_a = W.ca_a;
+    Y.cb_a = W.cb_a;
+    Y.whole_cells = W.cell.size();
+    Y.whole_nodes = W.node.size();
+    Y.colour_start = P.pml_colour_start;
+    const auto cnb = static_cast<std::size_t>(W.nb), cnq = static_cast<std::size_t>(W.nq);
+    for (const std::uint32_t c : P.pml_cells) {
+      Y.cell.push_back(W.cell[c]);
+      Y.glob_cell.push_back(c);
+      Y.own_cell.push_back(P.cell_rank[W.cell[c]] == me);
+      for (std::size_t a = 0; a < cnb; ++a) Y.cell_nodes.push_back(local(W.cell_nodes[c * cnb + a]));
+      Y.shape.push_back(W.shape[c]);
+      Y.kind.insert(Y.kind.end(), W.kind.begin() + c * cnq, W.kind.begin() + (c + 1) * cnq);
+      Y.xi.insert(Y.xi.end(), W.xi.begin() + 4 * cnq * c, W.xi.begin() + 4 * cnq * (c + 1));
+    }
+    for (const std::uint32_t j : P.pml_nodes) {
+      Y.node.push_back(local(W.node[j]));
+      Y.glob_node.push_back(j);
+      Y.m_sum.push_back(W.m_sum[j]);
+      Y.m_prod.push_back(W.m_prod[j]);
+      Y.zeta.insert(Y.zeta.end(), W.zeta.begin() + 4 * j, W.zeta.begin() + 4 * (j + 1));
+    }
+    for (const std::uint32_t n : W.touched)
+      if (to[n] != kNone) Y.touched.push_back(to[n]);
+  }
+  // The damping bands' stiffness-proportional part: the listed nodes held here, the rows of the
+  // own ones.
+  if (m.visc.active()) {
+    const Impl::Viscous& W = m.visc;
+    Impl::Viscous& Y = L.visc;
+    for (std::size_t r = 0; r < W.node.size(); ++r) {
+      const std::uint32_t n = W.node[r];
+      if (to[n] == kNone) continue;
+      if (P.node_rank[n] == me) {
+        Y.rows.push_back(static_cast<std::uint32_t>(Y.node.size()));
+        Y.row_node.push_back(to[n]);
+      }
+      Y.node.push_back(to[n]);
+      Y.root_beta.push_back(W.root_beta[r]);
+    }
+    Y.w.assign(2 * nl, 0.0);
+    Y.kw.assign(2 * nl, 0.0);
+  }
+
   // The cells this rank steps (its part's, and those around its own nodes).
   for (std::size_t c = 0; c < nc; ++c) {
     bool mine = P.cell_rank[c] == me;
@@ -196,6 +257,9 @@ static std::unique_ptr<Solver::Impl> local_model(const Solver::Impl& m, const So
   Q.bytes = P.bytes;
   Q.updates = P.updates;
   for (const auto n : P.own) Q.own.push_back(local(n));
+  for (std::size_t k = 0; k < L.pml.cell.size(); ++k) Q.pml_cells.push_back(static_cast<std::uint32_t>(k));
+  Q.pml_colour_start = L.pml.colour_start;
+  for (std::size_t k = 0; k < L.pml.node.size(); ++k) Q.pml_nodes.push_back(static_cast<std::uint32_t>(k));
   Q.node_rank.assign(nl, me);
   for (const auto& l : P.links) {
     Impl::Part::Link k;
@@ -216,7 +280,6 @@ bool Solver::localize() {
   Impl& m = *impl_;
   if (!m.part) throw FemError("FEM: localize() needs a model split over the ranks (distribute())");
   if (localized()) return true;
-  if (m.pml.active() || m.visc.active()) return false;
   std::unique_ptr<Impl> loc = local_model(m, *m.part, describe());
   if (m.part->rank == 0) keep_for_snapshots(std::move(impl_), *loc);
   impl_ = std::move(loc);  // the whole model goes (on rank 0 but for what the snapshots need)
@@ -333,6 +396,24 @@ std::string pack(const Solver::Impl& L, double dt, double t, long steps, const E
       }());
     }
   }
+  const Solver::Impl::Pml& Y = L.pml;
+  w.put("pml_sizes", std::vector<std::uint64_t>{static_cast<std::uint64_t>(Y.nb), static_cast<std::uint64_t>(Y.nq),
+                                                Y.whole_cells, Y.whole_nodes});
+  w.put("pml_scalars", std::vector<double>{Y.alpha, Y.dt_coef, Y.e_a, Y.ca_a, Y.cb_a});
+  for (const auto& [n, v] : {std::pair{"pml_grad", &Y.grad}, {"pml_kl", &Y.kl}, {"pml_km", &Y.km},
+                             {"pml_dx", &Y.dx}, {"pml_dy", &Y.dy}, {"pml_xi", &Y.xi}, {"pml_m_sum", &Y.m_sum},
+                             {"pml_m_prod", &Y.m_prod}, {"pml_zeta", &Y.zeta}, {"pml_packed", &Y.packed}})
+    w.put(n, *v);
+  for (const auto& [n, v] : {std::pair{"pml_colour_start", &Y.colour_start}, {"pml_cell", &Y.cell},
+                             {"pml_cell_nodes", &Y.cell_nodes}, {"pml_shape", &Y.shape}, {"pml_kind", &Y.kind},
+                             {"pml_node", &Y.node}, {"pml_touched", &Y.touched}, {"pml_glob_cell", &Y.glob_cell},
+                             {"pml_glob_node", &Y.glob_node}})
+    w.put(n, *v);
+  w.put("pml_own_cell", Y.own_cell);
+  const Solver::Impl::Viscous& V = L.visc;
+  for (const auto& [n, v] : {std::pair{"visc_node", &V.node}, {"visc_rows", &V.rows}, {"visc_row_node", &V.row_node}})
+    w.put(n, *v);
+  w.put("visc_root_beta", V.root_beta);
   w.put("described", static_cast<std::uint64_t>(L.described.size()));
   for (std::size_t k = 0; k < L.described.size(); ++k) w.put_string(key("line", k), L.described[k]);
   const Solver::Impl::Part& P = *L.part;
@@ -419,6 +500,38 @@ void unpack(const std::string& bytes, Solver::Impl& L, double& dt, double& t, lo
       q.dy.assign(v.begin() + 2 + 2 * n, v.end());
     }
   }
+  Solver::Impl::Pml& Y = L.pml;
+  std::vector<std::uint64_t> ps;
+  r.get("pml_sizes", ps, 4);
+  Y.nb = static_cast<int>(ps[0]);
+  Y.nq = static_cast<int>(ps[1]);
+  Y.whole_cells = ps[2];
+  Y.whole_nodes = ps[3];
+  std::vector<double> sc;
+  r.get("pml_scalars", sc, 5);
+  Y.alpha = sc[0];
+  Y.dt_coef = sc[1];
+  Y.e_a = sc[2];
+  Y.ca_a = sc[3];
+  Y.cb_a = sc[4];
+  for (const auto& [n, v] : {std::pair{"pml_grad", &Y.grad}, {"pml_kl", &Y.kl}, {"pml_km", &Y.km},
+                             {"pml_dx", &Y.dx}, {"pml_dy", &Y.dy}, {"pml_xi", &Y.xi}, {"pml_m_sum", &Y.m_sum},
+                             {"pml_m_prod", &Y.m_prod}, {"pml_zeta", &Y.zeta}, {"pml_packed", &Y.packed}})
+    r.get(n, *v);
+  for (const auto& [n, v] : {std::pair{"pml_colour_start", &Y.colour_start}, {"pml_cell", &Y.cell},
+                             {"pml_cell_nodes", &Y.cell_nodes}, {"pml_shape", &Y.shape}, {"pml_kind", &Y.kind},
+                             {"pml_node", &Y.node}, {"pml_touched", &Y.touched}, {"pml_glob_cell", &Y.glob_cell},
+                             {"pml_glob_node", &Y.glob_node}})
+    r.get(n, *v);
+  r.get("pml_own_cell", Y.own_cell);
+  Solver::Impl::Viscous& V = L.visc;
+  for (const auto& [n, v] : {std::pair{"visc_node", &V.node}, {"visc_rows", &V.rows}, {"visc_row_node", &V.row_node}})
+    r.get(n, *v);
+  r.get("visc_root_beta", V.root_beta);
+  if (V.active()) {
+    V.w.assign(L.u.size(), 0.0);
+    V.kw.assign(L.u.size(), 0.0);
+  }
   L.described.resize(r.get<std::uint64_t>("described"));
   for (std::size_t k = 0; k < L.described.size(); ++k) L.described[k] = r.get_string(key("line", k));
   auto part = std::make_unique<Solver::Impl::Part>();
@@ -435,6 +548,9 @@ void unpack(const std::string& bytes, Solver::Impl& L, double& dt, double& t, lo
   r.get("own", P.own);
   r.get("node_rank", P.node_rank);
   P.links.resize(r.get<std::uint64_t>("links"));
+  for (std::size_t k = 0; k < Y.cell.size(); ++k) P.pml_cells.push_back(static_cast<std::uint32_t>(k));
+  P.pml_colour_start = Y.colour_start;
+  for (std::size_t k = 0; k < Y.node.size(); ++k) P.pml_nodes.push_back(static_cast<std::uint32_t>(k));
   for (std::size_t k = 0; k < P.links.size(); ++k) {
     P.links[k].rank = r.get<std::int32_t>(key("link_rank", k));
     r.get(key("link_send", k), P.links[k].send);
@@ -472,8 +588,6 @@ void Solver::distribute_from_root() {
   std::string why;
   if (rank == 0) {
     try {
-      if (m.pml.active() || m.visc.active())
-        throw FemError("FEM: a far field with a PML or a stiffness-proportional band is built whole on every rank");
       if (m.n_cells < static_cast<std::size_t>(size))
         throw FemError("FEM: fewer cells (" + std::to_string(m.n_cells) + ") than MPI ranks (" +
                        std::to_string(size) + "): run it on fewer ranks or on a finer mesh");

@@ -10,9 +10,8 @@
 //   * the J2-softening film on 2 and 4 ranks within 1e-3 (its thresholds may flip);
 //   * a checkpoint of 2 ranks restarts on 1, 2 and 4;
 //   * what the ranks cannot share yet is refused before the run (exit 1, one line naming it);
-//   * the FE far field on 1-4 ranks: its fields to the bit, a checkpoint on 2 restarting on 1
-//     and 4; without PMLs and stiffness-proportional bands each rank holding only its part of
-//     the mesh, the same;
+//   * the FE far field on 1-4 ranks, built on rank 0 and each rank holding only its part: its
+//     fields to the bit, a checkpoint on 2 restarting on 1 and 4;
 //   * the MPM-FEM hybrid on 1-4 ranks (interfaces crossing the ranks' borders) as one process,
 //     a checkpoint on 2 restarting on 1 and 3;
 //   * a failure on one rank stops every rank (exit 2) and leaves RUN_INCOMPLETE saying why;
@@ -47,8 +46,6 @@ const std::string kCase = source_file("studies/pulse/cases/compressive_silent.js
 const std::string kShort = " --set time.end=4e-5 --set output.snapshots=0 -q";
 // The FE far field: a 40 x 40-cell square with every kind of FE boundary (fem_square.json).
 const std::string kFem = source_file("tests/mpi_cli/fem_square.json") + " -q";
-// The same square without the PMLs and the band's stiffness part: each rank keeps only its part.
-const std::string kFemLocal = source_file("tests/mpi_cli/fem_square_local.json") + " -q";
 
 std::string mpirun(int np) {
   return std::string("OMP_NUM_THREADS=1 ") + SMPM_MPIEXEC +
@@ -207,10 +204,9 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
       {kCase + kShort + " --ranks-across 3",
        "2 MPI ranks cannot form blocks 3 ranks across"},
       {kFem + " --set fem.size=0.04", "FEM: fewer cells (1) than MPI ranks (2)"},
-      // A far field set up from rank 0: its checks are rank 0's, and every rank's error.
-      {kFemLocal + " --set fem.size=0.04", "FEM: fewer cells (1) than MPI ranks (2)"},
-      {kFemLocal + " --set probes.1.at=[0.5,0.5]", "outside the FEM mesh"},
-      {kFemLocal + " --set 'time={\"end\": 2e-5, \"dt\": 1e-5}'", "above the FEM stability limit"},
+      // The far field is set up from rank 0: its checks are rank 0's, and every rank's error.
+      {kFem + " --set probes.1.at=[0.5,0.5]", "outside the FEM mesh"},
+      {kFem + " --set 'time={\"end\": 2e-5, \"dt\": 1e-5}'", "above the FEM stability limit"},
       {kFem + " --ranks-across 2", "--ranks-across 2 lays out the blocks of an MPM grid; an FE "
                                    "case's mesh is cut by METIS"}};
   int k = 0;
@@ -270,7 +266,9 @@ TEST(MpiCli, ParticleChecksOfRankZeroAreEveryRanksError) {
 // node's displacement and velocity, and the stresses from them, are those of one process to the
 // bit: fem.h5 equal dataset by dataset (bound 0), and fem.xdmf byte-identical. history.csv: on
 // 1 rank byte-identical; on more, sums over ranks (energies, a probe's cells on two ranks) are
-// added in another order: every column within 1e-13 of the largest of its kind.
+// added in another order: every column within 1e-13 of the largest of its kind. Rank 0 builds
+// the far field and sends each rank its part: the largest rank holds at most 3/4 of the mesh's
+// nodes on 2 ranks and 1/2 on 3 and 4 (measured below).
 TEST(MpiCli, FarFieldOnOneToFourRanksAsOneProcess) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   struct Run {
@@ -302,11 +300,16 @@ TEST(MpiCli, FarFieldOnOneToFourRanksAsOneProcess) {
     const nlohmann::json sb = summary(b);
     EXPECT_EQ(sb["mpi_ranks"], r.np);
     EXPECT_EQ(sb["dofs"], summary(a)["dofs"]);
+    const double nodes = sb["fem"]["nodes"].get<double>();
+    const double held = sb["mpi"]["held_nodes_most"].get<double>();
+    EXPECT_EQ(sb["fem"]["dashpot_nodes"], summary(a)["fem"]["dashpot_nodes"]);
     if (r.np > 1) {
       EXPECT_GT(sb["mpi"]["ghost_bytes_per_step"].get<double>(), 0);
+      EXPECT_LE(held, (r.np == 2 ? 0.75 : 0.5) * nodes) << r.np << " ranks";
     }
-    std::printf("FE far field, %s on %d rank(s): history within %.1e; fields: %s", q.c_str(),
-                r.np, worst, h.out.c_str());
+    std::printf("FE far field, %s on %d rank(s): history within %.1e; the largest rank holds "
+                "%.0f of %.0f nodes; fields: %s",
+                q.c_str(), r.np, worst, held, nodes, h.out.c_str());
   }
 }
 
@@ -427,46 +430,6 @@ TEST(MpiCli, HybridCheckpointOnTwoRanksRestartsOnAnyCount) {
 TEST(MpiCli, FarFieldCheckpointOnTwoRanksRestartsOnAnyCount) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   expect_checkpoint_restarts(kFem, "femck", 100, {0, 4}, 1e-13);
-}
-
-// The far field without PMLs and stiffness-proportional bands: each rank keeps only the nodes it
-// steps and receives (fem::Solver::localize). On 2, 3 (Q2) and 4 ranks fem.h5 equals the plain
-// run's dataset by dataset (bound 0) and fem.xdmf byte for byte; history.csv within 1e-13 of the
-// largest of a column's kind (sums over ranks); the largest rank holds at most 3/4 of the
-// mesh's nodes on 2 ranks and 1/2 on 3 and 4 (measured below). A checkpoint on 2 ranks restarts
-// on 1 process and on 4 ranks as the plain run ends (1e-13).
-TEST(MpiCli, FarFieldRanksHoldTheirPartOnly) {
-  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
-  struct Run {
-    int np;
-    std::string set;
-    double most;  // the largest rank's share of the mesh's nodes, at most
-  };
-  for (const Run& r : {Run{2, "", 0.75}, Run{4, "", 0.5}, Run{3, " --set fem.degree=2", 0.5}}) {
-    const std::string q = r.set.empty() ? "q1" : "q2";
-    const fs::path a = out_dir("femloc_plain_" + q), b = out_dir("femloc_np" + std::to_string(r.np));
-    ASSERT_EQ(run(0, kFemLocal + r.set + " --out " + a.string(), "femloc_plain").status, 0);
-    const Proc p = run(r.np, kFemLocal + r.set + " --out " + b.string(), "femloc_np");
-    ASSERT_EQ(p.status, 0) << p.err;
-    const Proc h = compare_h5(a / "fem.h5", b / "fem.h5", false, 0.0, "femloc_h5");
-    EXPECT_EQ(h.status, 0) << r.np << " ranks: " << h.out << h.err;
-    EXPECT_TRUE(case_testing::read_file(a / "fem.xdmf") == case_testing::read_file(b / "fem.xdmf"));
-    double worst = 0;
-    for (const auto& [c, d] : differences(b, a)) {
-      EXPECT_LE(d, 1e-13) << r.np << " ranks, column " << c;
-      worst = std::max(worst, d);
-    }
-    const nlohmann::json sb = summary(b);
-    const double nodes = sb["fem"]["nodes"].get<double>();
-    const double held = sb["mpi"]["held_nodes_most"].get<double>();
-    EXPECT_EQ(sb["dofs"], summary(a)["dofs"]);
-    EXPECT_EQ(sb["fem"]["dashpot_nodes"], summary(a)["fem"]["dashpot_nodes"]);
-    EXPECT_LE(held, r.most * nodes) << r.np << " ranks";
-    std::printf("FE far field, %s on %d ranks, each its part: history within %.1e; the largest "
-                "rank holds %.0f of %.0f nodes; fields: %s",
-                q.c_str(), r.np, worst, held, nodes, h.out.c_str());
-  }
-  expect_checkpoint_restarts(kFemLocal, "femlocck", 100, {0, 4}, 1e-13);
 }
 
 // Snapshots on 2 ranks, and on 4 as 2 x 2 blocks with deflated datasets: every rank writes its

@@ -271,17 +271,16 @@ class Solver {
   // dofs(), cells(), dashpot_count() and describe() still tell the whole mesh's; own_nodes(),
   // node_owner() and the per-node arrays (node_x(), displacement(), put_nodes ...) are local;
   // gathered() takes a local array and gives rank 0 the whole mesh's. Probes are added before.
-  // A model with a PML or a damping band's stiffness-proportional part keeps the whole mesh
-  // (their layer cells cross the ranks' borders as the whole model's): then it returns false,
-  // else true. Throws FemError when the model is not split.
+  // The PMLs keep the layer cells the rank steps and its own layer nodes, the damping bands'
+  // stiffness-proportional part the listed nodes it holds. Returns true; throws FemError when
+  // the model is not split.
   bool localize();
   bool localized() const;
   // The same parts, built on rank 0 alone: rank 0 holds the whole model (as built from the
   // spec, its probes added and dt set), the other ranks a Skeleton of the same spec; rank 0 cuts
   // it, builds each rank's local model (as localize() would) and sends it with the clock, and
   // keeps its own. So only rank 0 ever holds the whole model. Collective; throws FemError on
-  // every rank when the cut fails, and for a model with a PML or a stiffness-proportional band
-  // (those are built whole on every rank, distribute() and localize()).
+  // every rank when the cut fails.
   void distribute_from_root();
   bool is_skeleton() const;
   // The mesh number of each local node (every node on a model that holds the whole mesh).
