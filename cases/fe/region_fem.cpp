@@ -19,7 +19,8 @@ class FemRegion final : public Region {
   explicit FemRegion(Case& c) : c_(c), s_(*c.fem) {
     if (mpi() && c.scattered) {  // built on rank 0, which sends each rank its part
       s_.distribute_from_root();
-    } else if (mpi()) {  // one rank: the same part, kept from the whole model
+    } else if (mpi()) {  // not set up from rank 0 (one rank): the same part, kept from the whole
+                         // model each rank built
       s_.distribute();
       s_.localize();
     }

@@ -93,7 +93,7 @@ struct Solver::Impl {
     std::vector<double> root_beta;    // per listed node
     std::vector<std::uint32_t> rows;  // indices into node of the ones this rank steps
     std::vector<std::uint32_t> row_node;
-    std::vector<double> w, kw;        // 2 per mesh node (zero away from the listed nodes)
+    std::vector<double> w, kw;        // 2 per node held (zero away from the listed nodes)
     bool active() const { return !node.empty(); }
   };
   Viscous visc;
@@ -175,7 +175,9 @@ struct Solver::Impl {
 // (fem_setup.cpp).
 std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts);
 
-// Several processes (fem_parallel.cpp). A part METIS leaves empty is an error (FemError).
+// Several processes (fem_parallel.cpp). A model already split, or MPI not running, is an error
+// (FemError); so is a part METIS leaves empty.
+void check_can_split(const Solver::Impl& m);
 void check_parts(const std::vector<std::uint32_t>& cell_rank, int size, std::size_t nc);
 // Rank me's share of the whole model m under the cut P.cell_rank (P.size ranks): the nodes'
 // owners, its own nodes, its links to the others, its PML cells and nodes.

@@ -649,7 +649,9 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   put_nodes(w, pre + "ku", m.ku);
   w.put(pre + "ku_valid", static_cast<std::uint8_t>(m.ku_valid));
   w.put(pre + "snapshot_times", snapshot_times());
-  if (!m.pml.active()) return;
+  // A local model has layers when the whole model has, even if none is in this rank's part:
+  // every rank puts the same part blocks.
+  if (!(m.glob.empty() ? m.pml.active() : m.pml.whole_cells > 0)) return;
   if (!m.part) {
     w.put(pre + "pml_xi", m.pml.xi);
     w.put(pre + "pml_zeta", m.pml.zeta);
@@ -698,7 +700,7 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   if (m.pml.active() && m.glob.empty()) {
     get_items(r, pre + "pml_xi", pre + "pml_cells", m.pml.cell.size(), 4 * m.pml.nq, m.pml.xi);
     get_items(r, pre + "pml_zeta", pre + "pml_nodes", m.pml.node.size(), 4, m.pml.zeta);
-  } else if (m.pml.active()) {  // a local model: its cells' and nodes' memories
+  } else if (m.pml.whole_cells > 0) {  // a local model: its cells' and nodes' memories
     Impl::Pml& P = m.pml;
     const auto w = static_cast<std::size_t>(4 * P.nq);
     std::vector<double> xi, zeta;

@@ -38,11 +38,13 @@ std::size_t Solver::dashpot_count() const {
   return localized() ? impl_->mesh_dashpots : impl_->dash.size();
 }
 
-// Rank 0 of a local model keeps the whole mesh for the snapshots (nodes, cells, deal.II's mesh)
-// and frees the rest of the whole model.
+// Rank 0 of a local model keeps what it writes the snapshots with (the whole mesh's nodes, u and
+// v, cells and deal.II's mesh) and frees the rest of the whole model.
 static void keep_for_snapshots(std::unique_ptr<Solver::Impl> whole, Solver::Impl& L) {
   Solver::Impl& W = *whole;
   W.part.reset();
+  W.pml = Solver::Impl::Pml();
+  W.visc = Solver::Impl::Viscous();
   for (auto* v : {&W.mass, &W.inv_mass, &W.ku, &W.fext, &W.val, &W.dash_force}) release(*v);
   release(W.rowptr);
   release(W.col);
@@ -319,7 +321,8 @@ void gather_local(const Solver::Impl& m, const std::vector<const std::vector<dou
 namespace smpm::fem {
 
 namespace {
-constexpr int kPartTag = 7302;
+constexpr int kPartTag = 7305;
+constexpr std::uint64_t kFailed = ~std::uint64_t{0};  // a length that says rank 0 failed
 constexpr std::size_t kPiece = std::size_t{1} << 30;
 
 void send_bytes(const std::string& b, int to) {
@@ -330,9 +333,18 @@ void send_bytes(const std::string& b, int to) {
              MPI_COMM_WORLD);
 }
 
+// Rank 0 could not build a rank's part: the remaining ranks get its reason instead.
+void send_failure(const std::string& why, int to) {
+  std::uint64_t n = kFailed;
+  MPI_Send(&n, 1, MPI_UINT64_T, to, kPartTag, MPI_COMM_WORLD);
+  send_bytes(why, to);
+}
+
+// A message of send_bytes; rank 0's reason (FemError) when it sent send_failure.
 std::string recv_bytes(int from) {
   std::uint64_t n = 0;
   MPI_Recv(&n, 1, MPI_UINT64_T, from, kPartTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  if (n == kFailed) throw FemError(recv_bytes(from));
   std::string b(n, '\0');
   for (std::size_t o = 0; o < b.size(); o += kPiece)
     MPI_Recv(b.data() + o, static_cast<int>(std::min(kPiece, b.size() - o)), MPI_CHAR, from,
@@ -342,6 +354,54 @@ std::string recv_bytes(int from) {
 
 std::string key(const char* what, std::size_t k) { return std::string(what) + "." + std::to_string(k); }
 std::string key(const char* what, std::size_t k, std::size_t j) { return key(what, k) + "." + std::to_string(j); }
+
+// fn(name, array) for every array of a local model (pack writes them, unpack reads them).
+template <class Fn>
+void arrays(Solver::Impl& L, Fn&& fn) {
+  fn("x", L.x);
+  fn("y", L.y);
+  fn("mass", L.mass);
+  fn("inv_mass", L.inv_mass);
+  fn("u", L.u);
+  fn("v", L.v);
+  fn("ku", L.ku);
+  fn("fext", L.fext);
+  fn("val", L.val);
+  fn("dash_force", L.dash_force);
+  fn("mask", L.mask);
+  fn("dash_of_node", L.dash_of_node);
+  fn("rowptr", L.rowptr);
+  fn("col", L.col);
+  fn("row_val", L.row_val);
+  fn("dash", L.dash);
+  fn("cell_nodes", L.cell_nodes);
+  fn("glob", L.glob);
+  Solver::Impl::Pml& Y = L.pml;
+  fn("pml_grad", Y.grad);
+  fn("pml_kl", Y.kl);
+  fn("pml_km", Y.km);
+  fn("pml_dx", Y.dx);
+  fn("pml_dy", Y.dy);
+  fn("pml_xi", Y.xi);
+  fn("pml_m_sum", Y.m_sum);
+  fn("pml_m_prod", Y.m_prod);
+  fn("pml_zeta", Y.zeta);
+  fn("pml_packed", Y.packed);
+  fn("pml_colour_start", Y.colour_start);
+  fn("pml_cell", Y.cell);
+  fn("pml_cell_nodes", Y.cell_nodes);
+  fn("pml_shape", Y.shape);
+  fn("pml_kind", Y.kind);
+  fn("pml_node", Y.node);
+  fn("pml_touched", Y.touched);
+  fn("pml_glob_cell", Y.glob_cell);
+  fn("pml_glob_node", Y.glob_node);
+  fn("pml_own_cell", Y.own_cell);
+  fn("visc_node", L.visc.node);
+  fn("visc_rows", L.visc.rows);
+  fn("visc_row_node", L.visc.row_node);
+  fn("visc_root_beta", L.visc.root_beta);
+}
 
 // A local model's arrays (and the solver's clock), as a message. The spec is not in it: the
 // receiving rank read the same case.
@@ -356,18 +416,7 @@ std::string pack(const Solver::Impl& L, double dt, double t, long steps, const E
   w.put("crit_dt", L.crit_dt);
   w.put("ku_valid", static_cast<std::uint8_t>(L.ku_valid));
   w.put("snapshot_times", L.snapshot_times);
-  for (const auto& [n, v] : {std::pair{"x", &L.x}, {"y", &L.y}, {"mass", &L.mass}, {"inv_mass", &L.inv_mass},
-                             {"u", &L.u}, {"v", &L.v}, {"ku", &L.ku}, {"fext", &L.fext}, {"val", &L.val},
-                             {"dash_force", &L.dash_force}})
-    w.put(n, *v);
-  w.put("mask", L.mask);
-  w.put("dash_of_node", L.dash_of_node);
-  w.put("rowptr", L.rowptr);
-  w.put("col", L.col);
-  w.put("row_val", L.row_val);
-  w.put("dash", L.dash);
-  w.put("cell_nodes", L.cell_nodes);
-  w.put("glob", L.glob);
+  arrays(const_cast<Solver::Impl&>(L), [&](const char* name, const auto& v) { w.put(name, v); });
   w.put("loads", static_cast<std::uint64_t>(L.loads.size()));
   for (std::size_t k = 0; k < L.loads.size(); ++k) {
     w.put(key("load_nodes", k), L.loads[k].nodes);
@@ -400,20 +449,6 @@ std::string pack(const Solver::Impl& L, double dt, double t, long steps, const E
   w.put("pml_sizes", std::vector<std::uint64_t>{static_cast<std::uint64_t>(Y.nb), static_cast<std::uint64_t>(Y.nq),
                                                 Y.whole_cells, Y.whole_nodes});
   w.put("pml_scalars", std::vector<double>{Y.alpha, Y.dt_coef, Y.e_a, Y.ca_a, Y.cb_a});
-  for (const auto& [n, v] : {std::pair{"pml_grad", &Y.grad}, {"pml_kl", &Y.kl}, {"pml_km", &Y.km},
-                             {"pml_dx", &Y.dx}, {"pml_dy", &Y.dy}, {"pml_xi", &Y.xi}, {"pml_m_sum", &Y.m_sum},
-                             {"pml_m_prod", &Y.m_prod}, {"pml_zeta", &Y.zeta}, {"pml_packed", &Y.packed}})
-    w.put(n, *v);
-  for (const auto& [n, v] : {std::pair{"pml_colour_start", &Y.colour_start}, {"pml_cell", &Y.cell},
-                             {"pml_cell_nodes", &Y.cell_nodes}, {"pml_shape", &Y.shape}, {"pml_kind", &Y.kind},
-                             {"pml_node", &Y.node}, {"pml_touched", &Y.touched}, {"pml_glob_cell", &Y.glob_cell},
-                             {"pml_glob_node", &Y.glob_node}})
-    w.put(n, *v);
-  w.put("pml_own_cell", Y.own_cell);
-  const Solver::Impl::Viscous& V = L.visc;
-  for (const auto& [n, v] : {std::pair{"visc_node", &V.node}, {"visc_rows", &V.rows}, {"visc_row_node", &V.row_node}})
-    w.put(n, *v);
-  w.put("visc_root_beta", V.root_beta);
   w.put("described", static_cast<std::uint64_t>(L.described.size()));
   for (std::size_t k = 0; k < L.described.size(); ++k) w.put_string(key("line", k), L.described[k]);
   const Solver::Impl::Part& P = *L.part;
@@ -449,18 +484,7 @@ void unpack(const std::string& bytes, Solver::Impl& L, double& dt, double& t, lo
   L.ku_valid = r.get<std::uint8_t>("ku_valid") != 0;
   r.get("snapshot_times", L.snapshot_times);
   L.snapshots = static_cast<int>(L.snapshot_times.size());
-  for (const auto& [n, v] : {std::pair{"x", &L.x}, {"y", &L.y}, {"mass", &L.mass}, {"inv_mass", &L.inv_mass},
-                             {"u", &L.u}, {"v", &L.v}, {"ku", &L.ku}, {"fext", &L.fext}, {"val", &L.val},
-                             {"dash_force", &L.dash_force}})
-    r.get(n, *v);
-  r.get("mask", L.mask);
-  r.get("dash_of_node", L.dash_of_node);
-  r.get("rowptr", L.rowptr);
-  r.get("col", L.col);
-  r.get("row_val", L.row_val);
-  r.get("dash", L.dash);
-  r.get("cell_nodes", L.cell_nodes);
-  r.get("glob", L.glob);
+  arrays(L, [&](const char* name, auto& v) { r.get(name, v); });
   // One load per traction, in the order of the spec's boundaries (as the whole model has them).
   std::vector<const TimeFunction*> fns;
   for (const auto& b : L.spec.boundaries)
@@ -514,20 +538,7 @@ void unpack(const std::string& bytes, Solver::Impl& L, double& dt, double& t, lo
   Y.e_a = sc[2];
   Y.ca_a = sc[3];
   Y.cb_a = sc[4];
-  for (const auto& [n, v] : {std::pair{"pml_grad", &Y.grad}, {"pml_kl", &Y.kl}, {"pml_km", &Y.km},
-                             {"pml_dx", &Y.dx}, {"pml_dy", &Y.dy}, {"pml_xi", &Y.xi}, {"pml_m_sum", &Y.m_sum},
-                             {"pml_m_prod", &Y.m_prod}, {"pml_zeta", &Y.zeta}, {"pml_packed", &Y.packed}})
-    r.get(n, *v);
-  for (const auto& [n, v] : {std::pair{"pml_colour_start", &Y.colour_start}, {"pml_cell", &Y.cell},
-                             {"pml_cell_nodes", &Y.cell_nodes}, {"pml_shape", &Y.shape}, {"pml_kind", &Y.kind},
-                             {"pml_node", &Y.node}, {"pml_touched", &Y.touched}, {"pml_glob_cell", &Y.glob_cell},
-                             {"pml_glob_node", &Y.glob_node}})
-    r.get(n, *v);
-  r.get("pml_own_cell", Y.own_cell);
   Solver::Impl::Viscous& V = L.visc;
-  for (const auto& [n, v] : {std::pair{"visc_node", &V.node}, {"visc_rows", &V.rows}, {"visc_row_node", &V.row_node}})
-    r.get(n, *v);
-  r.get("visc_root_beta", V.root_beta);
   if (V.active()) {
     V.w.assign(L.u.size(), 0.0);
     V.kw.assign(L.u.size(), 0.0);
@@ -573,10 +584,7 @@ bool Solver::is_skeleton() const { return !impl_->part && impl_->glob.empty() &&
 
 void Solver::distribute_from_root() {
   Impl& m = *impl_;
-  if (m.part) throw FemError("FEM: the model is already split over the MPI ranks");
-  int running = 0;
-  MPI_Initialized(&running);
-  if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
+  check_can_split(m);
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
@@ -600,31 +608,47 @@ void Solver::distribute_from_root() {
   int ok = why.empty() ? 1 : 0;
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (!ok) throw FemError(rank == 0 ? why : "FEM: rank 0 could not cut the mesh");
+  // Each rank gets its part or rank 0's reason; then every rank says whether it has its part, so
+  // that a failure anywhere (rank 0 out of memory building a part, a message that does not
+  // unpack) stops all of them.
+  why.clear();
+  std::unique_ptr<Impl> loc;
   if (rank != 0) {
-    unpack(recv_bytes(0), m, dt, t, steps, energy);
-#if defined(__GLIBC__)
-    malloc_trim(0);  // the message's pages
-#endif
-    return;
+    try {
+      unpack(recv_bytes(0), m, dt, t, steps, energy);
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+  } else {
+    int r = 1;
+    try {
+      const std::vector<std::string> described = describe();
+      for (; r < size; ++r) {  // each other rank's part, built and sent one at a time
+        P.rank = r;
+        make_part(m, P, static_cast<std::uint32_t>(r));
+        P.work = P.absorbed = 0;
+        const std::unique_ptr<Impl> part = local_model(m, P, described);
+        send_bytes(pack(*part, dt, t, steps, energy), r);
+      }
+      P.rank = 0;
+      make_part(m, P, 0);
+      P.work = energy.external_work;  // the booked energies stay with rank 0
+      P.absorbed = energy.absorbed;
+      loc = local_model(m, P, described);
+    } catch (const std::exception& e) {
+      why = std::string("FEM: rank 0 could not build the ranks' parts: ") + e.what();
+      for (; r < size; ++r) send_failure(why, r);
+    }
   }
-  // Rank 0: each other rank's part, built and sent one at a time, then its own.
-  const std::vector<std::string> described = describe();
-  for (int r = 1; r < size; ++r) {
-    P.rank = r;
-    make_part(m, P, static_cast<std::uint32_t>(r));
-    P.work = P.absorbed = 0;
-    const std::unique_ptr<Impl> part = local_model(m, P, described);
-    send_bytes(pack(*part, dt, t, steps, energy), r);
+  int failed = why.empty() ? 0 : 1;
+  MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (failed) throw FemError(why.empty() ? "FEM: another rank could not take its part of the far field" : why);
+  if (rank == 0) {
+    keep_for_snapshots(std::move(impl_), *loc);
+    impl_ = std::move(loc);
   }
-  P.rank = 0;
-  make_part(m, P, 0);
-  P.work = energy.external_work;  // the booked energies stay with rank 0
-  P.absorbed = energy.absorbed;
-  std::unique_ptr<Impl> loc = local_model(m, P, described);
-  keep_for_snapshots(std::move(impl_), *loc);
-  impl_ = std::move(loc);
 #if defined(__GLIBC__)
-  malloc_trim(0);
+  malloc_trim(0);  // the whole model's pages (rank 0), the message's (the others)
 #endif
 }
 

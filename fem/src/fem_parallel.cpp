@@ -17,6 +17,13 @@ namespace {
 constexpr int kGhostTag = 7301;
 }  // namespace
 
+void check_can_split(const Solver::Impl& m) {
+  if (m.part) throw FemError("FEM: the model is already split over the MPI ranks");
+  int running = 0;
+  MPI_Initialized(&running);
+  if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
+}
+
 void check_parts(const std::vector<std::uint32_t>& cell_rank, int size, std::size_t nc) {
   const auto ranks = static_cast<std::size_t>(size);
   std::vector<std::size_t> cells_of(ranks, 0);
@@ -93,10 +100,7 @@ void make_part(const Solver::Impl& m, Solver::Impl::Part& P, std::uint32_t me) {
 
 void Solver::distribute() {
   Impl& m = *impl_;
-  if (m.part) throw FemError("FEM: the model is already split over the MPI ranks");
-  int running = 0;
-  MPI_Initialized(&running);
-  if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
+  check_can_split(m);
   auto part = std::make_unique<Impl::Part>();
   Impl::Part& P = *part;
   MPI_Comm_rank(MPI_COMM_WORLD, &P.rank);

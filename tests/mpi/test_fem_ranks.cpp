@@ -17,7 +17,8 @@
 //   * Each rank keeping only what it steps (fem::Solver::localize), against the same model split
 //     whole, the square with every boundary and one without its PMLs and stiffness-proportional
 //     band, Q1 and Q2, 300 steps: the probes, the energies and u, v gathered on rank 0 bit for
-//     bit (bound 0); the largest rank holds at most 3/4 of the nodes on 2 ranks, 1/2 on 4;
+//     bit (bound 0), and the checkpoint the ranks write at once the same file byte for byte; the
+//     largest rank holds at most 3/4 of the nodes on 2 ranks, 1/2 on 4;
 //     localize() before distribute() and a probe added after it are refused.
 //   * The oblique study's measurement, P at 30 degrees on a 10-cell PML and on LK: the
 //     reflection coefficients as on one process (1e-12 relative), on 2 ranks.
@@ -279,6 +280,23 @@ TEST(FemRanks, LocalModelStepsAsTheWholeSplit) {
                   "%.3e, work %.3e\n", degree, layers ? " with PMLs and a beta band" : "",
                   world_size(), held, nodes, part.energy.absorbed, part.energy.external_work);
     }
+    // Their checkpoints, written by the ranks at once, are the same file byte for byte (every
+    // rank puts the same blocks, a rank whose part has no layer cell too).
+    namespace fs = std::filesystem;
+    const fs::path dir = mpi_testing::scratch_folder("fem_ranks", "local_checkpoint");
+    std::string bytes[2];
+    for (int k = 0; k < 2; ++k) {
+      StateWriter w;
+      (k == 0 ? whole : part).save_state(w, "fem.");
+      const fs::path file = dir / ("state" + std::to_string(k) + ".smpm");
+      write_state_collectively(w, file.string(), MPI_COMM_WORLD);
+      std::ifstream in(file, std::ios::binary);
+      std::stringstream s;
+      s << in.rdbuf();
+      bytes[k] = s.str();
+    }
+    EXPECT_FALSE(bytes[0].empty());
+    EXPECT_TRUE(bytes[0] == bytes[1]) << "Q" << degree << (layers ? " with layers" : "");
     if (world_size() == 2) {
       EXPECT_LE(held, 0.75 * static_cast<double>(nodes));
     }

@@ -211,7 +211,9 @@ class Solver {
   const std::vector<double>& node_x() const;
   const std::vector<double>& node_y() const;
   const std::vector<double>& mass() const;          // lumped nodal mass (per component)
-  std::vector<double>& displacement();               // 2 per node, interleaved
+  // 2 per node, interleaved. step() writes u^{n+1} into a second buffer and swaps the two: take
+  // data() anew after a step.
+  std::vector<double>& displacement();
   std::vector<double>& velocity();                   // 2 per node, v^{n+1/2}
   // f = -K u (2 per node; after distribute(), this rank's own rows only). u and f must not alias.
   void internal_force(const double* u, double* f) const;
@@ -219,6 +221,7 @@ class Solver {
     std::uint32_t node;
     double cxx, cxy, cyy;
   };
+  // (A local model: the blocks of its own and received nodes.)
   const std::vector<DashpotBlock>& dashpots() const;
   // The mesh's nodes with a dashpot block (dashpots() holds a local model's own ones).
   std::size_t dashpot_count() const;
@@ -263,7 +266,8 @@ class Solver {
   // a split model too: internal_force fills the own rows, advance_free_nodes advances the own
   // nodes and then receives the neighbours' (collective).
   void distribute();
-  // After distribute(): keeps only what this rank steps (collective). Its arrays then hold its
+  // After distribute(): keeps only what this rank steps (each rank its part of the cut that
+  // distribute() shared; nothing is sent). Its arrays then hold its
   // own nodes and those it receives, numbered in the mesh's order (global_nodes() gives each
   // local node's mesh number), K only its own rows, cell_nodes() its cells; ranks other than 0
   // free deal.II's mesh, rank 0 keeps the mesh for the snapshots it writes. The step, probes,
