@@ -24,6 +24,11 @@ struct Solver::Impl {
   int threads = 1;
   std::size_t n_cells = 0;
   std::vector<std::uint32_t> cell_nodes;  // nodes of each cell, (degree+1)^2 per cell (coupling)
+  std::vector<std::int32_t> cell_region;  // each cell's physical surface (material) tag
+  // The snapshots' nodal gradients without deal.II: at each of a cell's nodes a (its support
+  // point in the reference cell), the reference gradients of the cell's shape functions b
+  // (ref_grad[2 (a nb + b) + j]) and of the bilinear map's vertex functions v (map_grad[2 (4 a + v) + j]).
+  std::vector<double> ref_grad, map_grad;
   std::array<double, 4> box{{0, 0, 0, 0}};
 
   // Per node.
@@ -170,6 +175,10 @@ struct Solver::Impl {
   int snapshots = 0;
   std::vector<double> snapshot_times;  // every snapshot's time (a restart's earlier ones too)
 };
+
+// Frees deal.II's mesh, dofs and element (the snapshots' writer stays): what a model needs no
+// more once it is split (fem_setup.cpp).
+void release_mesh(Solver::Impl& m);
 
 // The cells' parts for `parts` ranks (METIS through deal.II), in the mesh's cell order
 // (fem_setup.cpp).

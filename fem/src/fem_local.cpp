@@ -39,9 +39,11 @@ std::size_t Solver::dashpot_count() const {
 }
 
 // Rank 0 of a local model keeps what it writes the snapshots with (the whole mesh's nodes, u and
-// v, cells and deal.II's mesh) and frees the rest of the whole model.
+// v, cells and their regions, the writer) and frees the rest of the whole model, deal.II's mesh
+// with it.
 static void keep_for_snapshots(std::unique_ptr<Solver::Impl> whole, Solver::Impl& L) {
   Solver::Impl& W = *whole;
+  release_mesh(W);
   W.part.reset();
   W.pml = Solver::Impl::Pml();
   W.visc = Solver::Impl::Viscous();

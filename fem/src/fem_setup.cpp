@@ -42,10 +42,10 @@ using namespace dealii;
 struct Deal {
   Triangulation<2> tria;
   std::unique_ptr<FESystem<2>> fe;
-  DoFHandler<2> dofh;
+  std::unique_ptr<DoFHandler<2>> dofh;  // a pointer, so that release_mesh can free it before tria
   MappingQ<2> mapping{1};
   MeshSnapshotWriter snap;  // DIR/BASE.h5 + BASE.xdmf (Solver::write_snapshot)
-  Deal() : dofh(tria) {}
+  Deal() : dofh(std::make_unique<DoFHandler<2>>(tria)) {}
 };
 
 Solver::Impl::Impl() = default;
@@ -203,7 +203,7 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
   std::vector<Cell> cells;
   std::map<std::vector<long long>, std::uint32_t> shapes;
   std::set<std::uint32_t> touched;
-  for (const auto& cell : d.dofh.active_cell_iterators()) {
+  for (const auto& cell : d.dofh->active_cell_iterators()) {
     fv.reinit(cell);
     Cell c;
     c.index = static_cast<std::uint32_t>(cell->active_cell_index());
@@ -394,15 +394,15 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
   // --- dofs: Cuthill-McKee, then interleaved by node (dof = 2 node + component) ---
   d.fe = std::make_unique<FESystem<2>>(FE_Q<2>(m.degree), 2);
   const FESystem<2>& fe = *d.fe;
-  d.dofh.distribute_dofs(fe);
-  DoFRenumbering::Cuthill_McKee(d.dofh);
+  d.dofh->distribute_dofs(fe);
+  DoFRenumbering::Cuthill_McKee(*d.dofh);
   const unsigned dpc = fe.n_dofs_per_cell();
   const unsigned nbase = dpc / 2;
-  const std::size_t ndofs = d.dofh.n_dofs();
+  const std::size_t ndofs = d.dofh->n_dofs();
   {
     std::vector<types::global_dof_index> partner(ndofs, numbers::invalid_dof_index);
     std::vector<types::global_dof_index> ld(dpc);
-    for (const auto& cell : d.dofh.active_cell_iterators()) {
+    for (const auto& cell : d.dofh->active_cell_iterators()) {
       cell->get_dof_indices(ld);
       for (unsigned b = 0; b < nbase; ++b)
         partner[ld[fe.component_to_system_index(0, b)]] = ld[fe.component_to_system_index(1, b)];
@@ -416,12 +416,27 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
         ++k;
       }
     if (2 * k != ndofs) throw FemError(file + ": internal error numbering the nodes");
-    d.dofh.renumber_dofs(renum);
+    d.dofh->renumber_dofs(renum);
   }
   const std::size_t nn = ndofs / 2;
+  {  // the reference tables of the snapshots' gradients (Impl::ref_grad, map_grad)
+    const FiniteElement<2>& fe0 = fe.base_element(0);
+    const FE_Q<2> q1(1);
+    const auto& at = fe0.get_unit_support_points();
+    for (const auto& p : at) {
+      for (unsigned b = 0; b < fe0.n_dofs_per_cell(); ++b) {
+        const Tensor<1, 2> g = fe0.shape_grad(b, p);
+        m.ref_grad.insert(m.ref_grad.end(), {g[0], g[1]});
+      }
+      for (unsigned v = 0; v < 4; ++v) {
+        const Tensor<1, 2> g = q1.shape_grad(v, p);
+        m.map_grad.insert(m.map_grad.end(), {g[0], g[1]});
+      }
+    }
+  }
   {
     std::vector<Point<2>> pts(ndofs);
-    DoFTools::map_dofs_to_support_points(d.mapping, d.dofh, pts);
+    DoFTools::map_dofs_to_support_points(d.mapping, *d.dofh, pts);
     m.x.resize(nn);
     m.y.resize(nn);
     for (std::size_t i = 0; i < nn; ++i) {
@@ -435,11 +450,12 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
   {
     std::vector<std::vector<std::uint32_t>> adj(nn);
     std::vector<std::uint32_t> cn(nbase);
-    for (const auto& cell : d.dofh.active_cell_iterators()) {
+    for (const auto& cell : d.dofh->active_cell_iterators()) {
       cell->get_dof_indices(ld);
       for (unsigned b = 0; b < nbase; ++b)
         cn[b] = static_cast<std::uint32_t>(ld[fe.component_to_system_index(0, b)] / 2);
       m.cell_nodes.insert(m.cell_nodes.end(), cn.begin(), cn.end());
+      m.cell_region.push_back(static_cast<std::int32_t>(cell->material_id()));
       for (unsigned a = 0; a < nbase; ++a)
         for (unsigned b = 0; b < nbase; ++b) adj[cn[a]].push_back(cn[b]);
     }
@@ -471,7 +487,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
     };
     std::map<std::vector<long long>, Elem> cache;
     double lam_max = 0;
-    for (const auto& cell : d.dofh.active_cell_iterators()) {
+    for (const auto& cell : d.dofh->active_cell_iterators()) {
       const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
       auto key = cell_key(cell);
       auto it = cache.find(key);
@@ -529,7 +545,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
   {
     const unsigned dpf = fe.n_dofs_per_face();
     std::vector<types::global_dof_index> fd(dpf);
-    for (const auto& cell : d.dofh.active_cell_iterators())
+    for (const auto& cell : d.dofh->active_cell_iterators())
       for (const auto f : cell->face_indices())
         if (cell->face(f)->at_boundary()) {
           const int id = static_cast<int>(cell->face(f)->boundary_id());
@@ -581,7 +597,7 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
     std::vector<std::vector<std::array<double, 4>>> dseg(spec.boundaries.size());
     std::vector<double> dcd(spec.boundaries.size(), 0.0);
     std::vector<std::vector<PmlFace>> pml_faces(spec.boundaries.size());
-    for (const auto& cell : d.dofh.active_cell_iterators()) {
+    for (const auto& cell : d.dofh->active_cell_iterators()) {
       const Material& mat = spec.materials[spec.region_material.at(static_cast<int>(cell->material_id()))];
       for (const auto f : cell->face_indices()) {
         if (!cell->face(f)->at_boundary()) continue;
@@ -752,6 +768,13 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
 
 Solver::~Solver() = default;
 
+void release_mesh(Solver::Impl& m) {
+  if (!m.deal) return;
+  m.deal->dofh.reset();  // it subscribes to tria, which clears only without subscribers
+  m.deal->fe.reset();
+  m.deal->tria.clear();
+}
+
 std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts) {
   Triangulation<2>& tria = m.deal->tria;
   try {
@@ -781,11 +804,11 @@ int Solver::add_probe(double x, double y) {
   try {
     // Tolerance in reference coordinates: a point on an edge or a node belongs to every cell
     // that shares it.
-    found = GridTools::find_all_active_cells_around_point(d.mapping, d.dofh, p, 1e-9);
+    found = GridTools::find_all_active_cells_around_point(d.mapping, *d.dofh, p, 1e-9);
   } catch (...) {
     return -1;
   }
-  if (found.empty() || found.front().first == d.dofh.end()) return -1;
+  if (found.empty() || found.front().first == d.dofh->end()) return -1;
   const unsigned dpc = d.fe->n_dofs_per_cell();
   std::vector<types::global_dof_index> ld(dpc);
   Impl::Probe pr;
@@ -821,7 +844,7 @@ int Solver::add_probe(double x, double y) {
 // Snapshots (MeshSnapshotWriter): the mesh once, a Q1 cell as it is and a Q2 cell as the four
 // quadrilaterals of its nine nodes (counter-clockwise; the base element's nodes: vertices
 // (0,0) (1,0) (0,1) (1,1), then the lines x = 0, x = 1, y = 0, y = 1, then the centre).
-static void snapshot_mesh(const Solver::Impl& m, const Deal& d, std::vector<double>& xyz,
+static void snapshot_mesh(const Solver::Impl& m, std::vector<double>& xyz,
                           std::vector<std::int64_t>& cells, std::vector<std::int32_t>& material) {
   const std::size_t nn = m.x.size();
   xyz.assign(3 * nn, 0.0);
@@ -835,14 +858,12 @@ static void snapshot_mesh(const Solver::Impl& m, const Deal& d, std::vector<doub
   const int(*sub)[4] = m.degree == 1 ? q1 : q2;
   cells.clear();
   material.clear();
-  std::size_t c = 0;
-  for (const auto& cell : d.tria.active_cell_iterators()) {
+  for (std::size_t c = 0; c < m.n_cells; ++c) {
     const std::uint32_t* cn = m.cell_nodes.data() + c * nb;
     for (int s = 0; s < parts; ++s) {
       for (int a = 0; a < 4; ++a) cells.push_back(cn[sub[s][a]]);
-      material.push_back(static_cast<std::int32_t>(cell->material_id()));
+      material.push_back(m.cell_region[c]);
     }
-    ++c;
   }
 }
 
@@ -855,34 +876,48 @@ static void write_fields(Solver::Impl& m, const std::string& dir, const std::str
       std::vector<double> xyz;
       std::vector<std::int64_t> cells;
       std::vector<std::int32_t> material;
-      snapshot_mesh(m, d, xyz, cells, material);
+      snapshot_mesh(m, xyz, cells, material);
       d.snap.open(dir, base, xyz, cells, material);
     }
     // Displacement and velocity as 3-vectors; the stress and J2 at the nodes, each node's the
-    // mean of what its cells give there (their displacement gradients at the node).
+    // mean of what its cells give there (their displacement gradients at the node, through the
+    // cell's bilinear map: Impl::ref_grad and map_grad, no deal.II object).
     std::vector<double> disp(3 * nn, 0.0), vel(3 * nn, 0.0), sig(9 * nn, 0.0), j2(nn, 0.0);
     for (std::size_t i = 0; i < nn; ++i)
       for (int k = 0; k < 2; ++k) {
         disp[3 * i + k] = m.u[2 * i + k];
         vel[3 * i + k] = m.v[2 * i + k];
       }
-    const FiniteElement<2>& fe0 = d.fe->base_element(0);
-    const Quadrature<2> at_nodes(fe0.get_unit_support_points());
-    FEValues<2> fv(d.mapping, *d.fe, at_nodes, update_gradients);
-    const Vector<double> u(m.u.begin(), m.u.end());
-    const unsigned nb = fe0.n_dofs_per_cell();
-    std::vector<std::vector<Tensor<1, 2>>> grad(nb, std::vector<Tensor<1, 2>>(2));
+    const std::size_t nb = static_cast<std::size_t>((m.degree + 1) * (m.degree + 1));
     std::vector<double> acc(4 * nn, 0.0);
     std::vector<std::uint32_t> count(nn, 0);
-    std::size_t c = 0;
-    for (const auto& cell : d.dofh.active_cell_iterators()) {
-      fv.reinit(cell);
-      fv.get_function_gradients(u, grad);
-      const Material& mat = m.spec.materials[m.spec.region_material.at(
-          static_cast<int>(cell->material_id()))];
-      for (unsigned b = 0; b < nb; ++b) {
-        const std::uint32_t i = m.cell_nodes[c * nb + b];
-        const double exx = grad[b][0][0], eyy = grad[b][1][1], gxy = grad[b][0][1] + grad[b][1][0];
+    for (std::size_t c = 0; c < m.n_cells; ++c) {
+      const std::uint32_t* cn = m.cell_nodes.data() + c * nb;
+      const Material& mat = m.spec.materials[m.spec.region_material.at(m.cell_region[c])];
+      for (std::size_t a = 0; a < nb; ++a) {
+        // J = dx/dxi at node a, from the cell's four vertices (its first four nodes).
+        double J[2][2] = {{0, 0}, {0, 0}};
+        for (std::size_t v = 0; v < 4; ++v) {
+          const double* h = m.map_grad.data() + 2 * (4 * a + v);
+          for (int j = 0; j < 2; ++j) {
+            J[0][j] += m.x[cn[v]] * h[j];
+            J[1][j] += m.y[cn[v]] * h[j];
+          }
+        }
+        const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+        const double inv[2][2] = {{J[1][1] / det, -J[0][1] / det}, {-J[1][0] / det, J[0][0] / det}};
+        double g[2][2] = {{0, 0}, {0, 0}};  // du_k/dx_i
+        for (std::size_t b = 0; b < nb; ++b) {
+          const double* r = m.ref_grad.data() + 2 * (a * nb + b);
+          const double dx = inv[0][0] * r[0] + inv[1][0] * r[1];
+          const double dy = inv[0][1] * r[0] + inv[1][1] * r[1];
+          for (int k = 0; k < 2; ++k) {
+            g[k][0] += m.u[2 * cn[b] + k] * dx;
+            g[k][1] += m.u[2 * cn[b] + k] * dy;
+          }
+        }
+        const std::uint32_t i = cn[a];
+        const double exx = g[0][0], eyy = g[1][1], gxy = g[0][1] + g[1][0];
         const double tr = exx + eyy;
         acc[4 * i] += mat.lambda * tr + 2 * mat.mu * exx;
         acc[4 * i + 1] += mat.lambda * tr + 2 * mat.mu * eyy;
@@ -890,7 +925,6 @@ static void write_fields(Solver::Impl& m, const std::string& dir, const std::str
         acc[4 * i + 3] += mat.mu * gxy;
         ++count[i];
       }
-      ++c;
     }
     for (std::size_t i = 0; i < nn; ++i) {
       if (count[i] == 0) continue;
