@@ -2,7 +2,10 @@
 // probe fields (div and curl included), summary.json with dofs and the energy terms, and the
 // HDF5 + XDMF snapshots. The physics asserted: a step load on a roller column reaches the
 // uniaxial-strain plateau sigma_xx = -sigma0, sigma_yy = nu/(1-nu) sigma_xx, div u = -sigma0/M,
-// v_x = sigma0/(rho c_d); the energy balance closes.
+// v_x = sigma0/(rho c_d); the energy balance closes. The snapshots' nodal stresses (computed
+// through each cell's bilinear map, without deal.II) of a uniform strain on an unstructured mesh
+// of skewed quadrilaterals are its closed-form stress at every node, Q1 and Q2 (1e-10 of its
+// size; a transposed Jacobian is off by O(1) there).
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
@@ -128,6 +131,50 @@ TEST(FemCase, RunsThroughTheDriver) {
   }
   EXPECT_GE(plateau, 30);
   fs::remove_all(out);
+}
+
+TEST(FemCase, SnapshotStressOfAUniformStrainOnAnUnstructuredMesh) {
+  for (const int degree : {1, 2}) {
+    fem::Spec s;
+    s.mesh = fem::load_mesh(std::string(SMPM_SOURCE_DIR) + "/meshes/hybrid_film_substrate_unstructured.geo", 0);
+    s.degree = degree;
+    s.materials = {elastic("steel", 2e11, 0.25, 7800)};
+    for (const auto& g : s.mesh.surfaces) s.region_material[g.tag] = 0;
+    s.threads = 1;
+    fem::Solver f(s);
+    const double exx = 1e-3, eyy = -4e-4, exy = 7e-4;  // u = E x (symmetric E: no rotation)
+    for (std::size_t i = 0; i < f.nodes(); ++i) {
+      const double x = f.node_x()[i], y = f.node_y()[i];
+      f.displacement()[2 * i] = exx * x + exy * y;
+      f.displacement()[2 * i + 1] = exy * x + eyy * y;
+    }
+    const Material& m = s.materials[0];
+    const double tr = exx + eyy;
+    const double want[4] = {m.lambda * tr + 2 * m.mu * exx, m.lambda * tr + 2 * m.mu * eyy,
+                            m.lambda * tr, 2 * m.mu * exy};  // xx, yy, zz, xy
+    const fs::path dir = temp_dir() / ("uniform_strain_q" + std::to_string(degree));
+    fs::create_directories(dir);
+    f.write_snapshot(dir.string(), "fem");
+    f.close_snapshots();
+    const hid_t h = H5Fopen((dir / "fem.h5").string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(h, 0);
+    std::vector<double> sig(9 * f.nodes());
+    const hid_t ds = H5Dopen2(h, "/snapshot_00000/stress", H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    EXPECT_GE(H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, sig.data()), 0);
+    H5Dclose(ds);
+    H5Fclose(h);
+    double worst = 0;
+    const double scale = std::fabs(want[0]);
+    for (std::size_t i = 0; i < f.nodes(); ++i) {
+      const double* S = sig.data() + 9 * i;
+      for (const auto& [got, w] : {std::pair{S[0], want[0]}, {S[4], want[1]}, {S[8], want[2]}, {S[1], want[3]}})
+        worst = std::max(worst, std::fabs(got - w));
+    }
+    std::printf("  Q%d, %zu nodes: largest stress error %.3e of %.3e\n", degree, f.nodes(), worst, scale);
+    EXPECT_LE(worst, 1e-10 * scale);
+    fs::remove_all(dir);
+  }
 }
 
 // The progress line's rate counts the steps alone: with a snapshot every 2 steps, most of the run
