@@ -325,6 +325,7 @@ namespace smpm::fem {
 namespace {
 constexpr int kPartTag = 7305;
 constexpr std::uint64_t kFailed = ~std::uint64_t{0};  // a length that says rank 0 failed
+int g_part_fault = 0;  // Solver::set_part_fault
 constexpr std::size_t kPiece = std::size_t{1} << 30;
 
 void send_bytes(const std::string& b, int to) {
@@ -582,6 +583,8 @@ Solver::Solver(const Spec& spec, Skeleton) : impl_(std::make_unique<Impl>()) {
   m.threads = spec.threads > 0 ? spec.threads : omp_get_max_threads();
 }
 
+void Solver::set_part_fault(int rank) { g_part_fault = rank; }
+
 bool Solver::is_skeleton() const { return !impl_->part && impl_->glob.empty() && impl_->x.empty(); }
 
 void Solver::distribute_from_root() {
@@ -618,6 +621,7 @@ void Solver::distribute_from_root() {
   if (rank != 0) {
     try {
       unpack(recv_bytes(0), m, dt, t, steps, energy);
+      if (g_part_fault == -rank - 1) throw FemError("FEM: a fault set by a test (unpacking)");
     } catch (const std::exception& e) {
       why = e.what();
     }
@@ -627,6 +631,7 @@ void Solver::distribute_from_root() {
       const std::vector<std::string> described = describe();
       for (; r < size; ++r) {  // each other rank's part, built and sent one at a time
         P.rank = r;
+        if (g_part_fault == r) throw FemError("a fault set by a test");
         make_part(m, P, static_cast<std::uint32_t>(r));
         P.work = P.absorbed = 0;
         const std::unique_ptr<Impl> part = local_model(m, P, described);

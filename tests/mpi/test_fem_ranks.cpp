@@ -20,6 +20,10 @@
 //     bit (bound 0), and the checkpoint the ranks write at once the same file byte for byte; the
 //     largest rank holds at most 3/4 of the nodes on 2 ranks, 1/2 on 4;
 //     localize() before distribute() and a probe added after it are refused.
+//   * The far field set up from rank 0 (distribute_from_root, the other ranks skeletons): a
+//     failure while rank 0 builds the last rank's part, or while the last rank unpacks it,
+//     stops every rank with an error (none hangs), rank 0's reason on rank 0; a set-up without
+//     fault then steps as the whole split model (energies bit for bit).
 //   * The oblique study's measurement, P at 30 degrees on a 10-cell PML and on LK: the
 //     reflection coefficients as on one process (1e-12 relative), on 2 ranks.
 #include <gtest/gtest.h>
@@ -305,6 +309,52 @@ TEST(FemRanks, LocalModelStepsAsTheWholeSplit) {
     }
     EXPECT_GT(part.energy.absorbed, 0.0);
   }
+}
+
+TEST(FemRanks, PartsFromRankZeroFailOnEveryRankOrStepAsTheWhole) {
+  const int P = world_size(), last = P - 1;
+  if (P < 2) GTEST_SKIP() << "one rank: no part is sent";
+  auto build = [&] {
+    return root() ? std::make_unique<fem::Solver>(square(1, true))
+                  : std::make_unique<fem::Solver>(square(1, true), fem::Solver::Skeleton{});
+  };
+  for (const int fault : {last, -last - 1}) {
+    auto s = build();
+    if (root()) s->set_dt(0.5 * s->critical_dt());
+    fem::Solver::set_part_fault(fault);
+    std::string why;
+    try {
+      s->distribute_from_root();
+    } catch (const fem::FemError& e) {
+      why = e.what();
+    }
+    fem::Solver::set_part_fault(0);
+    EXPECT_FALSE(why.empty()) << "rank " << mpi_testing::world_rank() << ", fault " << fault;
+    const bool at = fault > 0 ? root() : mpi_testing::world_rank() == last;
+    if (at) {
+      EXPECT_NE(why.find("a fault set by a test"), std::string::npos) << why;
+    }
+    if (root()) std::printf("  fault %d: rank 0 says \"%s\"\n", fault, why.c_str());
+  }
+  // Without a fault: the parts step as the whole model split on every rank.
+  auto s = build();
+  fem::Solver whole(square(1, true));
+  whole.set_dt(0.5 * whole.critical_dt());
+  if (root()) s->set_dt(whole.dt);
+  s->distribute_from_root();
+  whole.distribute();
+  EXPECT_EQ(s->dt, whole.dt);
+  EXPECT_EQ(s->nodes(), whole.nodes());
+  for (int n = 0; n < 100; ++n) {
+    s->step();
+    whole.step();
+  }
+  s->update_energies();
+  whole.update_energies();
+  EXPECT_EQ(s->energy.kinetic, whole.energy.kinetic);
+  EXPECT_EQ(s->energy.elastic, whole.energy.elastic);
+  EXPECT_EQ(s->energy.absorbed, whole.energy.absorbed);
+  EXPECT_GT(whole.energy.kinetic, 0.0);
 }
 
 TEST(FemRanks, CheckpointFromTheRanksRestartsOneProcess) {

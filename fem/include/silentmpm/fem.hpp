@@ -301,6 +301,9 @@ class Solver {
   // many values (default 2^30; an MPI count is an int), so the whole has no count limit. A
   // test sets it small.
   static void set_gather_piece(std::size_t n);
+  // A test's fault: distribute_from_root() fails on rank 0 while it builds rank `rank`'s part
+  // (rank >= 1), or on rank r while it unpacks its own (rank = -r - 1); 0 clears it.
+  static void set_part_fault(int rank);
   // The ghost updates so far over all ranks (every rank calls it): the slowest rank's seconds,
   // the bytes all ranks sent, and the largest rank's counts; held_nodes: the nodes whose arrays
   // a rank holds (the whole mesh's, or after localize() its own and received ones).
