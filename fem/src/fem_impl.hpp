@@ -167,8 +167,9 @@ struct Solver::Impl {
   std::vector<std::uint32_t> glob;
   std::size_t mesh_nodes = 0, mesh_dashpots = 0;  // the whole mesh's counts (a local model)
   std::vector<std::string> described;             // describe() of the whole model (a local model)
-  // Rank 0 of a local model: the whole mesh as it was built (nodes, cells, deal.II's mesh), which
-  // the snapshots are written on; its other arrays are released.
+  // Rank 0 of a local model: the whole mesh's nodes, u, v, cells and their regions and the
+  // snapshots' writer, which the snapshots are written with; the rest of the whole model,
+  // deal.II's mesh included, is released.
   std::unique_ptr<Impl> whole;
 
   std::unique_ptr<Deal> deal;

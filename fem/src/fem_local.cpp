@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <new>
 #include <string>
 
 #include "fem_impl.hpp"
@@ -328,30 +329,63 @@ constexpr std::uint64_t kFailed = ~std::uint64_t{0};  // a length that says rank
 int g_part_fault = 0;  // Solver::set_part_fault
 constexpr std::size_t kPiece = std::size_t{1} << 30;
 
-void send_bytes(const std::string& b, int to) {
-  std::uint64_t n = b.size();
-  MPI_Send(&n, 1, MPI_UINT64_T, to, kPartTag, MPI_COMM_WORLD);
+void send_pieces(const std::string& b, int to) {
   for (std::size_t o = 0; o < b.size(); o += kPiece)
     MPI_Send(b.data() + o, static_cast<int>(std::min(kPiece, b.size() - o)), MPI_CHAR, to, kPartTag,
              MPI_COMM_WORLD);
 }
 
-// Rank 0 could not build a rank's part: the remaining ranks get its reason instead.
-void send_failure(const std::string& why, int to) {
-  std::uint64_t n = kFailed;
-  MPI_Send(&n, 1, MPI_UINT64_T, to, kPartTag, MPI_COMM_WORLD);
-  send_bytes(why, to);
-}
-
-// A message of send_bytes; rank 0's reason (FemError) when it sent send_failure.
-std::string recv_bytes(int from) {
-  std::uint64_t n = 0;
-  MPI_Recv(&n, 1, MPI_UINT64_T, from, kPartTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  if (n == kFailed) throw FemError(recv_bytes(from));
-  std::string b(n, '\0');
+void recv_pieces(std::string& b, int from) {
   for (std::size_t o = 0; o < b.size(); o += kPiece)
     MPI_Recv(b.data() + o, static_cast<int>(std::min(kPiece, b.size() - o)), MPI_CHAR, from,
              kPartTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+}
+
+// A rank's part: its length, the rank's word that it could make room for it, then the bytes
+// (none if it could not). Returns the rank's word.
+bool send_part(const std::string& b, int to) {
+  std::uint64_t n = b.size();
+  MPI_Send(&n, 1, MPI_UINT64_T, to, kPartTag, MPI_COMM_WORLD);
+  int room = 0;
+  MPI_Recv(&room, 1, MPI_INT, to, kPartTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  if (room) send_pieces(b, to);
+  return room != 0;
+}
+
+// Rank 0 could not build a rank's part: the remaining ranks get its reason instead (a short
+// message, sent whole).
+void send_failure(const std::string& why, int to) {
+  std::uint64_t n[2] = {kFailed, why.size()};
+  MPI_Send(n, 2, MPI_UINT64_T, to, kPartTag, MPI_COMM_WORLD);
+  send_pieces(why, to);
+}
+
+// This rank's part from rank 0 (send_part); rank 0's reason (FemError) when it sent
+// send_failure; a FemError, told to rank 0, when there is no room for the part.
+std::string recv_part(int rank) {
+  std::uint64_t n[2] = {0, 0};
+  MPI_Status st;
+  MPI_Recv(n, 2, MPI_UINT64_T, 0, kPartTag, MPI_COMM_WORLD, &st);
+  int got = 0;
+  MPI_Get_count(&st, MPI_UINT64_T, &got);
+  if (got == 2 && n[0] == kFailed) {
+    std::string why(n[1], '\0');
+    recv_pieces(why, 0);
+    throw FemError(why);
+  }
+  std::string b;
+  int room = 1;
+  try {
+    if (g_part_fault == -rank - 1) throw std::bad_alloc();
+    b.assign(n[0], '\0');
+  } catch (const std::bad_alloc&) {
+    room = 0;
+  }
+  MPI_Send(&room, 1, MPI_INT, 0, kPartTag, MPI_COMM_WORLD);
+  if (!room)
+    throw FemError("FEM: rank " + std::to_string(rank) + " has no room for its part of the far field (" +
+                   std::to_string(n[0]) + " bytes)" + (g_part_fault ? " (a fault set by a test)" : ""));
+  recv_pieces(b, 0);
   return b;
 }
 
@@ -613,15 +647,14 @@ void Solver::distribute_from_root() {
   int ok = why.empty() ? 1 : 0;
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (!ok) throw FemError(rank == 0 ? why : "FEM: rank 0 could not cut the mesh");
-  // Each rank gets its part or rank 0's reason; then every rank says whether it has its part, so
-  // that a failure anywhere (rank 0 out of memory building a part, a message that does not
-  // unpack) stops all of them.
+  // Each rank gets its part or rank 0's reason (a rank with no room for its part says so before
+  // rank 0 sends it); then every rank says whether it has its part, so that a failure anywhere
+  // (rank 0 or a rank out of memory, a message that does not unpack) stops all of them.
   why.clear();
   std::unique_ptr<Impl> loc;
   if (rank != 0) {
     try {
-      unpack(recv_bytes(0), m, dt, t, steps, energy);
-      if (g_part_fault == -rank - 1) throw FemError("FEM: a fault set by a test (unpacking)");
+      unpack(recv_part(rank), m, dt, t, steps, energy);
     } catch (const std::exception& e) {
       why = e.what();
     }
@@ -635,7 +668,10 @@ void Solver::distribute_from_root() {
         make_part(m, P, static_cast<std::uint32_t>(r));
         P.work = P.absorbed = 0;
         const std::unique_ptr<Impl> part = local_model(m, P, described);
-        send_bytes(pack(*part, dt, t, steps, energy), r);
+        if (!send_part(pack(*part, dt, t, steps, energy), r)) {
+          ++r;  // it knows
+          throw FemError("rank " + std::to_string(r - 1) + " has no room for it");
+        }
       }
       P.rank = 0;
       make_part(m, P, 0);
@@ -643,7 +679,7 @@ void Solver::distribute_from_root() {
       P.absorbed = energy.absorbed;
       loc = local_model(m, P, described);
     } catch (const std::exception& e) {
-      why = std::string("FEM: rank 0 could not build the ranks' parts: ") + e.what();
+      why = std::string("FEM: rank 0 could not send the far field's parts: ") + e.what();
       for (; r < size; ++r) send_failure(why, r);
     }
   }

@@ -21,8 +21,8 @@
 //     largest rank holds at most 3/4 of the nodes on 2 ranks, 1/2 on 4;
 //     localize() before distribute() and a probe added after it are refused.
 //   * The far field set up from rank 0 (distribute_from_root, the other ranks skeletons): a
-//     failure while rank 0 builds the last rank's part, or while the last rank unpacks it,
-//     stops every rank with an error (none hangs), rank 0's reason on rank 0; a set-up without
+//     failure while rank 0 builds the last rank's part, or the last rank finding no room for
+//     it, stops every rank with an error (none hangs), rank 0's reason on rank 0; a set-up without
 //     fault then steps as the whole split model (energies bit for bit).
 //   * The oblique study's measurement, P at 30 degrees on a 10-cell PML and on LK: the
 //     reflection coefficients as on one process (1e-12 relative), on 2 ranks.

@@ -269,8 +269,8 @@ class Solver {
   // After distribute(): keeps only what this rank steps (each rank its part of the cut that
   // distribute() shared; nothing is sent). Its arrays then hold its
   // own nodes and those it receives, numbered in the mesh's order (global_nodes() gives each
-  // local node's mesh number), K only its own rows, cell_nodes() its cells; ranks other than 0
-  // free deal.II's mesh, rank 0 keeps the mesh for the snapshots it writes. The step, probes,
+  // local node's mesh number), K only its own rows, cell_nodes() its cells; every rank frees
+  // deal.II's mesh, rank 0 keeps the mesh's arrays for the snapshots it writes. The step, probes,
   // energies, snapshots and checkpoints give the same bits as the split whole model. nodes(),
   // dofs(), cells(), dashpot_count() and describe() still tell the whole mesh's; own_nodes(),
   // node_owner() and the per-node arrays (node_x(), displacement(), put_nodes ...) are local;
@@ -284,7 +284,7 @@ class Solver {
   // spec, its probes added and dt set), the other ranks a Skeleton of the same spec; rank 0 cuts
   // it, builds each rank's local model (as localize() would) and sends it with the clock, and
   // keeps its own. So only rank 0 ever holds the whole model. Collective; throws FemError on
-  // every rank when the cut fails.
+  // every rank when the cut fails, or building, sending or unpacking a part fails on any rank.
   void distribute_from_root();
   bool is_skeleton() const;
   // The mesh number of each local node (every node on a model that holds the whole mesh).
@@ -302,7 +302,7 @@ class Solver {
   // test sets it small.
   static void set_gather_piece(std::size_t n);
   // A test's fault: distribute_from_root() fails on rank 0 while it builds rank `rank`'s part
-  // (rank >= 1), or on rank r while it unpacks its own (rank = -r - 1); 0 clears it.
+  // (rank >= 1), or rank r finds no room for its own (rank = -r - 1); 0 clears it.
   static void set_part_fault(int rank);
   // The ghost updates so far over all ranks (every rank calls it): the slowest rank's seconds,
   // the bytes all ranks sent, and the largest rank's counts; held_nodes: the nodes whose arrays
