@@ -188,6 +188,7 @@ std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts);
 // Several processes (fem_parallel.cpp). A model already split, or MPI not running, is an error
 // (FemError); so is a part METIS leaves empty.
 void check_can_split(const Solver::Impl& m);
+void check_enough_cells(std::size_t cells, int ranks);
 void check_parts(const std::vector<std::uint32_t>& cell_rank, int size, std::size_t nc);
 // Rank me's share of the whole model m under the cut P.cell_rank (P.size ranks): the nodes'
 // owners, its own nodes, its links to the others, its PML cells and nodes.

@@ -285,13 +285,16 @@ bool Solver::localize() {
   Impl& m = *impl_;
   if (!m.part) throw FemError("FEM: localize() needs a model split over the ranks (distribute())");
   if (localized()) return true;
-  std::unique_ptr<Impl> loc = local_model(m, *m.part, describe());
-  if (m.part->rank == 0) keep_for_snapshots(std::move(impl_), *loc);
+  adopt(local_model(m, *m.part, describe()), m.part->rank == 0);
+  return true;
+}
+
+void Solver::adopt(std::unique_ptr<Impl> loc, bool snapshots) {
+  if (snapshots) keep_for_snapshots(std::move(impl_), *loc);
   impl_ = std::move(loc);  // the whole model goes (on rank 0 but for what the snapshots need)
 #if defined(__GLIBC__)
   malloc_trim(0);  // and its pages go back to the system
 #endif
-  return true;
 }
 
 void gather_local(const Solver::Impl& m, const std::vector<const std::vector<double>*>& fields,
@@ -635,9 +638,7 @@ void Solver::distribute_from_root() {
   std::string why;
   if (rank == 0) {
     try {
-      if (m.n_cells < static_cast<std::size_t>(size))
-        throw FemError("FEM: fewer cells (" + std::to_string(m.n_cells) + ") than MPI ranks (" +
-                       std::to_string(size) + "): run it on fewer ranks or on a finer mesh");
+      check_enough_cells(m.n_cells, size);
       P.cell_rank = partition_cells(m, static_cast<unsigned>(size));
       check_parts(P.cell_rank, size, m.n_cells);
     } catch (const std::exception& e) {
@@ -687,12 +688,12 @@ void Solver::distribute_from_root() {
   MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   if (failed) throw FemError(why.empty() ? "FEM: another rank could not take its part of the far field" : why);
   if (rank == 0) {
-    keep_for_snapshots(std::move(impl_), *loc);
-    impl_ = std::move(loc);
-  }
+    adopt(std::move(loc), true);
+  } else {
 #if defined(__GLIBC__)
-  malloc_trim(0);  // the whole model's pages (rank 0), the message's (the others)
+    malloc_trim(0);  // the message's pages
 #endif
+  }
 }
 
 }  // namespace smpm::fem

@@ -24,6 +24,12 @@ void check_can_split(const Solver::Impl& m) {
   if (!running) throw FemError("FEM: splitting the model over ranks needs MPI, which is not running");
 }
 
+void check_enough_cells(std::size_t nc, int size) {
+  if (nc < static_cast<std::size_t>(size))
+    throw FemError("FEM: fewer cells (" + std::to_string(nc) + ") than MPI ranks (" +
+                   std::to_string(size) + "): run it on fewer ranks or on a finer mesh");
+}
+
 void check_parts(const std::vector<std::uint32_t>& cell_rank, int size, std::size_t nc) {
   const auto ranks = static_cast<std::size_t>(size);
   std::vector<std::size_t> cells_of(ranks, 0);
@@ -106,9 +112,7 @@ void Solver::distribute() {
   MPI_Comm_rank(MPI_COMM_WORLD, &P.rank);
   MPI_Comm_size(MPI_COMM_WORLD, &P.size);
   const std::size_t nc = m.n_cells;
-  if (nc < static_cast<std::size_t>(P.size))
-    throw FemError("FEM: fewer cells (" + std::to_string(nc) + ") than MPI ranks (" +
-                   std::to_string(P.size) + "): run it on fewer ranks or on a finer mesh");
+  check_enough_cells(nc, P.size);
   // Rank 0 cuts the mesh and sends the cut to the others, so that every rank holds the same one.
   // It says first whether the cut worked, so that a failure stops every rank (with rank 0's
   // reason printed by rank 0), not rank 0 alone while the others wait for the cut.

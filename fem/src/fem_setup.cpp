@@ -954,7 +954,7 @@ void Solver::write_snapshot(const std::string& dir, const std::string& base) {
     // model: on the whole mesh it keeps); whether it could is told to every rank, so that a
     // failure stops them all.
     std::vector<std::vector<double>> all;
-    if (m.whole || !m.glob.empty()) gather_local(m, {&m.u, &m.v}, 2, all);
+    if (!m.glob.empty()) gather_local(m, {&m.u, &m.v}, 2, all);
     else gather_on_root(m, m.part->node_rank, {&m.u, &m.v}, 2, all);
     std::string why;
     if (m.part->rank == 0) {

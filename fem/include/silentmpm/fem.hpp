@@ -317,6 +317,9 @@ class Solver {
   struct Impl;
 
  private:
+  // Takes a local model in place of the whole one (rank 0, `snapshots`: keeping what the
+  // snapshots are written with) and gives the freed pages back.
+  void adopt(std::unique_ptr<Impl> loc, bool snapshots);
   std::unique_ptr<Impl> impl_;
 };
 
