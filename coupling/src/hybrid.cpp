@@ -262,10 +262,36 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
       }
   }
 
-  // FE dashpot blocks by node.
-  dash_of_fe_.assign(nfe, -1);
-  const auto& D = fe_.dashpots();
-  for (std::size_t k = 0; k < D.size(); ++k) dash_of_fe_[D[k].node] = static_cast<std::int32_t>(k);
+  // What each shared node needs of the FE side (fe_at_ and the copies beside it).
+  {
+    std::vector<std::int32_t> dash_of(nfe, -1);
+    const auto& D = fe_.dashpots();
+    for (std::size_t k = 0; k < D.size(); ++k) dash_of[D[k].node] = static_cast<std::int32_t>(k);
+    const std::size_t ns = shared_.size();
+    const auto& mfe = fe_.mass();
+    const auto& v = fe_.velocity();
+    fe_at_.resize(ns);
+    fe_m_.resize(ns);
+    fe_v_.resize(2 * ns);
+    fe_c_.assign(3 * ns, 0.0);
+    fe_dash_.assign(ns, 0);
+    fe_xy_.resize(2 * ns);
+    for (std::size_t k = 0; k < ns; ++k) {
+      const std::uint32_t e = shared_[k][0];
+      fe_at_[k] = e;
+      fe_m_[k] = mfe[e];
+      fe_v_[2 * k] = v[2 * e];
+      fe_v_[2 * k + 1] = v[2 * e + 1];
+      fe_xy_[2 * k] = X[e];
+      fe_xy_[2 * k + 1] = Y[e];
+      if (dash_of[e] < 0) continue;
+      const auto& c = D[dash_of[e]];
+      fe_dash_[k] = 1;
+      fe_c_[3 * k] = c.cxx;
+      fe_c_[3 * k + 1] = c.cxy;
+      fe_c_[3 * k + 2] = c.cyy;
+    }
+  }
 
   fint_.assign(2 * nfe, 0.0);
   fext_.assign(2 * nfe, 0.0);
@@ -384,6 +410,24 @@ void Hybrid::distribute(Decomposition& d) {
     mpm_own_[k] = i >= own[0] && i <= own[1] && j >= own[2] && j <= own[3];
     fe_own_[k] = fe_.node_owner(shared_[k][0]) == d.rank();
   }
+  // This rank's part of the far field: its own nodes and those it receives, numbered in the
+  // mesh's order; the coupling's arrays by FE node follow that numbering.
+  fe_.localize();
+  const std::vector<std::uint32_t> glob = fe_.global_nodes();
+  std::vector<std::int64_t> grid_of(glob.size());
+  std::vector<double> fint(2 * glob.size());
+  for (std::size_t l = 0; l < glob.size(); ++l) {
+    grid_of[l] = grid_of_fe_[glob[l]];
+    fint[2 * l] = fint_[2 * glob[l]];
+    fint[2 * l + 1] = fint_[2 * glob[l] + 1];
+  }
+  grid_of_fe_.swap(grid_of);
+  fint_.swap(fint);
+  fext_.assign(2 * glob.size(), 0.0);  // written on the loaded nodes before each use
+  for (std::size_t k = 0; k < shared_.size(); ++k) {
+    const auto it = std::lower_bound(glob.begin(), glob.end(), shared_[k][0]);
+    fe_at_[k] = it != glob.end() && *it == shared_[k][0] ? it - glob.begin() : -1;
+  }
   fe_own_nodes_ = fe_.own_nodes();
   // The FE terms booked so far stay with rank 0 (each rank books its own nodes' from now on).
   if (d.rank() != 0) fe_absorbed_ = fe_work_ = 0;
@@ -405,37 +449,51 @@ void Hybrid::after_forces(Solver& S) {
   if (fe_.dt != S.dt) set_dt(S.dt);
   fe_.internal_force(fe_.displacement().data(), fint_.data());
   fe_.refresh_external_force(S.t, fext_.data());
-  const auto& mfe = fe_.mass();
   const std::vector<double>& v = fe_.velocity();
   const std::size_t ns = shared_.size();
-  // The FE forces of the shared nodes (split: from their FE owners, summed over the ranks).
-  force_.assign(2 * ns, 0.0);
+  // The FE forces of the shared nodes (split: from their FE owners, summed over the ranks),
+  // and how many FE owners found an FE load on a shared node that carries MPM mass (a guard).
+  force_.assign(2 * ns + 1, 0.0);
+  long loaded = -1;  // the first such node of this rank's
   for (std::size_t k = 0; k < ns; ++k) {
-    const std::uint32_t e = shared_[k][0];
-    if (has_mpm_mass_[k] && (fext_[2 * e] != 0 || fext_[2 * e + 1] != 0))
-      throw HybridError("hybrid: an FEM boundary load acts on the interface node at " +
-                        pt(fe_.node_x()[e], fe_.node_y()[e]) +
-                        ": no external load may act on a node shared with the MPM region");
+    const std::int64_t e = fe_at_[k];
+    if (e >= 0) {
+      fe_v_[2 * k] = v[2 * e];
+      fe_v_[2 * k + 1] = v[2 * e + 1];
+    }
     if (!fe_own_[k]) continue;
+    if (loaded < 0 && has_mpm_mass_[k] && (fext_[2 * e] != 0 || fext_[2 * e + 1] != 0))
+      loaded = static_cast<long>(k);
     force_[2 * k] = fint_[2 * e] + fext_[2 * e];
     force_[2 * k + 1] = fint_[2 * e + 1] + fext_[2 * e + 1];
   }
+  force_[2 * ns] = loaded >= 0 ? 1.0 : 0.0;
   share(force_);
+  if (force_[2 * ns] > 0) {  // every rank: the first such node over the ranks
+    if (dist_) {
+      double neg = loaded >= 0 ? -static_cast<double>(loaded) : -1e300;
+      dist_->max(&neg, 1);
+      loaded = static_cast<long>(-neg);
+    }
+    throw HybridError("hybrid: an FEM boundary load acts on the interface node at " +
+                      pt(fe_xy_[2 * loaded], fe_xy_[2 * loaded + 1]) +
+                      ": no external load may act on a node shared with the MPM region");
+  }
   for (std::size_t k = 0; k < ns; ++k) {
-    const std::uint32_t e = shared_[k][0];
     const std::int64_t n = node_[k];
     if (n < 0) continue;  // not in this rank's window
     // The particles' own velocity at the node, for their FLIP increment (before_g2p).
     mpm_v_[2 * k] = g.m[n] > 0 ? g.px[n] / g.m[n] : 0.0;
     mpm_v_[2 * k + 1] = g.m[n] > 0 ? g.py[n] / g.m[n] : 0.0;
-    g.m[n] += mfe[e];
-    g.px[n] += mfe[e] * v[2 * e];
-    g.py[n] += mfe[e] * v[2 * e + 1];
+    const double mfe = fe_m_[k];
+    g.m[n] += mfe;
+    g.px[n] += mfe * fe_v_[2 * k];
+    g.py[n] += mfe * fe_v_[2 * k + 1];
     g.fx[n] += force_[2 * k];
     g.fy[n] += force_[2 * k + 1];
     if (gx_ != 0 || gy_ != 0) {  // the FE mass's weight (the MPM step's covers m_MPM only)
-      g.fx[n] += mfe[e] * gx_;
-      g.fy[n] += mfe[e] * gy_;
+      g.fx[n] += mfe * gx_;
+      g.fy[n] += mfe * gy_;
     }
   }
 }
@@ -445,22 +503,20 @@ void Hybrid::after_forces(Solver& S) {
 void Hybrid::after_grid_update(Solver& S) {
   Grid& g = S.grid;
   const double dt = S.dt;
-  const auto& D = fe_.dashpots();
   double absorbed = 0;
   for (std::size_t k = 0; k < shared_.size(); ++k) {
-    const std::uint32_t e = shared_[k][0];
     const std::int64_t n = node_[k];
-    if (n < 0 || dash_of_fe_[e] < 0) continue;
-    const auto& c = D[dash_of_fe_[e]];
+    if (n < 0 || !fe_dash_[k]) continue;
+    const double cxx = fe_c_[3 * k], cxy = fe_c_[3 * k + 1], cyy = fe_c_[3 * k + 2];
     const double vx = g.vx[n], vy = g.vy[n];
     double a, b;
-    dashpot_velocity(g.m[n], c.cxx + g.cxx[n], c.cxy + g.cxy[n], c.cyy + g.cyy[n], vx, vy, g.fx[n],
+    dashpot_velocity(g.m[n], cxx + g.cxx[n], cxy + g.cxy[n], cyy + g.cyy[n], vx, vy, g.fx[n],
                      g.fy[n], dt, g.fix[n], a, b);
     g.vnx[n] = a;
     g.vny[n] = b;
     if (!mpm_own_[k]) continue;  // every copy updates; the owner books
     const double bx = 0.5 * (vx + a), by = 0.5 * (vy + b);
-    absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by));
+    absorbed += dt * (bx * (cxx * bx + cxy * by) + by * (cxy * bx + cyy * by));
   }
   step_absorbed_ = absorbed;
 }
@@ -502,11 +558,14 @@ void Hybrid::before_g2p(Solver& S) {
   fe_.advance_free_nodes(grid_of_fe_.data(), fint_.data(), fext_.data(), dt, fe_work_, absorbed);
   // Shared nodes take the grid velocity; FE loads there (FE-only nodes) do work with it.
   for (std::size_t k = 0; k < ns; ++k) {
-    const std::uint32_t e = shared_[k][0];
+    const std::int64_t e = fe_at_[k];
     const double vnx = vel_[4 * k + 2], vny = vel_[4 * k + 3];
     if (fe_own_[k])
       fe_work_ += dt * (fext_[2 * e] * 0.5 * (sum_v_[2 * k] + vnx) +
                         fext_[2 * e + 1] * 0.5 * (sum_v_[2 * k + 1] + vny));
+    fe_v_[2 * k] = vnx;
+    fe_v_[2 * k + 1] = vny;
+    if (e < 0) continue;  // not in this rank's part of the far field
     v[2 * e] = vnx;
     v[2 * e + 1] = vny;
   }
@@ -519,14 +578,11 @@ void Hybrid::before_g2p(Solver& S) {
 // with v+ instead reflects about twice as much: 1.5 % vs 0.8 % for a 20-cell pulse).
 void Hybrid::after_remap(Solver& S) {
   Grid& g = S.grid;
-  const auto& mfe = fe_.mass();
-  const std::vector<double>& v = fe_.velocity();
   for (std::size_t k = 0; k < shared_.size(); ++k) {
-    const std::uint32_t e = shared_[k][0];
     const std::int64_t n = node_[k];
     if (n < 0) continue;
-    g.qx[n] += mfe[e] * v[2 * e];
-    g.qy[n] += mfe[e] * v[2 * e + 1];
+    g.qx[n] += fe_m_[k] * fe_v_[2 * k];
+    g.qy[n] += fe_m_[k] * fe_v_[2 * k + 1];
   }
 }
 
@@ -552,7 +608,8 @@ void Hybrid::end_of_step(Solver& S) {
   double* u = fe_.displacement().data();
   const double dt = S.dt;
   for (std::size_t k = 0; k < ns; ++k) {
-    const std::uint32_t e = shared_[k][0];
+    const std::int64_t e = fe_at_[k];
+    if (e < 0) continue;  // not in this rank's part of the far field
     u[2 * e] += dt * disp_[2 * k];
     u[2 * e + 1] += dt * disp_[2 * k + 1];
   }
@@ -639,7 +696,6 @@ void Hybrid::save_state(StateWriter& w) const {
   terms.push_back(fe_initial_);
   w.put("hybrid.fe_terms", terms);
   fe_.put_nodes(w, "hybrid.fint", fint_);
-  w.put("hybrid.fext", fext_);
   w.put("hybrid.mpm_v", mpm_v_);
   w.put("hybrid.sum_v", sum_v_);
 }
@@ -659,7 +715,11 @@ bool Hybrid::load_state(const StateReader& r) {
   fe_work_ = terms[4];
   fe_initial_ = terms[5];
   fe_.get_nodes(r, "fem.", "hybrid.fint", fint_);
-  r.get("hybrid.fext", fext_, fext_.size());
+  const std::vector<double>& v = fe_.velocity();  // the shared nodes' FE velocities with it
+  for (std::size_t k = 0; k < shared_.size(); ++k) {
+    fe_v_[2 * k] = v[2 * fe_at_[k]];
+    fe_v_[2 * k + 1] = v[2 * fe_at_[k] + 1];
+  }
   r.get("hybrid.mpm_v", mpm_v_, mpm_v_.size());
   r.get("hybrid.sum_v", sum_v_, sum_v_.size());
   return same_order;

@@ -12,6 +12,8 @@
 //     of sigma_xx.
 //   * Particles thrown at 2000 m/s into the elements: every rank stops at the same step with
 //     the same error as one process (naming the particle with the lowest id inside an FE cell).
+//   * An FE load on an interface node: every rank stops at the first step with one process's
+//     error, though only the node's FE owner holds it (each rank keeps its part of the far field).
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -80,12 +82,12 @@ TEST(HybridRanks, UniformStrainPatchAcrossRankBorders) {
   Strip c;
   c.height = 16;
   HybRun m = make_uniform_strain_patch(c, eps), one = make_uniform_strain_patch(c, eps);
-  const auto d = split(m);
   for (double x : {13.3, 17.5, 22.25, 29.9})
     for (double y : {0.5, 4.0, 8.0, 15.7}) {
       ASSERT_GE(m.fe->add_probe(x * c.h, y * c.h), 0);
       ASSERT_GE(one.fe->add_probe(x * c.h, y * c.h), 0);
     }
+  const auto d = split(m);  // the far field's part is kept: probes are added before
   for (int k = 0; k < 200; ++k) {
     m.step();
     one.step();
@@ -143,6 +145,56 @@ TEST(HybridRanks, ParticleEnteringAnElementStopsEveryRankAtOneStep) {
   EXPECT_EQ(split_run, alone);
   EXPECT_EQ(m.mpm->steps, one.mpm->steps);
   if (mpi_testing::world_rank() == 0) std::printf("%s\n", split_run.c_str());
+}
+
+// An FE traction on the far field's top edge loads the interface node at its corner, which
+// carries MPM mass. Each rank keeps only its part of the far field, so only that node's FE
+// owner sees the load: every rank must still stop at the first step with one process's error
+// (the owners' verdicts travel in the interface's first sum).
+TEST(HybridRanks, FemLoadOnAnInterfaceNodeStopsEveryRank) {
+  const double h = 1e-3, H = 16 * h;
+  const auto build = [&] {
+    HybRun m;
+    m.mpm = std::make_unique<Solver>();
+    Solver& s = *m.mpm;
+    s.materials.push_back(smpm::testing::tungsten());
+    s.grid.init(-2 * h, 0.0, h, 34, 16);
+    s.seed_rectangle(0, 0, 20 * h, H, 1, 0, 0, 0, 0);
+    s.opt.threads = 1;
+    s.dt = 0.3 * h / s.materials[0].cd;
+    s.finalize();
+    fem::Spec spec;
+    spec.mesh = fem::load_mesh(box_geo("ranks_fe_load", 20 * h, 0, 30 * h, H, h), h);
+    spec.materials = {smpm::testing::tungsten()};
+    spec.region_material = {{1, 0}};
+    spec.threads = 1;
+    auto top = fe_bc(fem::Boundary::Kind::Traction, 14, "top");
+    top.normal = -1e6;
+    spec.boundaries.push_back(top);
+    m.fe = std::make_unique<fem::Solver>(spec);
+    m.hyb = std::make_unique<Hybrid>(s, *m.fe);
+    m.hyb->set_dt(s.dt);
+    return m;
+  };
+  const auto run = [](HybRun& r) {
+    try {
+      for (int k = 0; k < 5; ++k) r.step();
+    } catch (const HybridError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  HybRun one = build(), m = build();
+  const auto d = split(m);
+  const std::string alone = run(one), split_run = run(m);
+  EXPECT_NE(alone.find("FEM boundary load acts on the interface node at (0.02, 0.016)"),
+            std::string::npos)
+      << alone;
+  EXPECT_EQ(split_run, alone);
+  EXPECT_EQ(m.mpm->steps, 0);
+  // The far field's part: a rank holds no more than its share and the nodes it receives.
+  const double held = static_cast<double>(m.fe->traffic().held_nodes);
+  if (world_size() > 1) EXPECT_LE(held, 0.75 * static_cast<double>(m.fe->nodes()));
 }
 
 }  // namespace

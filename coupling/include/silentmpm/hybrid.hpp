@@ -38,10 +38,11 @@
 //     adds m_FE g).
 //
 // Over MPI ranks (distribute(); docs/parallel.md) the grid is cut into blocks and the FE mesh by
-// METIS, independently. A shared node's grid copies lie in the windows of one or more ranks, its
-// FE row on one: the step sums three short vectors over the ranks, each entry written by one
-// rank only (so the sums are exact): the FE forces of the shared nodes from their FE owners
-// (after the MPM forces), their v and v+ from their MPM owners (after the grid update), and the
+// METIS, independently, and each rank keeps only its part of the far field. A shared node's
+// grid copies lie in the windows of one or more ranks, its FE row on one: the step sums three
+// short vectors over the ranks, each entry written by one rank only (so the sums are exact):
+// the FE forces of the shared nodes from their FE owners (with the FE-load guard's verdict,
+// after the MPM forces), their v and v+ from their MPM owners (after the grid update), and the
 // velocity that advances their displacement (with the particle check's verdict, at the end).
 #include <array>
 #include <cstdint>
@@ -94,7 +95,9 @@ class Hybrid : public StepHooks {
 
   // Several processes: call once on every rank, after the MPM solver was cut by `d` (which
   // must outlive the steps) and the FE far field split (fem::Solver::distribute). Maps the
-  // shared nodes to this rank's window of the grid; the energy booked so far stays with rank 0.
+  // shared nodes to this rank's window of the grid, and keeps only this rank's part of the far
+  // field (fem::Solver::localize: its own nodes and those it receives); the energy booked so
+  // far stays with rank 0.
   void distribute(Decomposition& d);
 
   // Energies of both regions summed (kinetic, elastic; dissipated, absorbed and external work
@@ -131,8 +134,8 @@ class Hybrid : public StepHooks {
   Solver& mpm_;
   fem::Solver& fe_;
   std::vector<std::array<std::uint32_t, 2>> shared_;
-  std::vector<std::int64_t> grid_of_fe_;   // shared grid node of each FE node, or -1
-  std::vector<std::int32_t> dash_of_fe_;   // index into fe.dashpots(), or -1
+  // Shared grid node of each FE node the far field holds (its local nodes once split), or -1.
+  std::vector<std::int64_t> grid_of_fe_;
   std::vector<std::uint8_t> fe_cell_;      // per grid cell
   long fe_row_lo_ = 0, fe_row_hi_ = -1;    // grid rows holding an FE cell (empty: lo > hi)
   std::vector<std::uint8_t> has_mpm_mass_; // per shared pair: node had MPM mass at setup
@@ -152,6 +155,13 @@ class Hybrid : public StepHooks {
   std::vector<std::uint8_t> fe_own_, mpm_own_;
   std::vector<double> force_, vel_, disp_;
   std::vector<std::uint32_t> fe_own_nodes_;  // split: this rank's FE nodes
+  // Per shared node, what a rank whose window holds its grid node needs of the FE side even
+  // where its part of the far field lacks the node: the FE node in the far field's arrays (-1:
+  // not held), its lumped mass, its velocity (refreshed from the far field where held, else the
+  // shared v+ of the last step), its dashpot block (cxx, cxy, cyy; zero if none) and position.
+  std::vector<std::int64_t> fe_at_;
+  std::vector<double> fe_m_, fe_v_, fe_c_, fe_xy_;
+  std::vector<std::uint8_t> fe_dash_;
   Decomposition* dist_ = nullptr;
   mutable double share_seconds_ = 0, share_values_ = 0;
   // The whole grid (the particle check works in its cells) and this rank's window's origin.
