@@ -10,10 +10,11 @@
 #include <vector>
 
 #include "silentmpm/fem.hpp"
+#include "silentmpm/output.hpp"
 
 namespace smpm::fem {
 
-struct Deal;  // Triangulation, DoFHandler, FE, snapshot bookkeeping (fem_setup.cpp)
+struct Deal;  // Triangulation, DoFHandler, FE (fem_setup.cpp)
 
 struct Solver::Impl {
   Impl();
@@ -167,12 +168,16 @@ struct Solver::Impl {
   std::vector<std::uint32_t> glob;
   std::size_t mesh_nodes = 0, mesh_dashpots = 0;  // the whole mesh's counts (a local model)
   std::vector<std::string> described;             // describe() of the whole model (a local model)
-  // Rank 0 of a local model: the whole mesh's nodes, u, v, cells and their regions and the
-  // snapshots' writer, which the snapshots are written with; the rest of the whole model,
-  // deal.II's mesh included, is released.
-  std::unique_ptr<Impl> whole;
+  // A local model's cells (those of cell_nodes): each one's index among the mesh's cells, and
+  // whether it is of this rank's part (cell_region is then the local cells').
+  std::vector<std::uint32_t> cell_glob;
+  std::vector<std::uint8_t> cell_own;
 
   std::unique_ptr<Deal> deal;
+  // DIR/BASE.h5 + BASE.xdmf (Solver::write_snapshot, fem_snapshot.cpp); snap_ranks: set up for
+  // a local model's ranks writing it together.
+  MeshSnapshotWriter snap;
+  bool snap_ranks = false;
   int snapshots = 0;
   std::vector<double> snapshot_times;  // every snapshot's time (a restart's earlier ones too)
 };

@@ -19,11 +19,6 @@ namespace smpm::fem {
 
 namespace {
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
-template <class T>
-void release(std::vector<T>& v) {
-  std::vector<T>().swap(v);
-}
 }  // namespace
 
 bool Solver::localized() const { return !impl_->glob.empty(); }
@@ -37,30 +32,6 @@ std::vector<std::uint32_t> Solver::global_nodes() const {
 
 std::size_t Solver::dashpot_count() const {
   return localized() ? impl_->mesh_dashpots : impl_->dash.size();
-}
-
-// Rank 0 of a local model keeps what it writes the snapshots with (the whole mesh's nodes, u and
-// v, cells and their regions, the writer) and frees the rest of the whole model, deal.II's mesh
-// with it.
-static void keep_for_snapshots(std::unique_ptr<Solver::Impl> whole, Solver::Impl& L) {
-  Solver::Impl& W = *whole;
-  release_mesh(W);
-  W.part.reset();
-  W.pml = Solver::Impl::Pml();
-  W.visc = Solver::Impl::Viscous();
-  for (auto* v : {&W.mass, &W.inv_mass, &W.ku, &W.fext, &W.val, &W.dash_force}) release(*v);
-  release(W.rowptr);
-  release(W.col);
-  release(W.row_val);
-  release(W.mask);
-  release(W.dash_of_node);
-  release(W.dash);
-  W.loads.clear();
-  W.probes.clear();
-  W.curve_nodes.clear();
-  W.spec.mesh.msh.clear();
-  W.spec.mesh.msh.shrink_to_fit();
-  L.whole = std::move(whole);
 }
 
 // Rank P.rank's local model (Solver::localize) of the whole model m split by P.
@@ -233,7 +204,12 @@ static std::unique_ptr<Solver::Impl> local_model(const Solver::Impl& m, const So
     for (std::size_t a = 0; a < nb && !mine; ++a) mine = P.node_rank[m.cell_nodes[c * nb + a]] == me;
     if (!mine) continue;
     for (std::size_t a = 0; a < nb; ++a) L.cell_nodes.push_back(local(m.cell_nodes[c * nb + a]));
+    L.cell_glob.push_back(static_cast<std::uint32_t>(c));
+    L.cell_own.push_back(P.cell_rank[c] == me);
+    L.cell_region.push_back(m.cell_region[c]);
   }
+  L.ref_grad = m.ref_grad;  // the snapshots' tables
+  L.map_grad = m.map_grad;
 
   // The probes: the parts in this rank's part of the mesh, with the weights of the whole.
   for (const auto& pr : m.probes) {
@@ -285,13 +261,12 @@ bool Solver::localize() {
   Impl& m = *impl_;
   if (!m.part) throw FemError("FEM: localize() needs a model split over the ranks (distribute())");
   if (localized()) return true;
-  adopt(local_model(m, *m.part, describe()), m.part->rank == 0);
+  adopt(local_model(m, *m.part, describe()));
   return true;
 }
 
-void Solver::adopt(std::unique_ptr<Impl> loc, bool snapshots) {
-  if (snapshots) keep_for_snapshots(std::move(impl_), *loc);
-  impl_ = std::move(loc);  // the whole model goes (on rank 0 but for what the snapshots need)
+void Solver::adopt(std::unique_ptr<Impl> loc) {
+  impl_ = std::move(loc);  // the whole model goes
 #if defined(__GLIBC__)
   malloc_trim(0);  // and its pages go back to the system
 #endif
@@ -415,6 +390,11 @@ void arrays(Solver::Impl& L, Fn&& fn) {
   fn("row_val", L.row_val);
   fn("dash", L.dash);
   fn("cell_nodes", L.cell_nodes);
+  fn("cell_glob", L.cell_glob);
+  fn("cell_own", L.cell_own);
+  fn("cell_region", L.cell_region);
+  fn("ref_grad", L.ref_grad);
+  fn("map_grad", L.map_grad);
   fn("glob", L.glob);
   Solver::Impl::Pml& Y = L.pml;
   fn("pml_grad", Y.grad);
@@ -688,7 +668,7 @@ void Solver::distribute_from_root() {
   MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   if (failed) throw FemError(why.empty() ? "FEM: another rank could not take its part of the far field" : why);
   if (rank == 0) {
-    adopt(std::move(loc), true);
+    adopt(std::move(loc));
   } else {
 #if defined(__GLIBC__)
     malloc_trim(0);  // the message's pages

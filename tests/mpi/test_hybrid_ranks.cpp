@@ -194,7 +194,9 @@ TEST(HybridRanks, FemLoadOnAnInterfaceNodeStopsEveryRank) {
   EXPECT_EQ(m.mpm->steps, 0);
   // The far field's part: a rank holds no more than its share and the nodes it receives.
   const double held = static_cast<double>(m.fe->traffic().held_nodes);
-  if (world_size() > 1) EXPECT_LE(held, 0.75 * static_cast<double>(m.fe->nodes()));
+  if (world_size() > 1) {
+    EXPECT_LE(held, 0.75 * static_cast<double>(m.fe->nodes()));
+  }
 }
 
 }  // namespace

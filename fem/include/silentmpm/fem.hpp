@@ -270,8 +270,9 @@ class Solver {
   // distribute() shared; nothing is sent). Its arrays then hold its
   // own nodes and those it receives, numbered in the mesh's order (global_nodes() gives each
   // local node's mesh number), K only its own rows, cell_nodes() its cells; every rank frees
-  // deal.II's mesh, rank 0 keeps the mesh's arrays for the snapshots it writes. The step, probes,
-  // energies, snapshots and checkpoints give the same bits as the split whole model. nodes(),
+  // deal.II's mesh and the rest of the whole model. The step, probes, energies, snapshots (which
+  // every rank then writes at once, its runs of the file's rows) and checkpoints give the same
+  // bits as the split whole model. nodes(),
   // dofs(), cells(), dashpot_count() and describe() still tell the whole mesh's; own_nodes(),
   // node_owner() and the per-node arrays (node_x(), displacement(), put_nodes ...) are local;
   // gathered() takes a local array and gives rank 0 the whole mesh's. Probes are added before.
@@ -317,9 +318,8 @@ class Solver {
   struct Impl;
 
  private:
-  // Takes a local model in place of the whole one (rank 0, `snapshots`: keeping what the
-  // snapshots are written with) and gives the freed pages back.
-  void adopt(std::unique_ptr<Impl> loc, bool snapshots);
+  // Takes a local model in place of the whole one and gives the freed pages back.
+  void adopt(std::unique_ptr<Impl> loc);
   std::unique_ptr<Impl> impl_;
 };
 
