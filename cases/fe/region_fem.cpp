@@ -51,6 +51,9 @@ class FemRegion final : public Region {
   }
 
   void save(StateWriter& w) const override { s_.save_state(w, "fem."); }
+  std::vector<std::string> blocks_from_root() const override {
+    return mpi() ? fem::Solver::blocks_from_root("fem.") : std::vector<std::string>{};
+  }
   bool restore(const StateReader& r) override {
     s_.load_state(r, "fem.");
     return true;

@@ -84,14 +84,17 @@ long restore_run(const Case& c, detail::Region& region, const std::string& file,
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) throw StateError(file + ": no such checkpoint file");
   // A case set up from rank 0 (load_case_on_ranks): rank 0 reads the whole checkpoint, the
-  // others what is not the particles' (the clock, the accounts, the run record), which rank 0
-  // sends them; rank 0's error is every rank's. The particles follow with the split.
+  // others what is not the particles' or the far field's nodes' (the clock, the accounts, the
+  // run record), which rank 0 sends them; rank 0's error is every rank's. The particles follow
+  // with the split, the far field's nodal state in restore() (each rank its nodes').
   std::optional<StateReader> reader;
   if (process_count() > 1 && c.scattered) {
     std::string error, rest;
     if (process_rank() == 0) try {
         reader.emplace(StateReader::open(file));
-        rest = reader->without(Solver::particle_blocks("mpm."));
+        std::vector<std::string> skip = Solver::particle_blocks("mpm.");
+        for (const auto& b : region.blocks_from_root()) skip.push_back(b);
+        rest = reader->without(skip);
       } catch (const std::exception& e) {
         error = e.what();
       }

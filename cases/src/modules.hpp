@@ -31,7 +31,7 @@
 namespace smpm::detail {
 
 // Bumped whenever the table or a signature in it changes (as kGmshModuleApi).
-inline constexpr int kFarFieldModuleApi = 3;
+inline constexpr int kFarFieldModuleApi = 4;
 
 struct FarFieldModule {
   int api;

@@ -39,6 +39,10 @@ class Region {
   // continuation sums over particles in another order (another thread count). Throws StateError.
   virtual void save(StateWriter& w) const = 0;
   virtual bool restore(const StateReader& r) = 0;
+  // A restart on several ranks of a case set up from rank 0: the blocks (name prefixes) that
+  // restore() reads on rank 0 alone, which sends each rank its part of them itself; the other
+  // ranks receive the checkpoint without them.
+  virtual std::vector<std::string> blocks_from_root() const { return {}; }
   // Snapshots (only when the case asks for them): opened before the first one is written; after
   // restore(), the earlier run's snapshots in the folder are kept and listed again.
   virtual void open_snapshots(const std::string& out_dir) = 0;

@@ -51,6 +51,9 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   if (fe_.degree() != 1)
     throw HybridError("hybrid: the FEM region must use fem.degree 1 (Q1, like the MPM grid), got " +
                       std::to_string(fe_.degree()));
+  if (fe_.localized())
+    throw HybridError("hybrid: the FEM region is built whole (Hybrid::distribute keeps each rank's "
+                      "part of it)");
   const auto& X = fe_.node_x();
   const auto& Y = fe_.node_y();
   const std::size_t nfe = X.size();
@@ -396,7 +399,9 @@ void Hybrid::distribute(Decomposition& d) {
   if (fe_.ranks() != d.size())
     throw HybridError("hybrid: split the FE far field over the same ranks first "
                       "(fem::Solver::distribute)");
-  dist_ = &d;
+  if (fe_.localized())
+    throw HybridError("hybrid: the FE far field keeps its part in Hybrid::distribute: split it "
+                      "with fem::Solver::distribute only");
   const Grid& g = mpm_.grid;
   const auto org = d.window_origin();
   const auto own = d.own_nodes();
@@ -431,6 +436,7 @@ void Hybrid::distribute(Decomposition& d) {
   fe_own_nodes_ = fe_.own_nodes();
   // The FE terms booked so far stay with rank 0 (each rank books its own nodes' from now on).
   if (d.rank() != 0) fe_absorbed_ = fe_work_ = 0;
+  dist_ = &d;
 }
 
 // ---- the hooks of the coupled step ----------------------------------------------------------

@@ -182,10 +182,6 @@ struct Solver::Impl {
   std::vector<double> snapshot_times;  // every snapshot's time (a restart's earlier ones too)
 };
 
-// Frees deal.II's mesh, dofs and element (the snapshots' writer stays): what a model needs no
-// more once it is split (fem_setup.cpp).
-void release_mesh(Solver::Impl& m);
-
 // The cells' parts for `parts` ranks (METIS through deal.II), in the mesh's cell order
 // (fem_setup.cpp).
 std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts);
@@ -202,6 +198,24 @@ void make_part(const Solver::Impl& m, Solver::Impl::Part& P, std::uint32_t me);
 // place.
 void exchange_ghosts(Solver::Impl& m);
 void sum_over_ranks(const Solver::Impl& m, double* v, int n);
+// A block of `width` values per item (`items` of them) of a checkpoint, whole or as parts with
+// the items' numbers in the block `numbers` (which must name every item once); fem_kernels.cpp.
+void get_items(const StateReader& r, const std::string& name, const std::string& numbers,
+               std::size_t items, std::size_t width, std::vector<double>& v);
+// A local model on several ranks (Solver::load_state): rank 0 reads the checkpoint's nodal blocks
+// (u, v, K u, the flag of K u) and the PMLs' memories from r, whole, and sends each rank its
+// nodes' and layer cells' values; the other ranks' r need not hold them. Collective; rank 0's
+// error reading them (StateError) is every rank's.
+void load_from_root(Solver::Impl& m, const StateReader& r, const std::string& pre);
+// Each rank's items `mine` (mesh numbers of nodes, layer cells ...) of per-item arrays that
+// rank 0 alone holds whole (`whole`: `widths[f]` values an item of field f; ignored on the other
+// ranks): every rank receives its items' values into `out` (one array per field, in the order of
+// `mine`). Collective; rank 0 answers the ranks one by one, in messages of at most
+// gather_piece() values.
+void slices_from_root(const std::vector<std::uint32_t>& mine,
+                      const std::vector<const std::vector<double>*>& whole,
+                      const std::vector<std::size_t>& widths,
+                      const std::vector<std::vector<double>*>& out);
 // Items (nodes, layer cells ...) with an owning rank each: rank 0 receives every item's `width`
 // values of each array in `fields` from its owner into `out` (one array per field, the whole
 // size); the others send their own items' and leave `out` empty.

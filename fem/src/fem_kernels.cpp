@@ -577,8 +577,8 @@ std::vector<double> values_of(const std::vector<double>& v, const std::vector<st
   for (const auto i : which) out.insert(out.end(), v.begin() + width * i, v.begin() + width * (i + 1));
   return out;
 }
-// A block of `width` values per item (`items` of them), whole or as parts with the items'
-// numbers in the block `numbers` (which must name every item once).
+}  // namespace
+
 void get_items(const StateReader& r, const std::string& name, const std::string& numbers,
                std::size_t items, std::size_t width, std::vector<double>& v) {
   if (!r.has(numbers)) {
@@ -597,7 +597,6 @@ void get_items(const StateReader& r, const std::string& name, const std::string&
     std::copy_n(parts.begin() + width * q, width, v.begin() + width * at[q]);
   }
 }
-}  // namespace
 
 void Solver::put_nodes(StateWriter& w, const std::string& name,
                        const std::vector<double>& per_node) const {
@@ -688,10 +687,18 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   if (dt_saved != dt)
     r.fail("FE time step " + fmt(dt_saved) + " s in the checkpoint, " + fmt(dt) +
            " s in this case (a checkpoint of another case)");
-  get_nodes(r, pre, pre + "u", m.u);
-  get_nodes(r, pre, pre + "v", m.v);
-  get_nodes(r, pre, pre + "ku", m.ku);
-  m.ku_valid = r.get<std::uint8_t>(pre + "ku_valid") != 0;
+  // A local model on several ranks: rank 0 alone reads the nodal blocks and the layers'
+  // memories and sends each rank its own (a restart sends the others the checkpoint without
+  // them: Solver::blocks_from_root).
+  const bool from_root = m.part && !m.glob.empty() && m.part->size > 1;
+  if (from_root) {
+    load_from_root(m, r, pre);
+  } else {
+    get_nodes(r, pre, pre + "u", m.u);
+    get_nodes(r, pre, pre + "v", m.v);
+    get_nodes(r, pre, pre + "ku", m.ku);
+    m.ku_valid = r.get<std::uint8_t>(pre + "ku_valid") != 0;
+  }
   t = r.get<double>(pre + "t");
   steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
   energy = r.get<Energies>(pre + "energy");
@@ -700,7 +707,7 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   if (m.pml.active() && m.glob.empty()) {
     get_items(r, pre + "pml_xi", pre + "pml_cells", m.pml.cell.size(), 4 * m.pml.nq, m.pml.xi);
     get_items(r, pre + "pml_zeta", pre + "pml_nodes", m.pml.node.size(), 4, m.pml.zeta);
-  } else if (m.pml.whole_cells > 0) {  // a local model: its cells' and nodes' memories
+  } else if (m.pml.whole_cells > 0 && !from_root) {  // a local model: its cells' and nodes' memories
     Impl::Pml& P = m.pml;
     const auto w = static_cast<std::size_t>(4 * P.nq);
     std::vector<double> xi, zeta;
@@ -715,6 +722,15 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
     m.part->work = m.part->rank == 0 ? energy.external_work : 0.0;
     m.part->absorbed = m.part->rank == 0 ? energy.absorbed : 0.0;
   }
+}
+
+}  // namespace smpm::fem
+
+namespace smpm::fem {
+
+std::vector<std::string> Solver::blocks_from_root(const std::string& pre) {
+  // ("ku" covers the flag "ku_valid" too, which load_from_root sends with the nodes.)
+  return {pre + "u", pre + "v", pre + "ku", pre + "nodes", pre + "pml_"};
 }
 
 }  // namespace smpm::fem

@@ -266,6 +266,11 @@ bool Solver::localize() {
 }
 
 void Solver::adopt(std::unique_ptr<Impl> loc) {
+  // The snapshots' writer: its deflate level goes with the model; a file it has open would be
+  // started afresh by the ranks together, so the split comes before the first snapshot.
+  if (impl_->snap.is_open())
+    throw FemError("FEM: the far field is split over the ranks before its first snapshot");
+  loc->snap.set_compression(impl_->snap.compression());
   impl_ = std::move(loc);  // the whole model goes
 #if defined(__GLIBC__)
   malloc_trim(0);  // and its pages go back to the system

@@ -288,3 +288,107 @@ void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& own
 }
 
 }  // namespace smpm::fem
+
+namespace smpm::fem {
+
+namespace {
+constexpr int kSliceTag = 7306;
+// n values from `from` (or to `to`), in messages of at most gather_piece() values.
+template <class T>
+void send_pieces(const T* v, std::size_t n, MPI_Datatype type, int to) {
+  const auto piece = static_cast<std::size_t>(gather_piece());
+  for (std::size_t at = 0; at < n; at += piece)
+    MPI_Send(v + at, static_cast<int>(std::min(piece, n - at)), type, to, kSliceTag, MPI_COMM_WORLD);
+}
+template <class T>
+void recv_pieces(T* v, std::size_t n, MPI_Datatype type, int from) {
+  const auto piece = static_cast<std::size_t>(gather_piece());
+  for (std::size_t at = 0; at < n; at += piece)
+    MPI_Recv(v + at, static_cast<int>(std::min(piece, n - at)), type, from, kSliceTag,
+             MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+}
+}  // namespace
+
+void slices_from_root(const std::vector<std::uint32_t>& mine,
+                      const std::vector<const std::vector<double>*>& whole,
+                      const std::vector<std::size_t>& widths,
+                      const std::vector<std::vector<double>*>& out) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  std::size_t per = 0;  // values per item, over the fields
+  for (const auto w : widths) per += w;
+  // Item k of the list `at`: its values of every field, one after another.
+  const auto fill = [&](const std::vector<std::uint32_t>& at, std::vector<double>& values) {
+    values.resize(per * at.size());
+    double* o = values.data();
+    for (const auto i : at)
+      for (std::size_t f = 0; f < whole.size(); ++f) {
+        std::copy_n(whole[f]->begin() + static_cast<std::ptrdiff_t>(widths[f] * i), widths[f], o);
+        o += widths[f];
+      }
+  };
+  std::vector<double> values;
+  const unsigned long long n = mine.size();
+  if (rank == 0) {
+    for (int r = 1; r < size; ++r) {
+      unsigned long long m = 0;
+      MPI_Recv(&m, 1, MPI_UNSIGNED_LONG_LONG, r, kSliceTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      std::vector<std::uint32_t> at(m);
+      recv_pieces(at.data(), at.size(), MPI_UINT32_T, r);
+      fill(at, values);
+      send_pieces(values.data(), values.size(), MPI_DOUBLE, r);
+    }
+    fill(mine, values);
+  } else {
+    MPI_Send(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, kSliceTag, MPI_COMM_WORLD);
+    send_pieces(mine.data(), mine.size(), MPI_UINT32_T, 0);
+    values.resize(per * mine.size());
+    recv_pieces(values.data(), values.size(), MPI_DOUBLE, 0);
+  }
+  const double* v = values.data();
+  for (std::size_t f = 0; f < out.size(); ++f) out[f]->resize(widths[f] * mine.size());
+  for (std::size_t k = 0; k < mine.size(); ++k)
+    for (std::size_t f = 0; f < out.size(); ++f) {
+      std::copy_n(v, widths[f], out[f]->begin() + static_cast<std::ptrdiff_t>(widths[f] * k));
+      v += widths[f];
+    }
+}
+
+}  // namespace smpm::fem
+
+namespace smpm::fem {
+
+void load_from_root(Solver::Impl& m, const StateReader& r, const std::string& pre) {
+  const bool root = m.part->rank == 0;
+  const bool layers = m.pml.whole_cells > 0;
+  const std::size_t w = 4 * static_cast<std::size_t>(m.pml.nq);
+  std::vector<double> u, v, ku, xi, zeta;
+  std::string why;
+  std::uint8_t valid = 0;
+  if (root) {
+    try {
+      get_items(r, pre + "u", pre + "nodes", m.mesh_nodes, 2, u);
+      get_items(r, pre + "v", pre + "nodes", m.mesh_nodes, 2, v);
+      get_items(r, pre + "ku", pre + "nodes", m.mesh_nodes, 2, ku);
+      valid = r.get<std::uint8_t>(pre + "ku_valid");
+      if (layers) {
+        get_items(r, pre + "pml_xi", pre + "pml_cells", m.pml.whole_cells, w, xi);
+        get_items(r, pre + "pml_zeta", pre + "pml_nodes", m.pml.whole_nodes, 4, zeta);
+      }
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+  }
+  broadcast_bytes(why, MPI_COMM_WORLD);
+  if (!why.empty()) throw StateError(why);
+  MPI_Bcast(&valid, 1, MPI_UINT8_T, 0, MPI_COMM_WORLD);
+  m.ku_valid = valid != 0;
+  slices_from_root(m.glob, {&u, &v, &ku}, {2, 2, 2}, {&m.u, &m.v, &m.ku});
+  if (layers) {
+    slices_from_root(m.pml.glob_cell, {&xi}, {w}, {&m.pml.xi});
+    slices_from_root(m.pml.glob_node, {&zeta}, {4}, {&m.pml.zeta});
+  }
+}
+
+}  // namespace smpm::fem

@@ -42,7 +42,7 @@ using namespace dealii;
 struct Deal {
   Triangulation<2> tria;
   std::unique_ptr<FESystem<2>> fe;
-  std::unique_ptr<DoFHandler<2>> dofh;  // a pointer, so that release_mesh can free it before tria
+  std::unique_ptr<DoFHandler<2>> dofh;  // (declared after tria: destroyed before it, which it subscribes to)
   MappingQ<2> mapping{1};
   Deal() : dofh(std::make_unique<DoFHandler<2>>(tria)) {}
 };
@@ -766,13 +766,6 @@ Solver::Solver(const Spec& spec) : impl_(std::make_unique<Impl>()) {
 }
 
 Solver::~Solver() = default;
-
-void release_mesh(Solver::Impl& m) {
-  if (!m.deal) return;
-  m.deal->dofh.reset();  // it subscribes to tria, which clears only without subscribers
-  m.deal->fe.reset();
-  m.deal->tria.clear();
-}
 
 std::vector<std::uint32_t> partition_cells(Solver::Impl& m, unsigned parts) {
   Triangulation<2>& tria = m.deal->tria;

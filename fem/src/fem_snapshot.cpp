@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <new>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -181,34 +182,52 @@ std::size_t to_runs(const std::vector<std::uint64_t>& at, const std::vector<doub
   auto dest = [&](std::uint64_t i) {
     return static_cast<int>(std::upper_bound(first.begin(), first.end(), i) - first.begin()) - 1;
   };
+  // Every rank takes part in both exchanges; whether any rank's counts overflow an MPI count or
+  // its buffers its memory is agreed before the second, so that all stop together.
   std::vector<long long> count(P, 0);
   for (const auto i : at) count[dest(i)] += static_cast<long long>(width + 1);
-  std::vector<int> sc(P), sd(P), rc(P), rd(P);
+  std::vector<int> sc(P, 0), sd(P, 0), rc(P, 0), rd(P, 0);
+  int bad = 0;
   long long off = 0;
   for (int r = 0; r < P; ++r) {
-    if (count[r] > INT_MAX)
-      throw FemError("FEM snapshot: more than 2^31 values for one rank in one message");
+    if (count[r] > INT_MAX || off + count[r] > INT_MAX) bad = 1;
+    if (bad) break;
     sc[r] = static_cast<int>(count[r]);
     sd[r] = static_cast<int>(off);
     off += count[r];
-    if (off > INT_MAX) throw FemError("FEM snapshot: more than 2^31 values to send from one rank");
   }
-  std::vector<double> out(static_cast<std::size_t>(off));
-  std::vector<long long> put(sd.begin(), sd.end());
-  for (std::size_t k = 0; k < at.size(); ++k) {
-    double* o = out.data() + put[dest(at[k])];
-    o[0] = static_cast<double>(at[k]);  // exact below 2^53
-    std::copy_n(rows.begin() + static_cast<std::ptrdiff_t>(width * k), width, o + 1);
-    put[dest(at[k])] += static_cast<long long>(width + 1);
+  if (bad) std::fill(sc.begin(), sc.end(), 0);
+  std::vector<double> out, got;
+  try {
+    if (!bad) out.resize(static_cast<std::size_t>(off));
+  } catch (const std::bad_alloc&) {
+    bad = 1;
+  }
+  if (!bad) {
+    std::vector<long long> put(sd.begin(), sd.end());
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      double* o = out.data() + put[dest(at[k])];
+      o[0] = static_cast<double>(at[k]);  // exact below 2^53
+      std::copy_n(rows.begin() + static_cast<std::ptrdiff_t>(width * k), width, o + 1);
+      put[dest(at[k])] += static_cast<long long>(width + 1);
+    }
   }
   MPI_Alltoall(sc.data(), 1, MPI_INT, rc.data(), 1, MPI_INT, g_world);
   long long in = 0;
-  for (int r = 0; r < P; ++r) {
+  for (int r = 0; r < P && !bad; ++r) {
     rd[r] = static_cast<int>(in);
     in += rc[r];
-    if (in > INT_MAX) throw FemError("FEM snapshot: more than 2^31 values to receive on one rank");
+    if (in > INT_MAX) bad = 1;
   }
-  std::vector<double> got(static_cast<std::size_t>(in));
+  try {
+    if (!bad) got.resize(static_cast<std::size_t>(in));
+  } catch (const std::bad_alloc&) {
+    bad = 1;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, g_world);
+  if (bad)
+    throw FemError("FEM snapshot: a rank's share of the rows is more than one MPI message holds "
+                   "(2^31 - 1 values) or more than its memory holds");
   MPI_Alltoallv(out.data(), sc.data(), sd.data(), MPI_DOUBLE, got.data(), rc.data(), rd.data(),
                 MPI_DOUBLE, g_world);
   std::vector<double>().swap(out);

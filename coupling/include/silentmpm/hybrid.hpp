@@ -40,7 +40,8 @@
 // Over MPI ranks (distribute(); docs/parallel.md) the grid is cut into blocks and the FE mesh by
 // METIS, independently, and each rank keeps only its part of the far field. A shared node's
 // grid copies lie in the windows of one or more ranks, its FE row on one: the step sums three
-// short vectors over the ranks, each entry written by one rank only (so the sums are exact):
+// short vectors over the ranks, each value written by one rank only and each guard's entry a
+// count of the ranks that found the fault (so the sums are exact):
 // the FE forces of the shared nodes from their FE owners (with the FE-load guard's verdict,
 // after the MPM forces), their v and v+ from their MPM owners (after the grid update), and the
 // velocity that advances their displacement (with the particle check's verdict, at the end).

@@ -185,7 +185,8 @@ class Solver {
   void write_snapshot(const std::string& dir, const std::string& base);
   // The deflate level of the snapshot datasets (0, the default: none; 1-9: deflated chunks).
   void set_snapshot_compression(int level);
-  // Closes DIR/BASE.h5 at the end of a run. Throws FemError.
+  // Closes DIR/BASE.h5 at the end of a run (on a local model of several ranks every rank
+  // together). Throws FemError.
   void close_snapshots();
   int snapshot_count() const;
   // The times of the snapshots written so far.
@@ -197,13 +198,19 @@ class Solver {
   int resume_snapshots(const std::string& dir, const std::string& base);
 
   // Checkpoints: the state a later step reads (u, v, -K u^n, clock, energies, snapshot times) as
-  // blocks named `prefix` + ...; load_state restores it into a solver built from the same case.
+  // blocks named `prefix` + ...; load_state restores it into a solver built from the same case
+  // (on a local model of several ranks collectively: rank 0 reads the nodal blocks and sends
+  // each rank its nodes', blocks_from_root()).
   void save_state(StateWriter& w, const std::string& prefix) const;
   void load_state(const StateReader& r, const std::string& prefix);
   // A per-node array (2 values a node) in a checkpoint: whole on one process, as this rank's
   // own nodes' part on several (in the order of the block `prefix`nodes that save_state puts);
   // get_nodes reads either form.
   void put_nodes(StateWriter& w, const std::string& name, const std::vector<double>& per_node) const;
+  // The blocks (name prefixes) that load_state reads on rank 0 alone on a local model of several
+  // ranks (the nodal state and the PMLs' memories, which rank 0 sends each rank its part of):
+  // a restart may leave them out of what the other ranks read.
+  static std::vector<std::string> blocks_from_root(const std::string& prefix);
   void get_nodes(const StateReader& r, const std::string& prefix, const std::string& name,
                  std::vector<double>& per_node) const;
 

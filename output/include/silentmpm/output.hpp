@@ -155,6 +155,7 @@ class MeshSnapshotWriter {
   int resume(const std::string& dir, const std::string& base, const std::vector<double>& times);
   bool is_open() const { return file_ >= 0; }
   void set_compression(int level) { compression_ = level; }  // as SnapshotWriter's
+  int compression() const { return compression_; }
   // Several processes writing one file together (as SnapshotWriter::set_ranks): the mesh has
   // `nodes` nodes and `cells` cells in all, of which this rank writes the rows `own_nodes` and
   // `own_cells`; open()'s arrays and write()'s fields then hold those rows only, in order.
