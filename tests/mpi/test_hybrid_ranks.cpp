@@ -42,6 +42,16 @@ std::unique_ptr<Distributed> split(HybRun& m) {
   return d;
 }
 
+// The HybridError that stops r within `steps` steps ("" if none).
+std::string error_within(HybRun& r, int steps) {
+  try {
+    for (int k = 0; k < steps; ++k) r.step();
+  } catch (const HybridError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(HybridRanks, MomentumExactAcrossRankBorders) {
   Strip c = free_strip(16);
   c.v0 = 5.0;
@@ -132,15 +142,7 @@ TEST(HybridRanks, ParticleEnteringAnElementStopsEveryRankAtOneStep) {
   c.v0 = 2000;
   HybRun one = make_strip(c), m = make_strip(c);
   const auto d = split(m);
-  const auto run = [](HybRun& r) {
-    try {
-      for (int k = 0; k < 200; ++k) r.step();
-    } catch (const HybridError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
-  const std::string alone = run(one), split_run = run(m);
+  const std::string alone = error_within(one, 200), split_run = error_within(m, 200);
   EXPECT_NE(alone.find("is inside an FE cell at step"), std::string::npos) << alone;
   EXPECT_EQ(split_run, alone);
   EXPECT_EQ(m.mpm->steps, one.mpm->steps);
@@ -176,17 +178,9 @@ TEST(HybridRanks, FemLoadOnAnInterfaceNodeStopsEveryRank) {
     m.hyb->set_dt(s.dt);
     return m;
   };
-  const auto run = [](HybRun& r) {
-    try {
-      for (int k = 0; k < 5; ++k) r.step();
-    } catch (const HybridError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   HybRun one = build(), m = build();
   const auto d = split(m);
-  const std::string alone = run(one), split_run = run(m);
+  const std::string alone = error_within(one, 5), split_run = error_within(m, 5);
   EXPECT_NE(alone.find("FEM boundary load acts on the interface node at (0.02, 0.016)"),
             std::string::npos)
       << alone;
