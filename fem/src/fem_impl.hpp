@@ -198,6 +198,12 @@ void make_part(const Solver::Impl& m, Solver::Impl::Part& P, std::uint32_t me);
 // place.
 void exchange_ghosts(Solver::Impl& m);
 void sum_over_ranks(const Solver::Impl& m, double* v, int n);
+// A local model on more than one rank: its ranks write the snapshots together and rank 0 alone
+// reads a checkpoint's nodal blocks. (On one rank it holds the whole mesh, in order, and reads
+// and writes as one process does.)
+inline bool local_on_ranks(const Solver::Impl& m) {
+  return m.part && !m.glob.empty() && m.part->size > 1;
+}
 // A block of `width` values per item (`items` of them) of a checkpoint, whole or as parts with
 // the items' numbers in the block `numbers` (which must name every item once); fem_kernels.cpp.
 void get_items(const StateReader& r, const std::string& name, const std::string& numbers,

@@ -551,9 +551,7 @@ std::vector<Sample> Solver::sample() const {
   return out;
 }
 
-}  // namespace smpm::fem
 
-namespace smpm::fem {
 
 // Checkpoints: displacement, velocity, -K u^n (the step and the elastic energy reuse it), the
 // clock, the energies and the snapshot times (fem.xdmf is rebuilt from them on restart).
@@ -690,7 +688,7 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   // A local model on several ranks: rank 0 alone reads the nodal blocks and the layers'
   // memories and sends each rank its own (a restart sends the others the checkpoint without
   // them: Solver::blocks_from_root).
-  const bool from_root = m.part && !m.glob.empty() && m.part->size > 1;
+  const bool from_root = local_on_ranks(m);
   if (from_root) {
     load_from_root(m, r, pre);
   } else {
@@ -724,9 +722,7 @@ void Solver::load_state(const StateReader& r, const std::string& pre) {
   }
 }
 
-}  // namespace smpm::fem
 
-namespace smpm::fem {
 
 std::vector<std::string> Solver::blocks_from_root(const std::string& pre) {
   // ("ku" covers the flag "ku_valid" too, which load_from_root sends with the nodes.)

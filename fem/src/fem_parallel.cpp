@@ -287,9 +287,7 @@ void gather_on_root(const Solver::Impl& m, const std::vector<std::uint32_t>& own
   }
 }
 
-}  // namespace smpm::fem
 
-namespace smpm::fem {
 
 namespace {
 constexpr int kSliceTag = 7306;
@@ -355,9 +353,7 @@ void slices_from_root(const std::vector<std::uint32_t>& mine,
     }
 }
 
-}  // namespace smpm::fem
 
-namespace smpm::fem {
 
 void load_from_root(Solver::Impl& m, const StateReader& r, const std::string& pre) {
   const bool root = m.part->rank == 0;

@@ -312,16 +312,10 @@ void write_local(Solver::Impl& m, const std::string& dir, const std::string& bas
 
 }  // namespace
 
-namespace {
-// A local model on more than one rank: its ranks write the file together. (On one rank it holds
-// the whole mesh, in order: it writes as one process does, without MPI-IO.)
-bool written_together(const Solver::Impl& m) { return m.part && !m.glob.empty() && m.part->size > 1; }
-}  // namespace
-
 void Solver::write_snapshot(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
   std::string why;
-  if (written_together(m)) {
+  if (local_on_ranks(m)) {
     // Every rank writes its runs; a failure on any stops them all.
     try {
       write_local(m, dir, base, t);
@@ -376,7 +370,7 @@ void Solver::close_snapshots() {
 
 int Solver::resume_snapshots(const std::string& dir, const std::string& base) {
   Impl& m = *impl_;
-  const bool local = written_together(m);
+  const bool local = local_on_ranks(m);
   // Who opens the file: every rank of a local model together, else rank 0 (or one process).
   const bool writer = !m.part || !m.glob.empty() || m.part->rank == 0;
   int found = 0;
