@@ -1114,26 +1114,51 @@ void Solver::boundary_work(bool remapped) {
     }
     energy.external_work += dt * w;
   }
+  // The nodal dashpot blocks C_i (the silent layers' nodal form, the damping layers' mass part,
+  // the perfectly matched layers' damping): the force -C_i vbar_i that grid_update applied, its
+  // power with wbar_i, node by node in the order the blocks were assembled; this rank's own
+  // nodes (a shared node's block is summed over the halo). The per-entry sum of the same terms,
+  // sum_q w_q N_i C_q, gives the same work up to round-off.
+  if (has_nodal_dashpot_) {
+    double w = 0;
+    for (const long i : dashpot_nodes_) {
+      if (!owns_node(i)) continue;
+      double ax, ay, bx, by;
+      vbar(i, ax, ay);
+      wbar(i, bx, by);
+      w += (grid.cxx[i] * ax + grid.cxy[i] * ay) * bx + (grid.cxy[i] * ax + grid.cyy[i] * ay) * by;
+    }
+    energy.absorbed += dt * w;
+  }
+  // Silent layers: the springs' displacements advance (USF: in apply_loads); the particle
+  // form's dashpot acts on the particle velocity, entry by entry.
   for (auto& sl : silents) {
     const auto& L = sl.layer;
     const bool advance = sl.springs() && opt.scheme != Scheme::USF;
-    entry_sums(static_cast<long>(L.idx.size()), none, [&](long q, double* T) {
+    const bool particle = sl.form == SilentForm::Particle;
+    const long n = static_cast<long>(L.idx.size());
+    if (!particle) {
+      if (!advance) continue;
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
+      for (long q = 0; q < n; ++q)
+        advance_spring<K>(sl, q, sl.N.data() + K * q, sl.nodes.data() + K * q, ux, uy, dt);
+      continue;
+    }
+    entry_sums(n, none, [&](long q, double* T) {
       const long* sn = sl.nodes.data() + K * q;  // the weights apply_loads mapped with
       const double* N = sl.N.data() + K * q;
       if (advance) advance_spring<K>(sl, q, N, sn, ux, uy, dt);
+      double tx, ty;
+      dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
       for (int a = 0; a < K; ++a) {
-        double ax, ay, tx, ty, bx, by;
-        vbar(sn[a], ax, ay);
+        double bx, by;
         wbar(sn[a], bx, by);
-        // The dashpot acts on the particle velocity (paper form) or on each node's mid-step one.
-        if (sl.form == SilentForm::Particle) dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], tx, ty);
-        else dashpot_of(sl, q, ax, ay, tx, ty);
         T[a] = dt * L.w[q] * N[a] * (tx * bx + ty * by);
       }
     }, energy.absorbed, true);
   }
-  // Perfectly matched layers: the damping force's power, and that of the explicit loads; then
-  // the particles' displacements advance (USF: in pml_loads).
+  // Perfectly matched layers: the power of the explicit loads (their damping is a nodal block,
+  // above); then the particles' displacements advance (USF: in pml_loads).
   if (pml.active()) {
     entry_sums(static_cast<long>(pml.layer.idx.size()), none, [&](long q, double* T) {
       const long* pn = pml.nodes.data() + K * q;
@@ -1141,34 +1166,20 @@ void Solver::boundary_work(bool remapped) {
       const double* dNx = pml.dNx.data() + K * q;
       const double* dNy = pml.dNy.data() + K * q;
       const double* f = pml.f.data() + 6 * q;
-      const double cm = (pml.dx[q] + pml.dy[q]) * p.mass[pml.layer.idx[q]];
       for (int a = 0; a < K; ++a) {
-        double ax, ay, bx, by;
-        vbar(pn[a], ax, ay);
+        double bx, by;
         wbar(pn[a], bx, by);
         const double fx = f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
         const double fy = f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
-        T[a] = dt * (cm * N[a] * (ax * bx + ay * by) - (fx * bx + fy * by));
+        T[a] = dt * (fx * bx + fy * by);
       }
-    }, energy.absorbed, false);
+    }, energy.absorbed, true);
     if (opt.scheme != Scheme::USF) pml_advance<S>(ux, uy);
   }
-  // Damping layers: the nodal damping force -C_i vbar_i, its power with wbar_i, with the
-  // weights the blocks were assembled with.
+  // Damping layers: the stiffness-proportional part (their mass part is a nodal block, above).
   for (auto& dl : dampers) {
     const auto& L = dl.layer;
     const long n = static_cast<long>(L.idx.size());
-    entry_sums(n, [&](long q) { return dl.alpha[q] == 0; }, [&](long q, double* T) {
-      const long* dn = dl.nodes.data() + K * q;
-      const double* N = dl.N.data() + K * q;
-      const double c = dl.alpha[q] * p.mass[L.idx[q]];
-      for (int a = 0; a < K; ++a) {
-        double ax, ay, bx, by;
-        vbar(dn[a], ax, ay);
-        wbar(dn[a], bx, by);
-        T[a] = dt * c * N[a] * (ax * bx + ay * by);
-      }
-    }, energy.absorbed, false);
     if (!(dl.beta0 > 0)) continue;
     // The stiffness-proportional part: the work of the viscous force this step applied (with
     // the power's velocity), then the viscous stress beta C : D for the next, all with the
