@@ -873,35 +873,33 @@ void Solver::apply_loads() {
     const auto& L = sl.layer;
     const long n = static_cast<long>(L.idx.size());
     layer_weights<S>(L, sl.anchor, sl.nodes, sl.N, none);
-    // Per entry: the spring's traction (2), then the particle form's dashpot traction (2) or
-    // the nodal form's block (3), rho and c_d (2; their product is taken as (w N rho) c_d).
-    layer_scratch_.resize(7 * static_cast<std::size_t>(n));
-    double* sc = layer_scratch_.data();
-    const bool usf = opt.scheme == Scheme::USF;
+    // Per entry, with springs or the particle form: the spring's traction (2), the particle
+    // form's dashpot traction (2). The nodal form's block is a few products, taken in the sum.
+    const bool particle = sl.form == SilentForm::Particle;
+    double* sc = nullptr;
+    if (sl.springs() || particle) {
+      layer_scratch_.resize(4 * static_cast<std::size_t>(n));
+      sc = layer_scratch_.data();
+      const bool usf = opt.scheme == Scheme::USF;
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 256)
-    for (long q = 0; q < n; ++q) {
-      const long* nodes = sl.nodes.data() + K * q;
-      double* o = sc + 7 * q;
-      if (sl.springs()) {  // explicit: the displacement at the start of the step
-        // USF strains the particles with the start-of-step velocity before the forces: the
-        // springs do the same.
-        if (usf) advance_spring<K>(sl, q, sl.N.data() + K * q, nodes, grid.vx, grid.vy, dt);
-        spring_of(sl, q, sl.ux[q], sl.uy[q], o[0], o[1]);
-      }
-      if (sl.form == SilentForm::Particle) {  // lagged: the particle velocity of the last step
-        dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], o[2], o[3]);
-      } else {
-        lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], o[2], o[3], o[4]);
-        const Material& mq = materials[p.group[L.idx[q]]];
-        o[5] = mq.rho;
-        o[6] = mq.cd;
+      for (long q = 0; q < n; ++q) {
+        const long* nodes = sl.nodes.data() + K * q;
+        double* o = sc + 4 * q;
+        if (sl.springs()) {  // explicit: the displacement at the start of the step
+          // USF strains the particles with the start-of-step velocity before the forces: the
+          // springs do the same.
+          if (usf) advance_spring<K>(sl, q, sl.N.data() + K * q, nodes, grid.vx, grid.vy, dt);
+          spring_of(sl, q, sl.ux[q], sl.uy[q], o[0], o[1]);
+        }
+        if (particle)  // lagged: the particle velocity of the last step
+          dashpot_of(sl, q, p.vx[L.idx[q]], p.vy[L.idx[q]], o[2], o[3]);
       }
     }
     const bool updated = !updated_weight_.empty() && sl.updated_velocity;
     for (long q = 0; q < n; ++q) {
       const long* nodes = sl.nodes.data() + K * q;
       const double* N = sl.N.data() + K * q;
-      const double* o = sc + 7 * q;
+      const double* o = sc ? sc + 4 * q : nullptr;
       if (sl.springs())
         for (int a = 0; a < K; ++a) {
           grid.fx[nodes[a]] += o[0] * L.w[q] * N[a];
@@ -915,13 +913,18 @@ void Solver::apply_loads() {
         continue;
       }
       has_nodal_dashpot_ = true;
+      double bxx, bxy, byy;
+      lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], bxx, bxy, byy);
       for (int a = 0; a < K; ++a) {
         const double wn = L.w[q] * N[a];
-        grid.cxx[nodes[a]] += wn * o[2];
-        grid.cxy[nodes[a]] += wn * o[3];
-        grid.cyy[nodes[a]] += wn * o[4];
-        if (updated) updated_weight_[nodes[a]] += wn * o[5] * o[6];
+        grid.cxx[nodes[a]] += wn * bxx;
+        grid.cxy[nodes[a]] += wn * bxy;
+        grid.cyy[nodes[a]] += wn * byy;
         add_dashpot_node(nodes[a]);
+      }
+      if (updated) {  // (w N rho) c_d
+        const Material& mq = materials[p.group[L.idx[q]]];
+        for (int a = 0; a < K; ++a) updated_weight_[nodes[a]] += L.w[q] * N[a] * mq.rho * mq.cd;
       }
     }
   }
