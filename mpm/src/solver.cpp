@@ -872,14 +872,12 @@ void Solver::apply_loads() {
   for (auto& sl : silents) {
     const auto& L = sl.layer;
     const long n = static_cast<long>(L.idx.size());
-    // Per entry, with springs or the particle form: the weights (kept for boundary_work), the
-    // spring's traction (2), the particle form's dashpot traction (2). The nodal form's weights
-    // and block are taken in the sum (boundary_work needs neither: its work is nodal).
+    layer_weights<S>(L, sl.anchor, sl.nodes, sl.N, none);
+    // Per entry, with springs or the particle form: the spring's traction (2), the particle
+    // form's dashpot traction (2). The nodal form's block is a few products, taken in the sum.
     const bool particle = sl.form == SilentForm::Particle;
-    const bool stored = sl.springs() || particle;
     double* sc = nullptr;
-    if (stored) {
-      layer_weights<S>(L, sl.anchor, sl.nodes, sl.N, none);
+    if (sl.springs() || particle) {
       layer_scratch_.resize(4 * static_cast<std::size_t>(n));
       sc = layer_scratch_.data();
       const bool usf = opt.scheme == Scheme::USF;
@@ -899,11 +897,8 @@ void Solver::apply_loads() {
     }
     const bool updated = !updated_weight_.empty() && sl.updated_velocity;
     for (long q = 0; q < n; ++q) {
-      S sf;
-      long own_nodes[K];
-      if (!stored) load_weights(L, q, sl.anchor, sf, own_nodes);
-      const long* nodes = stored ? sl.nodes.data() + K * q : own_nodes;
-      const double* N = stored ? sl.N.data() + K * q : sf.N;
+      const long* nodes = sl.nodes.data() + K * q;
+      const double* N = sl.N.data() + K * q;
       const double* o = sc ? sc + 4 * q : nullptr;
       if (sl.springs())
         for (int a = 0; a < K; ++a) {
