@@ -1365,7 +1365,41 @@ class Builder {
     // Which velocity MUSL and USF strain the particles with at the dashpots' nodes
     // (docs/physics.md section 4): the particles' own (MUSL's re-mapped one, USF's start-of-step
     // one; default) or the updated one the dashpots produced (USF: the last step's).
-    if (o.choice("edge_velocity", {"remapped", "updated"}, "remapped") == "updated") {
+    const std::string edge_velocity =
+        o.choice("edge_velocity", {"remapped", "updated", "delayed"}, "remapped");
+    if (edge_velocity == "delayed") {
+      auto need = [&](bool ok, const std::string& why) {
+        if (!ok) o.fail("edge_velocity", "\"delayed\" " + why);
+      };
+      need(s_->opt.scheme != Scheme::USL,
+           "applies under scheme.update \"MUSL\" or \"USF\" (USL's end reflects 0.2 % without it)");
+      need(sb.form == SilentForm::Nodal, "needs the nodal form");
+      need(!s_->contact.multi(), "is not available with multi-field contact");
+      need(type == "silent", "is not available with Kelvin-Voigt springs");
+      need(sb.a == 1 && sb.b == 1, "needs a = b = 1 (its delay is the waves' travel time over a "
+                                   "cell, h / c_d and h / c_s)");
+      // Its derivation holds for 1 particle per cell and an edge on a grid line along an axis
+      // (docs/physics.md section 4): checked at each of the layer's particles.
+      const Particles& P = s_->p;
+      const double h = grid_.h, cell = h * h;
+      for (std::size_t q = 0; q < sb.layer.idx.size(); ++q) {
+        const std::uint32_t k = sb.layer.idx[q];
+        const double nx = sb.layer.nx[q], ny = sb.layer.ny[q];
+        const std::string at = "the particle at (" + fmt(P.x[k]) + ", " + fmt(P.y[k]) + ")";
+        need(std::abs(P.vol[k] - cell) <= 1e-6 * cell,
+             "needs 1 particle per cell (" + at + " fills " + fmt(P.vol[k] / cell) + " of a cell)");
+        const bool along_x = std::abs(std::abs(nx) - 1) < 1e-12, along_y = std::abs(std::abs(ny) - 1) < 1e-12;
+        need(along_x || along_y, "needs an edge along the grid's axes (" + at + " has the normal (" +
+                                     fmt(nx) + ", " + fmt(ny) + "))");
+        const double e = along_x ? (P.x[k] + sb.layer.d[q] * nx - grid_.x0) / h
+                                 : (P.y[k] + sb.layer.d[q] * ny - grid_.y0) / h;
+        const double off = std::abs(e - std::round(e));
+        need(off <= 1e-6, "needs the edge on a grid line (the edge at " + at + " lies " + fmt(off) +
+                              " of a cell off one)");
+      }
+      sb.delayed = true;
+    }
+    if (edge_velocity == "updated") {
       if (s_->opt.scheme == Scheme::USL)
         o.fail("edge_velocity", "\"updated\" applies under scheme.update \"MUSL\" or \"USF\" "
                                 "(USL strains the particles with the updated velocity "
@@ -1385,7 +1419,8 @@ class Builder {
                         fmt(sb.a) + " rho c_d, b " + fmt(sb.b) + " rho c_s, " +
                         (sb.form == SilentForm::Nodal ? "nodal" : "particle") + " form, at the " +
                         (sb.anchor == Anchor::Boundary ? "boundary" : "particles") +
-                        (sb.updated_velocity ? ", strained with the updated velocity" : ""));
+                        (sb.updated_velocity ? ", strained with the updated velocity" : "") +
+                        (sb.delayed ? ", the delayed closure of 1 particle per cell" : ""));
     // The impedances a rho c_d and b rho c_s of each particle's material are set by
     // Solver::finalize().
     s_->silents.push_back(std::move(sb));

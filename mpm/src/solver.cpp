@@ -191,6 +191,25 @@ void Solver::finalize() {
             body_of_group_.empty();
   updated_weight_.assign(updated ? grid.nodes() : 0, 0.0);
   edge_velocity_.clear();
+  bool delayed = false;  // a layer with the delayed closure (MUSL or USF, one field)
+  for (const auto& s : silents) delayed = delayed || (s.form == SilentForm::Nodal && s.delayed);
+  delayed = delayed && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
+            body_of_group_.empty();
+  delay_rho_.assign(delayed ? grid.nodes() : 0, 0.0);
+  delay_.clear();
+  delay_cap_ = 0;
+  if (delayed) {  // the slowest wave speed of the layers' materials (delay_prepare)
+    double cmin = 0;
+    for (const auto& s : silents)
+      if (s.delayed)
+        for (const uint32_t k : s.layer.idx) {
+          const Material& m = materials[p.group[k]];
+          const double c = m.cs > 0 ? m.cs : m.cd;
+          cmin = cmin > 0 ? std::min(cmin, c) : c;
+        }
+    delay_cmin_ = cmin;
+  }
+  delay_map();
   // Damping of each layer particle from its depth and its material's c_d.
   for (auto& dl : dampers) {
     const BoundaryLayer& L = dl.layer;
@@ -546,6 +565,8 @@ void Solver::start_velocities() {
       grid.vy[n] = edge_velocity_[e + 4];
     }
   }
+  if (!delay_rho_.empty() && delay_cap_ > 0)
+    delay_strain_velocities(grid.vx.data(), grid.vy.data(), false);
 }
 
 // USF with layers strained with the updated velocity: this step's v+ at their dashpot nodes
@@ -559,6 +580,102 @@ void Solver::keep_edge_velocities() {
     const double j = static_cast<double>(n / grid.nnx + o[1]);
     edge_velocity_.insert(edge_velocity_.end(),
                           {i, j, updated_weight_[n], grid.vnx[n], grid.vny[n]});
+  }
+}
+
+// The delayed closure of the LK edge at 1 particle per cell (SilentBoundary::delayed;
+// docs/physics.md section 4). MUSL and USF then strain a particle with its two neighbours'
+// velocities and accelerate it with their stresses: two sublattices, each a staggered scheme of
+// spacing 2h. A right-going wave of such a scheme satisfies sigma = -rho c v(x + h, t) =
+// -rho c v(x, t - h/c) exactly, h/c later than LK's same-point relation; the closure gives each
+// sublattice that relation at the edge node: its dashpot acts with the node's start velocity of
+// h/c - dt/2 earlier (the half step of the leapfrog) on the node weighed as a whole one (the
+// velocity-stress sublattice's ghost stress), and the strain velocity there is the mean of the
+// re-mapped one and the force of as long ago over the dashpot's coefficient (the other
+// sublattice's ghost velocity).
+int Solver::delay_cap_needed() const {
+  return delay_cmin_ > 0 && dt > 0 ? static_cast<int>(std::floor(grid.h / (delay_cmin_ * dt))) + 3
+                                   : 3;
+}
+
+void Solver::delay_map() {
+  delay_slot_.assign(delay_rho_.empty() ? 0 : grid.nodes(), -1);
+  if (delay_rho_.empty() || delay_cap_ == 0) return;
+  const std::array<int, 2> o = window_origin();
+  const std::size_t R = delay_stride();
+  for (std::size_t r = 0; r * R < delay_.size(); ++r) {
+    const long i = static_cast<long>(delay_[r * R]) - o[0];
+    const long j = static_cast<long>(delay_[r * R + 1]) - o[1];
+    if (i >= 0 && j >= 0 && i < grid.nnx && j < grid.nny)
+      delay_slot_[j * grid.nnx + i] = static_cast<int>(r);
+  }
+}
+
+// A record for every node the delayed layers reach this step (in the order of the dashpot
+// nodes, serially), the ring sized for this dt.
+void Solver::delay_prepare() {
+  const int cap = delay_cap_needed();
+  if (cap != delay_cap_) {  // a new time step: the history restarts
+    delay_cap_ = cap;
+    delay_.clear();
+    delay_map();
+  }
+  const std::array<int, 2> o = window_origin();
+  const std::size_t R = delay_stride();
+  for (const long n : dashpot_nodes_) {
+    if (!(delay_rho_[n] > 0) || delay_slot_[n] >= 0) continue;
+    delay_slot_[n] = static_cast<int>(delay_.size() / R);
+    delay_.resize(delay_.size() + R, 0.0);
+    double* rec = delay_.data() + delay_.size() - R;
+    rec[0] = static_cast<double>(n % grid.nnx + o[0]);
+    rec[1] = static_cast<double>(n / grid.nnx + o[1]);
+    rec[5] = -1;
+  }
+}
+
+// Field f (0, 1: start velocity x, y; 2, 3: force less gravity) of a record's ring, d steps
+// (fractional) before the entry of `back` steps ago.
+double Solver::delay_value(const double* rec, int field, double d, long back) const {
+  d = std::clamp(d, 0.0, static_cast<double>(delay_cap_ - 2 - back));
+  const long k = static_cast<long>(std::floor(d));
+  const double f = d - static_cast<double>(k);
+  const double* ring = rec + kDelayHead;
+  auto at = [&](long b) {
+    const long s = ((steps - b) % delay_cap_ + delay_cap_) % delay_cap_;
+    return ring[4 * s + field];
+  };
+  return (1 - f) * at(back + k) + f * at(back + k + 1);
+}
+
+// The strain velocity at the delayed nodes: g <- (g + C^-1 f(t - tau)) / 2 per component
+// (C diagonal: edges along the grid's axes). MUSL (current): the nodes delayed in this step's
+// grid_update, with this step's ring entry the latest; USF (before the forces): those delayed
+// in the last step, with its blocks. The change is kept for boundary_work's account.
+void Solver::delay_strain_velocities(double* gx, double* gy, bool current) {
+  const std::size_t R = delay_stride();
+  const long back = current ? 0 : 1;
+  const double want = static_cast<double>(steps - back);
+  const std::array<int, 2> o = window_origin();
+  for (std::size_t r = 0; r * R < delay_.size(); ++r) {
+    double* rec = delay_.data() + r * R;
+    rec[10] = rec[11] = 0;
+    if (rec[5] != want) continue;
+    const long i = static_cast<long>(rec[0]) - o[0], j = static_cast<long>(rec[1]) - o[1];
+    if (i < 0 || j < 0 || i >= grid.nnx || j >= grid.nny) continue;
+    const long n = j * grid.nnx + i;
+    if (!(grid.m[n] > mass_floor_)) continue;
+    const double c[2] = {rec[2], rec[3]};
+    double* g[2] = {gx, gy};
+    for (int a = 0; a < 2; ++a) {
+      // The normal component only (the larger block: c_d against c_s; none at a corner, where
+      // the two are alike): the tangential one made the column's edge unstable within 2 000
+      // steps, and without the normal one a run grew after 4-9 * 10^4 (docs/physics.md).
+      if ((grid.fix[n] & (1 << a)) || !(c[a] > c[1 - a])) continue;
+      const double d = grid.h / (c[a] / rec[4] * dt) - 0.5;
+      const double ng = 0.5 * (g[a][n] + delay_value(rec, 2 + a, d, back) / c[a]);
+      rec[10 + a] = ng - g[a][n];
+      g[a][n] = ng;
+    }
   }
 }
 
@@ -593,6 +710,8 @@ void Solver::remapped_velocities(bool updated_edges) {
   for (const VelocityField& F : fields_)
     kernels::nodal_velocity(grid, F.box, F.f.m, grid.fix.data(), F.f.qx, F.f.qy, F.f.qx, F.f.qy,
                             mass_floor_, nthreads_);
+  if (updated_edges && !delay_rho_.empty())
+    delay_strain_velocities(grid.qx.data(), grid.qy.data(), true);
   if (!updated_edges || updated_weight_.empty()) return;
   for (const long i : dashpot_nodes_) {
     if (takes_updated(i, updated_weight_[i])) {
@@ -867,6 +986,8 @@ void Solver::apply_loads() {
   }
   if (!updated_weight_.empty())
     for (long i : dashpot_nodes_) updated_weight_[i] = 0;
+  if (!delay_rho_.empty())
+    for (long i : dashpot_nodes_) delay_rho_[i] = 0;
   dashpot_nodes_.clear();
   has_nodal_dashpot_ = false;
   for (auto& sl : silents) {
@@ -896,6 +1017,7 @@ void Solver::apply_loads() {
       }
     }
     const bool updated = !updated_weight_.empty() && sl.updated_velocity;
+    const bool delayed = !delay_rho_.empty() && sl.delayed;
     for (long q = 0; q < n; ++q) {
       const long* nodes = sl.nodes.data() + K * q;
       const double* N = sl.N.data() + K * q;
@@ -925,6 +1047,10 @@ void Solver::apply_loads() {
       if (updated) {  // (w N rho) c_d
         const Material& mq = materials[p.group[L.idx[q]]];
         for (int a = 0; a < K; ++a) updated_weight_[nodes[a]] += L.w[q] * N[a] * mq.rho * mq.cd;
+      }
+      if (delayed) {
+        const Material& mq = materials[p.group[L.idx[q]]];
+        for (int a = 0; a < K; ++a) delay_rho_[nodes[a]] += L.w[q] * N[a] * mq.rho;
       }
     }
   }
@@ -1027,11 +1153,49 @@ void Solver::grid_update() {
   }
   if (bad) fail_nonfinite();
   if (!has_nodal_dashpot_) return;
+  const bool delayed = !delay_rho_.empty();
+  if (delayed) delay_prepare();
   const long nd = static_cast<long>(dashpot_nodes_.size());
   const long* dnodes = dashpot_nodes_.data();
+  const double gx = opt.gravity_x, gy = opt.gravity_y;
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
   for (long k = 0; k < nd; ++k) {  // each node its own: in parallel, the same values
     const long i = dnodes[k];
+    if (delayed && delay_rho_[i] > 0) {
+      // The delayed closure (delay_strain_velocities): the ring takes this step's start
+      // velocity and force less gravity. An edge node holds half the mass of its layer's
+      // weight times h (w N rho h against rho h^2 / 2); a node the layer reaches only with the
+      // weights of points that moved into the last cell (less than its mass), one lighter than
+      // dt/2 times its block (the explicit dashpot's limit), or one with a block off the axes
+      // takes the trapezoidal update.
+      double* rec = delay_.data() + delay_stride() * delay_slot_[i];
+      const long s = steps % delay_cap_;
+      double* ring = rec + kDelayHead + 4 * s;
+      const double frx = fx[i] - m[i] * gx, fry = fy[i] - m[i] * gy;
+      ring[0] = vx[i];
+      ring[1] = vy[i];
+      ring[2] = frx;
+      ring[3] = fry;
+      const double cxx = grid.cxx[i], cyy = grid.cyy[i];
+      rec[2] = cxx;
+      rec[3] = cyy;
+      rec[4] = delay_rho_[i];
+      rec[5] = -1;
+      if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && cxx > 0 &&
+          cyy > 0 && rec[4] * grid.h >= m[i]) {
+        const double vdx = delay_value(rec, 0, grid.h / (cxx / rec[4] * DT) - 0.5, 0);
+        const double vdy = delay_value(rec, 1, grid.h / (cyy / rec[4] * DT) - 0.5, 0);
+        const double M = rec[4] * grid.h;  // a whole node's mass: rho h times its edge length
+        ux[i] = (fix[i] & 1) ? 0.0 : vx[i] + DT * gx + DT * (frx - cxx * vdx) / M;
+        uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * gy + DT * (fry - cyy * vdy) / M;
+        rec[5] = static_cast<double>(steps);
+        rec[6] = frx;
+        rec[7] = fry;
+        rec[8] = vdx;
+        rec[9] = vdy;
+        continue;
+      }
+    }
     if (m[i] <= floor) continue;
     dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
                      fix[i], ux[i], uy[i]);
@@ -1124,11 +1288,21 @@ void Solver::boundary_work(bool remapped) {
   // sum_q w_q N_i C_q, gives the same work up to round-off.
   if (has_nodal_dashpot_) {
     double w = 0;
+    const double now = static_cast<double>(steps);
     for (const long i : dashpot_nodes_) {
       if (!owns_node(i)) continue;
       double ax, ay, bx, by;
-      vbar(i, ax, ay);
       wbar(i, bx, by);
+      const double* rec = delay_slot_.empty() ? nullptr : delay_record(i);
+      if (rec && rec[5] == now) {
+        // The delayed closure: what it takes out against the conservative update, the force
+        // and its work with the strain velocity (delay_strain_velocities):
+        // (f + C v_d)/2 . wbar + f . (g - g0), f the force less gravity.
+        const double cx = rec[2] * rec[8], cy = rec[3] * rec[9];
+        w += 0.5 * ((rec[6] + cx) * bx + (rec[7] + cy) * by) + rec[6] * rec[10] + rec[7] * rec[11];
+        continue;
+      }
+      vbar(i, ax, ay);
       w += (grid.cxx[i] * ax + grid.cxy[i] * ay) * bx + (grid.cxy[i] * ax + grid.cyy[i] * ay) * by;
     }
     energy.absorbed += dt * w;

@@ -49,6 +49,10 @@ void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool das
   halo_dashpots_ = dashpots;
   dashpot_nodes_.clear();
   dashpot_mark_.assign(grid.nodes(), 0);
+  if (!delay_rho_.empty()) {  // the window's nodes
+    delay_rho_.assign(grid.nodes(), 0.0);
+    delay_map();
+  }
   // This rank's share of the energy account: its particles' energies, nothing booked yet.
   update_energies();
   energy.initial = energy.kinetic + energy.elastic;
@@ -88,6 +92,7 @@ void Solver::sum_halo(bool momentum, bool force) {
     if (halo_dashpots_) {
       for (auto* v : {&grid.cxx, &grid.cxy, &grid.cyy}) f.push_back(v->data());
       if (!updated_weight_.empty()) f.push_back(updated_weight_.data());
+      if (!delay_rho_.empty()) f.push_back(delay_rho_.data());
     }
   }
   const bool bodies = !body_of_group_.empty();

@@ -42,6 +42,7 @@ struct ColumnSpec {
   int pml_cells = 0;        // a perfectly matched layer this many cells thick at the right end
   double pml_alpha = 0;
   bool updated_edge = false;  // MUSL: strain with the updated velocity at the end's dashpot nodes
+  bool delayed_edge = false;  // MUSL, USF: the delayed closure at the end's dashpot nodes
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -68,6 +69,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
     sb.form = c.form;
     sb.anchor = c.anchor;
     sb.updated_velocity = c.updated_edge;
+    sb.delayed = c.delayed_edge;
     s->silents.push_back(sb);
   } else if (c.end == End::Fixed) {
     const double xr = c.offset + L;

@@ -81,6 +81,13 @@ struct SilentBoundary {
   // enough, instead of the re-mapped one (docs/physics.md section 4; the case key
   // "edge_velocity": "updated").
   bool updated_velocity = false;
+  // MUSL and USF, nodal form, one velocity field, 1 particle per cell and the edge on a grid
+  // line: the closure of the scheme's two particle sublattices (docs/physics.md section 4; the
+  // case key "edge_velocity": "delayed"). At this layer's dashpot nodes the dashpot acts with the
+  // node's start velocity of h/c - dt/2 earlier on the node weighed as a whole one, and the
+  // particles are strained with the mean of the re-mapped velocity and the force of as long ago
+  // over the dashpot's coefficient.
+  bool delayed = false;
   bool springs() const { return delta > 0; }
 };
 

@@ -264,6 +264,28 @@ class Solver {
   std::vector<double> edge_velocity_;
   bool usf_edges() const { return !updated_weight_.empty() && opt.scheme == Scheme::USF; }
   void keep_edge_velocities();
+  // Layers with SilentBoundary::delayed: per window node, the sum of w N rho they put on it this
+  // step (empty when there are none); and per node they have reached, a record in delay_ of
+  // delay_stride() values: the whole grid's node (i, j), the last step's blocks C_xx, C_yy and
+  // weight, the step it was last treated as delayed, that step's force less gravity (2), delayed
+  // velocity (2) and change of the strain velocity (2), then a ring of its start velocity and
+  // force less gravity (x, y, fx, fy) over the last delay_cap_ steps. delay_slot_ maps a window
+  // node to its record (-1: none). Part of a checkpoint.
+  std::vector<double> delay_rho_;
+  std::vector<double> delay_;
+  std::vector<int> delay_slot_;
+  int delay_cap_ = 0;
+  double delay_cmin_ = 0;
+  int delay_cap_needed() const;
+  static constexpr int kDelayHead = 12;
+  std::size_t delay_stride() const { return kDelayHead + 4 * static_cast<std::size_t>(delay_cap_); }
+  double* delay_record(long n) {
+    return delay_slot_[n] < 0 ? nullptr : delay_.data() + delay_stride() * delay_slot_[n];
+  }
+  void delay_prepare();
+  void delay_map();  // delay_slot_ from the records' nodes
+  double delay_value(const double* rec, int field, double d, long back) const;
+  void delay_strain_velocities(double* gx, double* gy, bool current);
   // Whether node n, holding `weight` of such layers' impedance, takes v+: it must hold at least
   // dt/2 times that weight of mass (remapped_velocities()).
   bool takes_updated(long n, double weight) const {
