@@ -66,23 +66,25 @@ void put_head(StateWriter& w, const std::string& pre, double dt, double t, long 
   });
 }
 
-// USF with layers strained with the updated velocity (Solver::edge_velocity_): the entries
-// of the nodes in `own` (window numbering, origin o; i1 < i0: every node), ordered by the whole
-// grid's (j, i), so that a rank's part does not depend on the order nodes were met (the reader
-// keys each entry by its node).
-std::vector<double> own_edge_velocities(const std::vector<double>& all, const NodeBox& own,
-                                        std::array<int, 2> o) {
-  std::vector<std::array<double, 5>> e;
-  for (std::size_t k = 0; k < all.size(); k += 5) {
+// Per-node records keyed by the whole grid's node (i, j) in their first two values, `stride`
+// values each (USF's kept edge velocities, Solver::edge_velocity_; the delayed closure's
+// histories, Solver::delay_): those of the nodes in `own` (window numbering, origin o; i1 < i0:
+// every node), ordered by the whole grid's (j, i), so that a rank's part does not depend on the
+// order nodes were met (the reader keys each record by its node).
+std::vector<double> own_node_records(const std::vector<double>& all, std::size_t stride,
+                                     const NodeBox& own, std::array<int, 2> o) {
+  std::vector<std::size_t> at;
+  for (std::size_t k = 0; k + stride <= all.size(); k += stride) {
     const long i = static_cast<long>(all[k]) - o[0], j = static_cast<long>(all[k + 1]) - o[1];
     if (own[1] >= own[0] && (i < own[0] || i > own[1] || j < own[2] || j > own[3])) continue;
-    e.push_back({all[k], all[k + 1], all[k + 2], all[k + 3], all[k + 4]});
+    at.push_back(k);
   }
-  std::sort(e.begin(), e.end(), [](const auto& a, const auto& b) {
-    return a[1] != b[1] ? a[1] < b[1] : a[0] < b[0];
+  std::sort(at.begin(), at.end(), [&](std::size_t a, std::size_t b) {
+    return all[a + 1] != all[b + 1] ? all[a + 1] < all[b + 1] : all[a] < all[b];
   });
   std::vector<double> out;
-  for (const auto& v : e) out.insert(out.end(), v.begin(), v.end());
+  out.reserve(at.size() * stride);
+  for (const std::size_t k : at) out.insert(out.end(), all.begin() + k, all.begin() + k + stride);
   return out;
 }
 
@@ -113,8 +115,13 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   for (const auto& F : fields_) boxes.insert(boxes.end(), F.box.begin(), F.box.end());
   w.put(pre + "field_boxes", boxes);
   if (usf_edges())
-    w.put(pre + "edge_velocity", own_edge_velocities(edge_velocity_, NodeBox{0, -1, 0, -1},
-                                                     window_origin()));
+    w.put(pre + "edge_velocity", own_node_records(edge_velocity_, 5, NodeBox{0, -1, 0, -1},
+                                                  window_origin()));
+  if (!delay_rho_.empty()) {  // the delayed closure's histories
+    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_));
+    w.put(pre + "delay", own_node_records(delay_, delay_stride(), NodeBox{0, -1, 0, -1},
+                                          window_origin()));
+  }
 }
 
 void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
@@ -142,7 +149,12 @@ void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
   w.put(pre + "field_boxes", std::vector<std::int32_t>{});
   // USF's kept edge velocities: each node's from its owner.
   if (usf_edges())
-    w.put_part(pre + "edge_velocity", own_edge_velocities(edge_velocity_, own_, window_origin()));
+    w.put_part(pre + "edge_velocity", own_node_records(edge_velocity_, 5, own_, window_origin()));
+  // The delayed closure's histories: each node's from its owner.
+  if (!delay_rho_.empty()) {
+    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_));
+    w.put_part(pre + "delay", own_node_records(delay_, delay_stride(), own_, window_origin()));
+  }
 }
 
 std::vector<std::string> Solver::particle_blocks(const std::string& pre) {
@@ -170,6 +182,25 @@ void Solver::load_clock(const StateReader& r, const std::string& pre) {
             j == std::floor(j)))
         r.fail("edge_velocity names a node outside the grid (corrupt checkpoint)");
     }
+  }
+  delay_.clear();
+  if (!delay_rho_.empty()) {
+    delay_cap_ = r.get<std::int32_t>(pre + "delay_cap");
+    if (delay_cap_ != delay_cap_needed() && delay_cap_ != 0)
+      r.fail("delay_cap " + std::to_string(delay_cap_) + " in the checkpoint, " +
+             std::to_string(delay_cap_needed()) + " for this case (a checkpoint of another case)");
+    r.get(pre + "delay", delay_);
+    const std::size_t R = delay_stride();
+    if (delay_.size() % R != 0)
+      r.fail("delay holds " + std::to_string(delay_.size()) + " values, not a multiple of " +
+             std::to_string(R) + " (corrupt checkpoint)");
+    for (std::size_t k = 0; k < delay_.size(); k += R) {
+      const double i = delay_[k], j = delay_[k + 1];
+      if (!(i >= 0 && i < grid.nnx && j >= 0 && j < grid.nny && i == std::floor(i) &&
+            j == std::floor(j)))
+        r.fail("delay names a node outside the grid (corrupt checkpoint)");
+    }
+    delay_map();
   }
 }
 

@@ -85,6 +85,21 @@ TEST(Restart, MpmUsfUpdatedEdgeBitIdentical) {
   EXPECT_EQ(from, 300);
 }
 
+// The delayed closure at the silent edge (1 ppc): each edge node's ring of start velocities and
+// forces is state (the dashpot acts with the velocity of h/c earlier), under MUSL and USF. The
+// pulse is at the edge at step 300.
+TEST(Restart, MpmDelayedEdgeBitIdentical) {
+  using namespace hybrid_case_testing;
+  for (const char* scheme : {"MUSL", "USF"}) {
+    json c = small_plate(1, 340);
+    c["scheme"]["update"] = scheme;
+    c["boundaries"][1]["edge_velocity"] = "delayed";
+    const long from = expect_restart_identical(std::string("mpm_delayed_") + scheme, c,
+                                               "checkpoint_every", 100);
+    EXPECT_EQ(from, 300) << scheme;
+  }
+}
+
 // A perfectly matched layer on particles (USL): its displacements and memories are state.
 TEST(Restart, MpmPmlBitIdentical) {
   using namespace hybrid_case_testing;
