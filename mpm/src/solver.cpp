@@ -198,15 +198,13 @@ void Solver::finalize() {
   delay_rho_.assign(delayed ? grid.nodes() : 0, 0.0);
   delay_.clear();
   delay_cap_ = 0;
-  if (delayed) {  // the slowest wave speed of the layers' materials (delay_prepare)
+  if (delayed) {  // the slowest wave speed of the materials (delay_prepare); of every material,
+                  // not the layers' particles': a rank's skeleton has none yet
     double cmin = 0;
-    for (const auto& s : silents)
-      if (s.delayed)
-        for (const uint32_t k : s.layer.idx) {
-          const Material& m = materials[p.group[k]];
-          const double c = m.cs > 0 ? m.cs : m.cd;
-          cmin = cmin > 0 ? std::min(cmin, c) : c;
-        }
+    for (const Material& m : materials) {
+      const double c = m.cs > 0 ? m.cs : m.cd;
+      if (c > 0) cmin = cmin > 0 ? std::min(cmin, c) : c;
+    }
     delay_cmin_ = cmin;
   }
   delay_map();

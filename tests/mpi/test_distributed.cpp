@@ -56,6 +56,7 @@ struct PlateSpec {
   // the particle form, and gravity.
   bool other_layers = false;
   bool updated = false;        // MUSL, USF: the LK edges strained with the updated velocity
+  bool delayed = false;        // MUSL, USF: the LK edges with the delayed closure (1 ppc)
   bool skeleton = false;       // the case without its particles (Solver::seed_nothing)
 };
 
@@ -107,6 +108,7 @@ std::unique_ptr<Solver> make_plate(const PlateSpec& c) {
     sb.layer = s->select_layer(side ? "right" : "left", 0, x, side ? 0 : H, x, side ? H : 0,
                                side ? 1 : -1, 0, h);
     sb.updated_velocity = c.updated;
+    sb.delayed = c.delayed;
     s->silents.push_back(sb);
   }
   SilentBoundary kv;
@@ -114,6 +116,7 @@ std::unique_ptr<Solver> make_plate(const PlateSpec& c) {
   kv.alpha_n = kv.alpha_t = c.spring_alpha;
   kv.layer = s->select_layer("bottom", 0, 0, 0, W, 0, 0, -1, h);
   kv.updated_velocity = c.updated;
+  kv.delayed = c.delayed && !c.springs;
   if (c.springs) kv.delta = 10 * h;
   if (!c.other_layers) s->silents.push_back(kv);
   s->opt.scheme = c.scheme;
@@ -268,6 +271,18 @@ TEST(Ranks, PulsePlateAgreesWithOneProcessEveryScheme) {
     c.scheme = sc;
     c.updated = true;
     expect_layouts_agree(c, 200, std::string(scheme_name(sc)) + ", updated edges");
+  }
+  // The delayed closure at 1 ppc: each edge node's ring of start velocities and forces, kept by
+  // every rank that holds the node (from the sums over the halo), and its delay from the
+  // impedance and weight summed over the halo.
+  for (Scheme sc : {Scheme::MUSL, Scheme::USF}) {
+    PlateSpec c;
+    c.scheme = sc;
+    c.ppc = 1;
+    c.springs = false;
+    c.delayed = true;
+    const Outcome s = expect_layouts_agree(c, 200, std::string(scheme_name(sc)) + ", delayed edges");
+    EXPECT_GT(s.e.absorbed, 0.01 * s.e.external_work) << "the pulse reached the silent layers";
   }
 }
 

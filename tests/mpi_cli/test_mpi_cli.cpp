@@ -547,6 +547,16 @@ TEST(MpiCli, UsfUpdatedEdgeCheckpointOnTwoRanksRestartsOnAnyCount) {
       "ckusf", 300, {0, 4}, 1e-10);
 }
 
+// The delayed closure at the silent edge (MUSL, 1 ppc): the ring of each edge node is state,
+// kept on every rank that holds the node and checkpointed by its owner; the ranks other than 0
+// start as skeletons, so the ring's length must not depend on a rank's particles. Plain on 2
+// ranks and restarts on 1 process and on 4 ranks against the plain run.
+TEST(MpiCli, DelayedEdgeOnRanksAndRestartsOnAnyCount) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  expect_checkpoint_restarts(kCase + kShort + " --set boundaries.1.edge_velocity=delayed",
+                             "ckdelayed", 300, {0, 4}, 1e-10);
+}
+
 // A restart on several ranks: rank 0 reads the whole checkpoint and the others what is not the
 // particles', so rank 0's verdict is every rank's. A checkpoint with a corrupt byte, and one
 // whose particle lies off the grid behind a recomputed checksum (which rank 0 alone sees), are
