@@ -582,15 +582,14 @@ void Solver::keep_edge_velocities() {
 }
 
 // The delayed closure of the LK edge at 1 particle per cell (SilentBoundary::delayed;
-// docs/physics.md section 4). MUSL and USF then strain a particle with its two neighbours'
-// velocities and accelerate it with their stresses: two sublattices, each a staggered scheme of
-// spacing 2h. A right-going wave of such a scheme satisfies sigma = -rho c v(x + h, t) =
-// -rho c v(x, t - h/c) exactly, h/c later than LK's same-point relation; the closure gives each
-// sublattice that relation at the edge node: its dashpot acts with the node's start velocity of
-// h/c - dt/2 earlier (the half step of the leapfrog) on the node weighed as a whole one (the
-// velocity-stress sublattice's ghost stress), and the strain velocity there is the mean of the
-// re-mapped one and the force of as long ago over the dashpot's coefficient (the other
-// sublattice's ghost velocity).
+// docs/physics.md section 4). MUSL and USF then accelerate a particle with its two neighbours'
+// stresses and strain it with their velocities: two sublattices, each a staggered scheme of
+// spacing 2h. A right-going wave of such a scheme satisfies sigma(x + h) = -rho c v(x, t - h/c)
+// exactly, where LK sets sigma(x) = -rho c v(x, t). At an edge node the closure gives the last
+// particle that ghost stress: the dashpot acts with the node's start velocity of h/c - dt/2
+// earlier (the half step of the leapfrog) on the node weighed as a whole one. The normal
+// strain velocity there is the mean of the re-mapped one and the force of as long ago over
+// the dashpot's coefficient, which keeps long runs bounded (delay_strain_velocities).
 int Solver::delay_cap_needed() const {
   return delay_cmin_ > 0 && dt > 0 ? static_cast<int>(std::floor(grid.h / (delay_cmin_ * dt))) + 3
                                    : 3;

@@ -296,7 +296,48 @@ std::vector<Bad> bad_cases() {
       {"silent_with_delta", [](ojson& j) { bnd(j, 2)["delta"] = 0.01; },
        "boundaries[2].delta: unknown key for a silent boundary"},
       {"edge_velocity_unknown", [](ojson& j) { bnd(j, 2)["edge_velocity"] = "update"; },
-       "boundaries[2].edge_velocity: must be one of \"remapped\", \"updated\", got \"update\""},
+       "boundaries[2].edge_velocity: must be one of \"remapped\", \"updated\", \"delayed\", got "
+       "\"update\""},
+      // The delayed closure: MUSL or USF, the nodal form, LK a = b = 1, 1 particle per cell, the
+      // edge on a grid line along an axis.
+      {"delayed_under_usl",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["edge_velocity"] = "delayed";
+       },
+       "boundaries[2].edge_velocity: \"delayed\" applies under scheme.update \"MUSL\" or \"USF\""},
+      {"delayed_lk_coefficient",
+       [](ojson& j) {
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["a"] = 0.5;
+         bnd(j, 2)["edge_velocity"] = "delayed";
+       },
+       "boundaries[2].edge_velocity: \"delayed\" needs a = b = 1"},
+      {"delayed_springs",
+       [](ojson& j) {
+         bnd(j, 2) = {{"type", "kelvin_voigt"}, {"body", "plate"}, {"side", "bottom"},
+                      {"delta", 0.01}, {"edge_velocity", "delayed"}};
+       },
+       "boundaries[2].edge_velocity: \"delayed\" is not available with Kelvin-Voigt springs"},
+      {"delayed_four_ppc",
+       [](ojson& j) {
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["edge_velocity"] = "delayed";
+       },
+       "boundaries[2].edge_velocity: \"delayed\" needs 1 particle per cell (the particle at "
+       "(0.00025, 0.00025) fills 0.25 of a cell)"},
+      {"delayed_off_grid_line",
+       [](ojson& j) {
+         j["bodies"][0]["particles_per_cell"] = 1;
+         j["bodies"][0]["box"] = {0, 0.0003, 0.01, 0.0053};
+         bnd(j, 0) = {{"type", "fixed"}, {"grid_side", "right"}};
+         bnd(j, 1)["width"] = 0.001;
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["edge_velocity"] = "delayed";
+       },
+       "boundaries[2].edge_velocity: \"delayed\" needs the edge on a grid line (the edge at the "
+       "particle at (0.0005, 0.0008) lies 0.3 of a cell off one)"},
       {"edge_velocity_under_usl",
        [](ojson& j) { j["scheme"]["update"] = "USL"; bnd(j, 2)["edge_velocity"] = "updated"; },
        "boundaries[2].edge_velocity: \"updated\" applies under scheme.update \"MUSL\" or \"USF\""},
