@@ -699,6 +699,16 @@ class Builder {
     if (bnd)
       for (std::size_t i = 0; i < bnd->size(); ++i)
         parse_boundary(Obj(ctx_, (*bnd)[i], index_path("boundaries", i)), i, c);
+    // The delayed closure reads a node's whole block as its own edge's (docs/physics.md section 4).
+    if (!delayed_at_.empty()) {
+      bool others = !s_->dampers.empty() || !s_->pml_bands.empty();
+      for (const auto& sl : s_->silents)
+        others = others || (!sl.delayed && (sl.form == SilentForm::Nodal || sl.springs()));
+      if (others)
+        ctx_.fail(delayed_at_ + ".edge_velocity",
+                  "\"delayed\" must be on every nodal silent edge of the case, with no "
+                  "kelvin_voigt, damping_layer or pml (their blocks would share its nodes)");
+    }
     if (checking_) return c;  // no solver: the keys are read
 
     if (!skeleton_) note_particles_on_grid_lines(c);
@@ -756,6 +766,7 @@ class Builder {
   bool skeleton_;        // this rank builds the case without its particles
   bool scattered_ = false;  // scatter_, and the case allows it
   GridSpec grid_;
+  std::string delayed_at_;  // the first boundary with "edge_velocity": "delayed"
   std::unique_ptr<Solver> s_ = std::make_unique<Solver>();
   std::vector<Material> materials_;
   std::map<std::string, int> material_index_;
@@ -1378,6 +1389,8 @@ class Builder {
       need(type == "silent", "is not available with Kelvin-Voigt springs");
       need(sb.a == 1 && sb.b == 1, "needs a = b = 1 (its delay is the waves' travel time over a "
                                    "cell, h / c_d and h / c_s)");
+      need(sb.anchor == Anchor::Boundary, "needs \"anchor\": \"boundary\"");
+      need(s_->opt.shape == ShapeKind::Bilinear, "needs scheme.shape \"bilinear\"");
       // Its derivation holds for 1 particle per cell and an edge on a grid line along an axis
       // (docs/physics.md section 4): checked at each of the layer's particles.
       const Particles& P = s_->p;
@@ -1396,7 +1409,13 @@ class Builder {
         const double off = std::abs(e - std::round(e));
         need(off <= 1e-6, "needs the edge on a grid line (the edge at " + at + " lies " + fmt(off) +
                               " of a cell off one)");
+        need(s_->materials[P.group[k]].cs > 0, "needs a material with a shear wave speed (" + at +
+                                                   " has none)");
+        // The blocks exactly on the axes (the closure runs where C_xy is 0).
+        sb.layer.nx[q] = along_x ? std::copysign(1.0, nx) : 0.0;
+        sb.layer.ny[q] = along_x ? 0.0 : std::copysign(1.0, ny);
       }
+      delayed_at_ = o.path();
       sb.delayed = true;
     }
     if (edge_velocity == "updated") {

@@ -48,6 +48,12 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
     throw HybridError(std::string("hybrid: the MPM region must use scheme.shape \"bilinear\" (its "
                                   "grid shares nodes with Q1 elements), got \"") +
                       shape_name(mpm_.opt.shape) + "\"");
+  for (const SilentBoundary& sl : mpm_.silents)
+    if (sl.delayed)
+      throw HybridError("hybrid: the MPM region's silent edge \"" + sl.layer.name +
+                        "\" has \"edge_velocity\": \"delayed\", which the coupled step does "
+                        "not support (its interface nodes take the FE region's velocity); use "
+                        "\"remapped\" or \"updated\"");
   if (fe_.degree() != 1)
     throw HybridError("hybrid: the FEM region must use fem.degree 1 (Q1, like the MPM grid), got " +
                       std::to_string(fe_.degree()));

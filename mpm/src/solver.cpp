@@ -627,6 +627,7 @@ void Solver::delay_prepare() {
     rec[0] = static_cast<double>(n % grid.nnx + o[0]);
     rec[1] = static_cast<double>(n / grid.nnx + o[1]);
     rec[5] = -1;
+    rec[12] = -2;
   }
 }
 
@@ -1163,9 +1164,12 @@ void Solver::grid_update() {
       // velocity and force less gravity. An edge node holds half the mass of its layer's
       // weight times h (w N rho h against rho h^2 / 2); a node the layer reaches only with the
       // weights of points that moved into the last cell (less than its mass), one lighter than
-      // dt/2 times its block (the explicit dashpot's limit), or one with a block off the axes
-      // takes the trapezoidal update.
+      // dt/2 times its block (the explicit dashpot's limit), one with a block off the axes, or
+      // one whose ring does not yet reach back the delay takes the trapezoidal update.
       double* rec = delay_.data() + delay_stride() * delay_slot_[i];
+      // A node whose ring missed a step (not reached by the layer then) starts its history anew.
+      if (rec[12] != static_cast<double>(steps - 1)) rec[13] = static_cast<double>(steps);
+      rec[12] = static_cast<double>(steps);
       const long s = steps % delay_cap_;
       double* ring = rec + kDelayHead + 4 * s;
       const double frx = fx[i] - m[i] * gx, fry = fy[i] - m[i] * gy;
@@ -1178,10 +1182,14 @@ void Solver::grid_update() {
       rec[3] = cyy;
       rec[4] = delay_rho_[i];
       rec[5] = -1;
-      if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && cxx > 0 &&
-          cyy > 0 && rec[4] * grid.h >= m[i]) {
-        const double vdx = delay_value(rec, 0, grid.h / (cxx / rec[4] * DT) - 0.5, 0);
-        const double vdy = delay_value(rec, 1, grid.h / (cyy / rec[4] * DT) - 0.5, 0);
+      const bool blocks = cxx > 0 && cyy > 0;
+      const double dx = blocks ? grid.h / (cxx / rec[4] * DT) - 0.5 : 0.0;
+      const double dy = blocks ? grid.h / (cyy / rec[4] * DT) - 0.5 : 0.0;
+      const double history = static_cast<double>(steps) - rec[13];  // entries before this one
+      if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
+          rec[4] * grid.h >= m[i] && std::floor(std::max(dx, dy)) + 1 <= history) {
+        const double vdx = delay_value(rec, 0, dx, 0);
+        const double vdy = delay_value(rec, 1, dy, 0);
         const double M = rec[4] * grid.h;  // a whole node's mass: rho h times its edge length
         ux[i] = (fix[i] & 1) ? 0.0 : vx[i] + DT * gx + DT * (frx - cxx * vdx) / M;
         uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * gy + DT * (fry - cyy * vdy) / M;

@@ -118,7 +118,7 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
     w.put(pre + "edge_velocity", own_node_records(edge_velocity_, 5, NodeBox{0, -1, 0, -1},
                                                   window_origin()));
   if (!delay_rho_.empty()) {  // the delayed closure's histories
-    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_));
+    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_needed()));
     w.put(pre + "delay", own_node_records(delay_, delay_stride(), NodeBox{0, -1, 0, -1},
                                           window_origin()));
   }
@@ -152,7 +152,7 @@ void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
     w.put_part(pre + "edge_velocity", own_node_records(edge_velocity_, 5, own_, window_origin()));
   // The delayed closure's histories: each node's from its owner.
   if (!delay_rho_.empty()) {
-    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_));
+    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_needed()));
     w.put_part(pre + "delay", own_node_records(delay_, delay_stride(), own_, window_origin()));
   }
 }

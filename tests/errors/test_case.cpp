@@ -320,6 +320,31 @@ std::vector<Bad> bad_cases() {
                       {"delta", 0.01}, {"edge_velocity", "delayed"}};
        },
        "boundaries[2].edge_velocity: \"delayed\" is not available with Kelvin-Voigt springs"},
+      {"delayed_particle_anchor",
+       [](ojson& j) {
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["anchor"] = "particle";
+         bnd(j, 2)["edge_velocity"] = "delayed";
+       },
+       "boundaries[2].edge_velocity: \"delayed\" needs \"anchor\": \"boundary\""},
+      {"delayed_bspline",
+       [](ojson& j) {
+         j["scheme"]["shape"] = "bspline";
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["edge_velocity"] = "delayed";
+       },
+       "boundaries[2].edge_velocity: \"delayed\" needs scheme.shape \"bilinear\""},
+      {"delayed_with_damping_layer",
+       [](ojson& j) {
+         j["bodies"][0]["particles_per_cell"] = 1;
+         bnd(j, 1)["width"] = 0.001;
+         bnd(j, 2)["form"] = "nodal";
+         bnd(j, 2)["edge_velocity"] = "delayed";
+         j["boundaries"].push_back(
+             {{"type", "damping_layer"}, {"body", "plate"}, {"side", "top"}, {"width", 0.002}});
+       },
+       "boundaries[2].edge_velocity: \"delayed\" must be on every nodal silent edge of the case, "
+       "with no kelvin_voigt, damping_layer or pml"},
       {"delayed_four_ppc",
        [](ojson& j) {
          bnd(j, 2)["form"] = "nodal";

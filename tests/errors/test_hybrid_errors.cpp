@@ -188,3 +188,19 @@ TEST(HybridErrors, LayerOnTheSharedNodes) {
         << e;
   }
 }
+
+// The delayed closure of an MPM silent edge: the coupled step's interface takes the FE region's
+// velocity, which the closure's ring does not follow: refused, naming the edge.
+TEST(HybridErrors, DelayedSilentEdge) {
+  auto s = particles();
+  const double h = 1e-3;
+  SilentBoundary sb;
+  sb.layer = s->select_layer("bottom", 0, 0, 0, 20 * h, 0, 0, -1, h);
+  sb.delayed = true;
+  s->silents.push_back(sb);
+  auto f = elements(20e-3, 1e-3);
+  const std::string e = error_of([&] { Hybrid hy(*s, *f); });
+  EXPECT_NE(e.find("the MPM region's silent edge \"bottom\" has \"edge_velocity\": \"delayed\""),
+            std::string::npos)
+      << e;
+}

@@ -268,16 +268,17 @@ class Solver {
   // step (empty when there are none); and per node they have reached, a record in delay_ of
   // delay_stride() values: the whole grid's node (i, j), the last step's blocks C_xx, C_yy and
   // weight, the step it was last treated as delayed, that step's force less gravity (2), delayed
-  // velocity (2) and change of the strain velocity (2), then a ring of its start velocity and
-  // force less gravity (x, y, fx, fy) over the last delay_cap_ steps. delay_slot_ maps a window
-  // node to its record (-1: none). Part of a checkpoint.
+  // velocity (2) and change of the strain velocity (2), the last step its ring was written and
+  // the first of that unbroken run of steps, then a ring of its start velocity and force less
+  // gravity (x, y, fx, fy) over the last delay_cap_ steps. delay_slot_ maps a window node to its
+  // record (-1: none). Part of a checkpoint.
   std::vector<double> delay_rho_;
   std::vector<double> delay_;
   std::vector<int> delay_slot_;
   int delay_cap_ = 0;
   double delay_cmin_ = 0;
   int delay_cap_needed() const;
-  static constexpr int kDelayHead = 12;
+  static constexpr int kDelayHead = 14;
   std::size_t delay_stride() const { return kDelayHead + 4 * static_cast<std::size_t>(delay_cap_); }
   double* delay_record(long n) {
     return delay_slot_[n] < 0 ? nullptr : delay_.data() + delay_stride() * delay_slot_[n];
