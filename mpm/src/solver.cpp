@@ -150,6 +150,10 @@ long Solver::first_particle_outside() const {
 
 void Solver::finalize() {
   nthreads_ = opt.threads > 0 ? opt.threads : omp_get_max_threads();
+  if (!dist_) {
+    whole_x0_ = grid.x0;
+    whole_y0_ = grid.y0;
+  }
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
   for (const Material& m : materials)
     if (m.model == Model::J2Film && !p.has_film()) p.enable_film();
@@ -1788,10 +1792,15 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
   // Per probe: the 4 nodes of its cell; accumulate m, m*field for each.
   struct Acc { double m[4] = {0, 0, 0, 0}, f[4][6] = {}; int ci, cj; Bilinear sf; };
   std::vector<Acc> acc(np);
+  // The probe's cell and weights from the whole grid's origin, the same on every rank: from a
+  // window's own origin a point on a grid line can fall in the next cell on one rank, and the
+  // ranks' sums of the cell's four nodes would then mix two cells.
+  const std::array<int, 2> o = window_origin();
+  const double X0 = dist_ ? whole_x0_ : grid.x0, Y0 = dist_ ? whole_y0_ : grid.y0;
   for (std::size_t q = 0; q < np; ++q) {
-    acc[q].sf.eval(pts[q][0], pts[q][1], grid.x0, grid.y0, grid.inv_h);
-    acc[q].ci = acc[q].sf.ci;
-    acc[q].cj = acc[q].sf.cj;
+    acc[q].sf.eval(pts[q][0], pts[q][1], X0, Y0, grid.inv_h);
+    acc[q].ci = acc[q].sf.ci - o[0];
+    acc[q].cj = acc[q].sf.cj - o[1];
   }
   // Many probes (curve probes): the probes near each cell (their cell within one of it) as a
   // sorted (cell, probe) list, so that a particle visits only the probes it can reach; with

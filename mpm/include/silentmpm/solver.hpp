@@ -293,6 +293,9 @@ class Solver {
     return weight > 0 && grid.m[n] > mass_floor_ && 0.5 * dt * weight <= grid.m[n];
   }
   std::array<int, 2> window_origin() const;  // the whole grid's node of the window's (0, 0)
+  // The whole grid's origin (finalize, before a split). A window's origin x0 + i0 h differs
+  // from it in round-off: a point's cell is found from this one, the same on every rank.
+  double whole_x0_ = 0, whole_y0_ = 0;
   bool usf_remapped_power() const;
   double mass_floor_ = 0;
   double viscous_beta_ = -1;  // the largest beta at a particle (finalize()); -1: not yet
