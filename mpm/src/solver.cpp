@@ -595,8 +595,9 @@ void Solver::keep_edge_velocities() {
 // strain velocity there is the mean of the re-mapped one and the force of as long ago over
 // the dashpot's coefficient, which keeps long runs bounded (delay_strain_velocities).
 int Solver::delay_cap_needed() const {
-  return delay_cmin_ > 0 && dt > 0 ? static_cast<int>(std::floor(grid.h / (delay_cmin_ * dt))) + 3
-                                   : 3;
+  if (!(delay_cmin_ > 0 && dt > 0)) return 3;
+  // (Bounded: a delay of a million steps would mean a wave that never crosses a cell.)
+  return static_cast<int>(std::min(std::floor(grid.h / (delay_cmin_ * dt)), 1e6)) + 3;
 }
 
 void Solver::delay_map() {
@@ -1165,11 +1166,13 @@ void Solver::grid_update() {
     const long i = dnodes[k];
     if (delayed && delay_rho_[i] > 0) {
       // The delayed closure (delay_strain_velocities): the ring takes this step's start
-      // velocity and force less gravity. An edge node holds half the mass of its layer's
-      // weight times h (w N rho h against rho h^2 / 2); a node the layer reaches only with the
-      // weights of points that moved into the last cell (less than its mass), one lighter than
-      // dt/2 times its block (the explicit dashpot's limit), one with a block off the axes, or
-      // one whose ring does not yet reach back the delay takes the trapezoidal update.
+      // velocity and force less gravity. An edge node on its grid line holds half its layer's
+      // weight times h (w N rho h against rho h^2 / 2). A node whose mass is off that by more
+      // than kDelayMassTolerance (the layer reaches it only through points moved into the last
+      // cell, or the end has drifted off the grid line: the closure's premise is gone), one
+      // lighter than dt/2 times its block (the explicit dashpot's limit), one with a block off
+      // the axes, or one whose ring does not yet reach back the delay takes the trapezoidal
+      // update.
       double* rec = delay_.data() + delay_stride() * delay_slot_[i];
       // A node whose ring missed a step (not reached by the layer then) starts its history anew.
       if (rec[12] != static_cast<double>(steps - 1)) rec[13] = static_cast<double>(steps);
@@ -1190,8 +1193,10 @@ void Solver::grid_update() {
       const double dx = blocks ? grid.h / (cxx / rec[4] * DT) - 0.5 : 0.0;
       const double dy = blocks ? grid.h / (cyy / rec[4] * DT) - 0.5 : 0.0;
       const double history = static_cast<double>(steps) - rec[13];  // entries before this one
+      const double half = 0.5 * rec[4] * grid.h;  // an edge node's mass on its grid line
       if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
-          rec[4] * grid.h >= m[i] && std::floor(std::max(dx, dy)) + 1 <= history) {
+          std::abs(m[i] - half) <= kDelayMassTolerance * half &&
+          std::floor(std::max(dx, dy)) + 1 <= history) {
         const double vdx = delay_value(rec, 0, dx, 0);
         const double vdy = delay_value(rec, 1, dy, 0);
         const double M = rec[4] * grid.h;  // a whole node's mass: rho h times its edge length

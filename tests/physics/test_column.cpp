@@ -384,17 +384,22 @@ TEST(KelvinVoigt, ReflectionMatchesClosedForm) {
 // (The spring ends 0.34 % above the weight in MUSL and USF, exact in USL or with the particle
 // anchor: the sudden load leaves a node-to-node checkerboard of grid forces, +-280 N against a
 // 48 kN weight, that particles at cell centres do not see and MUSL's re-map never damps; the
-// end node carries part of it.)
+// end node carries part of it.) The delayed closure's end sinks as LK's (its ring holds the
+// steady velocity, its block the same dashpot): 2.659e-5 m against LK's 2.654e-5 and the
+// estimate 2.649e-5. A delayed end under a load it cannot carry drifts off its grid line; past 5 %
+// of a cell it takes the trapezoidal update (docs/physics.md section 4).
 TEST(KelvinVoigt, ColumnUnderGravity) {
   const Material m = tungsten();
   const double g = 2e4, h = 1e-3, L = 40 * h, M = m.rho * m.cd * m.cd;  // rho g L = 12 MPa
-  for (End end : {End::KelvinVoigt, End::Silent}) {
+  for (int variant = 0; variant < 3; ++variant) {
+    const End end = variant == 0 ? End::KelvinVoigt : End::Silent;
     ColumnSpec c;
     c.cells = 40;
     c.end = end;
     c.delta = L;
     c.amplitude = 0;
     c.gravity = g;
+    c.delayed_edge = variant == 2;
     auto s = make_column(c);
     const auto x0 = start_positions(*s);
     while (s->t < 30 * L / m.cd) s->step();
@@ -417,7 +422,8 @@ TEST(KelvinVoigt, ColumnUnderGravity) {
     } else {
       // Terminal velocity g L / c_d: after 30 transits the end has sunk by about 29 L/c_d * g L/c_d.
       const double sink = 29 * (L / m.cd) * (g * L / m.cd);
-      std::printf("  [LK] end displacement %.6e m (terminal-velocity estimate %.6e)\n", u, sink);
+      std::printf("  [LK%s] end displacement %.6e m (terminal-velocity estimate %.6e)\n",
+                  c.delayed_edge ? ", delayed" : "", u, sink);
       EXPECT_NEAR(u, sink, 0.1 * sink);
     }
   }

@@ -279,6 +279,9 @@ class Solver {
   double delay_cmin_ = 0;
   int delay_cap_needed() const;
   static constexpr int kDelayHead = 14;
+  // How far an edge node's mass may be from half its layer's weight times h (an end that has
+  // drifted by 5 % of a cell) and still take the delayed closure.
+  static constexpr double kDelayMassTolerance = 0.1;
   std::size_t delay_stride() const { return kDelayHead + 4 * static_cast<std::size_t>(delay_cap_); }
   double* delay_record(long n) {
     return delay_slot_[n] < 0 ? nullptr : delay_.data() + delay_stride() * delay_slot_[n];
