@@ -1401,7 +1401,8 @@ class Builder {
         const std::string at = "the particle at (" + fmt(P.x[k]) + ", " + fmt(P.y[k]) + ")";
         need(std::abs(P.vol[k] - cell) <= 1e-6 * cell,
              "needs 1 particle per cell (" + at + " fills " + fmt(P.vol[k] / cell) + " of a cell)");
-        const bool along_x = std::abs(std::abs(nx) - 1) < 1e-12, along_y = std::abs(std::abs(ny) - 1) < 1e-12;
+        const bool along_x = std::abs(std::abs(nx) - 1) < 1e-12;
+        const bool along_y = std::abs(std::abs(ny) - 1) < 1e-12;
         need(along_x || along_y, "needs an edge along the grid's axes (" + at + " has the normal (" +
                                      fmt(nx) + ", " + fmt(ny) + "))");
         const double e = along_x ? (P.x[k] + sb.layer.d[q] * nx - grid_.x0) / h

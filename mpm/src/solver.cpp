@@ -606,8 +606,8 @@ void Solver::delay_map() {
   const std::array<int, 2> o = window_origin();
   const std::size_t R = delay_stride();
   for (std::size_t r = 0; r * R < delay_.size(); ++r) {
-    const long i = static_cast<long>(delay_[r * R]) - o[0];
-    const long j = static_cast<long>(delay_[r * R + 1]) - o[1];
+    const long i = static_cast<long>(delay_[r * R + kDelayI]) - o[0];
+    const long j = static_cast<long>(delay_[r * R + kDelayJ]) - o[1];
     if (i >= 0 && j >= 0 && i < grid.nnx && j < grid.nny)
       delay_slot_[j * grid.nnx + i] = static_cast<int>(r);
   }
@@ -629,10 +629,10 @@ void Solver::delay_prepare() {
     delay_slot_[n] = static_cast<int>(delay_.size() / R);
     delay_.resize(delay_.size() + R, 0.0);
     double* rec = delay_.data() + delay_.size() - R;
-    rec[0] = static_cast<double>(n % grid.nnx + o[0]);
-    rec[1] = static_cast<double>(n / grid.nnx + o[1]);
-    rec[5] = -1;
-    rec[12] = -2;
+    rec[kDelayI] = static_cast<double>(n % grid.nnx + o[0]);
+    rec[kDelayJ] = static_cast<double>(n / grid.nnx + o[1]);
+    rec[kDelayAt] = -1;
+    rec[kDelayWritten] = -2;
   }
 }
 
@@ -661,22 +661,22 @@ void Solver::delay_strain_velocities(double* gx, double* gy, bool current) {
   const std::array<int, 2> o = window_origin();
   for (std::size_t r = 0; r * R < delay_.size(); ++r) {
     double* rec = delay_.data() + r * R;
-    rec[10] = rec[11] = 0;
-    if (rec[5] != want) continue;
-    const long i = static_cast<long>(rec[0]) - o[0], j = static_cast<long>(rec[1]) - o[1];
+    rec[kDelayDgx] = rec[kDelayDgy] = 0;
+    if (rec[kDelayAt] != want) continue;
+    const long i = static_cast<long>(rec[kDelayI]) - o[0], j = static_cast<long>(rec[kDelayJ]) - o[1];
     if (i < 0 || j < 0 || i >= grid.nnx || j >= grid.nny) continue;
     const long n = j * grid.nnx + i;
     if (!(grid.m[n] > mass_floor_)) continue;
-    const double c[2] = {rec[2], rec[3]};
+    const double c[2] = {rec[kDelayCxx], rec[kDelayCyy]};
     double* g[2] = {gx, gy};
     for (int a = 0; a < 2; ++a) {
       // The normal component only (the larger block: c_d against c_s; none at a corner, where
       // the two are alike): the tangential one made the column's edge unstable within 2 000
       // steps, and without the normal one a run grew after 4-9 * 10^4 (docs/physics.md).
       if ((grid.fix[n] & (1 << a)) || !(c[a] > c[1 - a])) continue;
-      const double d = grid.h / (c[a] / rec[4] * dt) - 0.5;
+      const double d = grid.h / (c[a] / rec[kDelayRho] * dt) - 0.5;
       const double ng = 0.5 * (g[a][n] + delay_value(rec, 2 + a, d, back) / c[a]);
-      rec[10 + a] = ng - g[a][n];
+      rec[kDelayDgx + a] = ng - g[a][n];
       g[a][n] = ng;
     }
   }
@@ -1175,8 +1175,9 @@ void Solver::grid_update() {
       // update.
       double* rec = delay_.data() + delay_stride() * delay_slot_[i];
       // A node whose ring missed a step (not reached by the layer then) starts its history anew.
-      if (rec[12] != static_cast<double>(steps - 1)) rec[13] = static_cast<double>(steps);
-      rec[12] = static_cast<double>(steps);
+      if (rec[kDelayWritten] != static_cast<double>(steps - 1))
+        rec[kDelayRunFrom] = static_cast<double>(steps);
+      rec[kDelayWritten] = static_cast<double>(steps);
       const long s = steps % delay_cap_;
       double* ring = rec + kDelayHead + 4 * s;
       const double frx = fx[i] - m[i] * gx, fry = fy[i] - m[i] * gy;
@@ -1185,28 +1186,28 @@ void Solver::grid_update() {
       ring[2] = frx;
       ring[3] = fry;
       const double cxx = grid.cxx[i], cyy = grid.cyy[i];
-      rec[2] = cxx;
-      rec[3] = cyy;
-      rec[4] = delay_rho_[i];
-      rec[5] = -1;
+      rec[kDelayCxx] = cxx;
+      rec[kDelayCyy] = cyy;
+      rec[kDelayRho] = delay_rho_[i];
+      rec[kDelayAt] = -1;
       const bool blocks = cxx > 0 && cyy > 0;
-      const double dx = blocks ? grid.h / (cxx / rec[4] * DT) - 0.5 : 0.0;
-      const double dy = blocks ? grid.h / (cyy / rec[4] * DT) - 0.5 : 0.0;
-      const double history = static_cast<double>(steps) - rec[13];  // entries before this one
-      const double half = 0.5 * rec[4] * grid.h;  // an edge node's mass on its grid line
+      const double dx = blocks ? grid.h / (cxx / rec[kDelayRho] * DT) - 0.5 : 0.0;
+      const double dy = blocks ? grid.h / (cyy / rec[kDelayRho] * DT) - 0.5 : 0.0;
+      const double history = static_cast<double>(steps) - rec[kDelayRunFrom];  // entries before
+      const double half = 0.5 * rec[kDelayRho] * grid.h;  // an edge node's mass on its line
       if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
           std::abs(m[i] - half) <= kDelayMassTolerance * half &&
           std::floor(std::max(dx, dy)) + 1 <= history) {
         const double vdx = delay_value(rec, 0, dx, 0);
         const double vdy = delay_value(rec, 1, dy, 0);
-        const double M = rec[4] * grid.h;  // a whole node's mass: rho h times its edge length
+        const double M = rec[kDelayRho] * grid.h;  // a whole node's mass: rho h times its edge length
         ux[i] = (fix[i] & 1) ? 0.0 : vx[i] + DT * gx + DT * (frx - cxx * vdx) / M;
         uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * gy + DT * (fry - cyy * vdy) / M;
-        rec[5] = static_cast<double>(steps);
-        rec[6] = frx;
-        rec[7] = fry;
-        rec[8] = vdx;
-        rec[9] = vdy;
+        rec[kDelayAt] = static_cast<double>(steps);
+        rec[kDelayFx] = frx;
+        rec[kDelayFy] = fry;
+        rec[kDelayVx] = vdx;
+        rec[kDelayVy] = vdy;
         continue;
       }
     }
@@ -1308,12 +1309,13 @@ void Solver::boundary_work(bool remapped) {
       double ax, ay, bx, by;
       wbar(i, bx, by);
       const double* rec = delay_slot_.empty() ? nullptr : delay_record(i);
-      if (rec && rec[5] == now) {
+      if (rec && rec[kDelayAt] == now) {
         // The delayed closure: what it takes out against the conservative update, the force
         // and its work with the strain velocity (delay_strain_velocities):
         // (f + C v_d)/2 . wbar + f . (g - g0), f the force less gravity.
-        const double cx = rec[2] * rec[8], cy = rec[3] * rec[9];
-        w += 0.5 * ((rec[6] + cx) * bx + (rec[7] + cy) * by) + rec[6] * rec[10] + rec[7] * rec[11];
+        const double fx = rec[kDelayFx], fy = rec[kDelayFy];
+        const double cx = rec[kDelayCxx] * rec[kDelayVx], cy = rec[kDelayCyy] * rec[kDelayVy];
+        w += 0.5 * ((fx + cx) * bx + (fy + cy) * by) + fx * rec[kDelayDgx] + fy * rec[kDelayDgy];
         continue;
       }
       vbar(i, ax, ay);

@@ -117,11 +117,9 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   if (usf_edges())
     w.put(pre + "edge_velocity", own_node_records(edge_velocity_, 5, NodeBox{0, -1, 0, -1},
                                                   window_origin()));
-  if (!delay_rho_.empty()) {  // the delayed closure's histories
-    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_needed()));
+  if (!delay_rho_.empty())  // the delayed closure's histories (records of delay_cap_needed())
     w.put(pre + "delay", own_node_records(delay_, delay_stride(), NodeBox{0, -1, 0, -1},
                                           window_origin()));
-  }
 }
 
 void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
@@ -151,10 +149,8 @@ void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
   if (usf_edges())
     w.put_part(pre + "edge_velocity", own_node_records(edge_velocity_, 5, own_, window_origin()));
   // The delayed closure's histories: each node's from its owner.
-  if (!delay_rho_.empty()) {
-    w.put(pre + "delay_cap", static_cast<std::int32_t>(delay_cap_needed()));
+  if (!delay_rho_.empty())
     w.put_part(pre + "delay", own_node_records(delay_, delay_stride(), own_, window_origin()));
-  }
 }
 
 std::vector<std::string> Solver::particle_blocks(const std::string& pre) {
@@ -171,36 +167,28 @@ void Solver::load_clock(const StateReader& r, const std::string& pre) {
   energy = r.get<Energies>(pre + "energy");
   contact.dissipated = r.get<double>(pre + "contact_dissipated");
   edge_velocity_.clear();
-  if (usf_edges()) {
-    r.get(pre + "edge_velocity", edge_velocity_);
-    if (edge_velocity_.size() % 5 != 0)
-      r.fail("edge_velocity holds " + std::to_string(edge_velocity_.size()) +
-             " values, not a multiple of 5 (corrupt checkpoint)");
-    for (std::size_t k = 0; k < edge_velocity_.size(); k += 5) {
-      const double i = edge_velocity_[k], j = edge_velocity_[k + 1];
-      if (!(i >= 0 && i < grid.nnx && j >= 0 && j < grid.nny && i == std::floor(i) &&
-            j == std::floor(j)))
-        r.fail("edge_velocity names a node outside the grid (corrupt checkpoint)");
-    }
-  }
+  if (usf_edges()) read_node_records(r, pre, "edge_velocity", 5, edge_velocity_);
   delay_.clear();
-  if (!delay_rho_.empty()) {
-    delay_cap_ = r.get<std::int32_t>(pre + "delay_cap");
-    if (delay_cap_ != delay_cap_needed() && delay_cap_ != 0)
-      r.fail("delay_cap " + std::to_string(delay_cap_) + " in the checkpoint, " +
-             std::to_string(delay_cap_needed()) + " for this case (a checkpoint of another case)");
-    r.get(pre + "delay", delay_);
-    const std::size_t R = delay_stride();
-    if (delay_.size() % R != 0)
-      r.fail("delay holds " + std::to_string(delay_.size()) + " values, not a multiple of " +
-             std::to_string(R) + " (corrupt checkpoint)");
-    for (std::size_t k = 0; k < delay_.size(); k += R) {
-      const double i = delay_[k], j = delay_[k + 1];
-      if (!(i >= 0 && i < grid.nnx && j >= 0 && j < grid.nny && i == std::floor(i) &&
-            j == std::floor(j)))
-        r.fail("delay names a node outside the grid (corrupt checkpoint)");
-    }
+  if (!delay_rho_.empty()) {  // records of the ring this case's dt and materials need
+    delay_cap_ = delay_cap_needed();
+    read_node_records(r, pre, "delay", delay_stride(), delay_);
     delay_map();
+  }
+}
+
+// Records keyed by the whole grid's node (i, j) in their first two values (own_node_records):
+// a whole number of them, each naming a node of the grid.
+void Solver::read_node_records(const StateReader& r, const std::string& pre, const std::string& name,
+                               std::size_t stride, std::vector<double>& v) const {
+  r.get(pre + name, v);
+  if (v.size() % stride != 0)
+    r.fail(name + " holds " + std::to_string(v.size()) + " values, not a multiple of " +
+           std::to_string(stride) + " (corrupt checkpoint)");
+  for (std::size_t k = 0; k < v.size(); k += stride) {
+    const double i = v[k], j = v[k + 1];
+    if (!(i >= 0 && i < grid.nnx && j >= 0 && j < grid.nny && i == std::floor(i) &&
+          j == std::floor(j)))
+      r.fail(name + " names a node outside the grid (corrupt checkpoint)");
   }
 }
 

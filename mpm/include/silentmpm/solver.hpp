@@ -224,8 +224,8 @@ class Solver {
   // are then re-sorted, and sums over them run in another order. Throws StateError.
   bool load_state(const StateReader& r, const std::string& prefix);
   // The part of load_state that is not the particles' (the clock, the time step's check, the
-  // energy account, contact dissipation, USF's kept edge velocities): what a rank whose
-  // particles rank 0 sends it reads (docs/parallel.md "Set-up").
+  // energy account, contact dissipation, USF's kept edge velocities, the delayed closure's
+  // histories): what a rank whose particles rank 0 sends it reads (docs/parallel.md "Set-up").
   void load_clock(const StateReader& r, const std::string& prefix);
   // The prefixes of the blocks that hold the particles and their layer entries (what
   // load_clock does not read).
@@ -266,19 +266,27 @@ class Solver {
   void keep_edge_velocities();
   // Layers with SilentBoundary::delayed: per window node, the sum of w N rho they put on it this
   // step (empty when there are none); and per node they have reached, a record in delay_ of
-  // delay_stride() values: the whole grid's node (i, j), the last step's blocks C_xx, C_yy and
-  // weight, the step it was last treated as delayed, that step's force less gravity (2), delayed
-  // velocity (2) and change of the strain velocity (2), the last step its ring was written and
-  // the first of that unbroken run of steps, then a ring of its start velocity and force less
-  // gravity (x, y, fx, fy) over the last delay_cap_ steps. delay_slot_ maps a window node to its
-  // record (-1: none). Part of a checkpoint.
+  // delay_stride() values, the fields of Delay, then a ring of its start velocity and force less
+  // gravity (x, y, fx, fy) over the last delay_cap_ steps (delay_cap_needed(), from dt and the
+  // materials). delay_slot_ maps a window node to its record (-1: none). Part of a checkpoint.
+  enum Delay : int {
+    kDelayI, kDelayJ,          // the whole grid's node
+    kDelayCxx, kDelayCyy,      // the last step's blocks
+    kDelayRho,                 // and weight, sum of w N rho
+    kDelayAt,                  // the step it was last treated as delayed (-1: none yet)
+    kDelayFx, kDelayFy,        // that step's force less gravity
+    kDelayVx, kDelayVy,        // its delayed velocity
+    kDelayDgx, kDelayDgy,      // the change of the strain velocity (boundary_work's account)
+    kDelayWritten,             // the last step its ring was written
+    kDelayRunFrom,             // the first of that unbroken run of steps
+    kDelayHead
+  };
   std::vector<double> delay_rho_;
   std::vector<double> delay_;
   std::vector<int> delay_slot_;
   int delay_cap_ = 0;
   double delay_cmin_ = 0;
   int delay_cap_needed() const;
-  static constexpr int kDelayHead = 14;
   // How far an edge node's mass may be from half its layer's weight times h (an end that has
   // drifted by 5 % of a cell) and still take the delayed closure.
   static constexpr double kDelayMassTolerance = 0.1;
@@ -287,6 +295,8 @@ class Solver {
     return delay_slot_[n] < 0 ? nullptr : delay_.data() + delay_stride() * delay_slot_[n];
   }
   void delay_prepare();
+  void read_node_records(const StateReader& r, const std::string& pre, const std::string& name,
+                         std::size_t stride, std::vector<double>& v) const;
   void delay_map();  // delay_slot_ from the records' nodes
   double delay_value(const double* rec, int field, double d, long back) const;
   void delay_strain_velocities(double* gx, double* gy, bool current);
