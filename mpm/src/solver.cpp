@@ -1191,18 +1191,24 @@ void Solver::grid_update() {
       rec[kDelayRho] = delay_rho_[i];
       rec[kDelayAt] = -1;
       const bool blocks = cxx > 0 && cyy > 0;
+      // The closure takes the normal component (delayed_axis); the tangential one keeps the
+      // trapezoidal update.
+      const bool on_x = delayed_axis(cxx, cyy), on_y = delayed_axis(cyy, cxx);
       const double dx = blocks ? grid.h / (cxx / rec[kDelayRho] * DT) - 0.5 : 0.0;
       const double dy = blocks ? grid.h / (cyy / rec[kDelayRho] * DT) - 0.5 : 0.0;
+      const double reach = std::max(on_x ? dx : 0.0, on_y ? dy : 0.0);
       const double history = static_cast<double>(steps) - rec[kDelayRunFrom];  // entries before
       const double half = 0.5 * rec[kDelayRho] * grid.h;  // an edge node's mass on its line
       if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
-          std::abs(m[i] - half) <= kDelayMassTolerance * half &&
-          std::floor(std::max(dx, dy)) + 1 <= history) {
-        const double vdx = delay_value(rec, 0, dx, 0);
-        const double vdy = delay_value(rec, 1, dy, 0);
+          std::abs(m[i] - half) <= kDelayMassTolerance * half && std::floor(reach) + 1 <= history) {
+        const double vdx = on_x ? delay_value(rec, 0, dx, 0) : 0.0;
+        const double vdy = on_y ? delay_value(rec, 1, dy, 0) : 0.0;
         const double M = rec[kDelayRho] * grid.h;  // a whole node's mass: rho h times its edge length
-        ux[i] = (fix[i] & 1) ? 0.0 : vx[i] + DT * gx + DT * (frx - cxx * vdx) / M;
-        uy[i] = (fix[i] & 2) ? 0.0 : vy[i] + DT * gy + DT * (fry - cyy * vdy) / M;
+        double tx = 0, ty = 0;  // the trapezoidal update, for the tangential component
+        if (!(on_x && on_y))
+          dashpot_velocity(m[i], cxx, 0.0, cyy, vx[i], vy[i], fx[i], fy[i], DT, fix[i], tx, ty);
+        ux[i] = !on_x ? tx : (fix[i] & 1) ? 0.0 : vx[i] + DT * gx + DT * (frx - cxx * vdx) / M;
+        uy[i] = !on_y ? ty : (fix[i] & 2) ? 0.0 : vy[i] + DT * gy + DT * (fry - cyy * vdy) / M;
         rec[kDelayAt] = static_cast<double>(steps);
         rec[kDelayFx] = frx;
         rec[kDelayFy] = fry;
@@ -1313,9 +1319,16 @@ void Solver::boundary_work(bool remapped) {
         // The delayed closure: what it takes out against the conservative update, the force
         // and its work with the strain velocity (delay_strain_velocities):
         // (f + C v_d)/2 . wbar + f . (g - g0), f the force less gravity.
+        // The tangential component took the trapezoidal update: C vbar . wbar.
         const double fx = rec[kDelayFx], fy = rec[kDelayFy];
         const double cx = rec[kDelayCxx] * rec[kDelayVx], cy = rec[kDelayCyy] * rec[kDelayVy];
-        w += 0.5 * ((fx + cx) * bx + (fy + cy) * by) + fx * rec[kDelayDgx] + fy * rec[kDelayDgy];
+        vbar(i, ax, ay);
+        w += delayed_axis(rec[kDelayCxx], rec[kDelayCyy])
+                 ? 0.5 * (fx + cx) * bx + fx * rec[kDelayDgx]
+                 : grid.cxx[i] * ax * bx;
+        w += delayed_axis(rec[kDelayCyy], rec[kDelayCxx])
+                 ? 0.5 * (fy + cy) * by + fy * rec[kDelayDgy]
+                 : grid.cyy[i] * ay * by;
         continue;
       }
       vbar(i, ax, ay);

@@ -1088,13 +1088,15 @@ static ColumnSpec delayed_column(Scheme sc, double cfl, bool shear, int cells) {
 }
 
 // The delayed closure at 1 ppc (docs/physics.md section 4, "edge_velocity": "delayed"): the edge
-// node's dashpot acts with its start velocity of h/c - dt/2 earlier on the node weighed as a
-// whole one, and its normal strain velocity is the mean of the re-mapped one and the force of
-// as long ago over the dashpot's coefficient. 16-cell pulses on a grid line, MUSL and USF, P
-// and S. Measured at 1e4 Pa (the end moves 1e-10 h): 0.069-0.079 % at CFL 0.3 and 0.5 (the
-// default 1.03-1.54 % P, 0.75-0.98 % S); at 100 MPa the P pulse moves the end by 0.4 % of a cell
-// off its grid line, and P returns 0.54 % (default 1.12 %; S 0.076 %). Bounds: 0.1 % at small
-// amplitude, 0.6 % (P) and 0.1 % (S) at 100 MPa.
+// node's dashpot acts on its normal component with its start velocity of h/c_d - dt/2 earlier,
+// on the node weighed as a whole one, and its normal strain velocity is the mean of the
+// re-mapped one and the force of as long ago over the dashpot's coefficient; the tangential
+// component keeps LK's trapezoidal update (delayed, it made a two-dimensional body unstable:
+// SilentStability.DelayedClosureSquareDecays). 16-cell pulses on a grid line, MUSL and USF, P
+// and S. Measured at 1e4 Pa (the end moves 1e-10 h): P 0.070-0.079 % at CFL 0.3 and 0.5 (the
+// default 1.03-1.54 %), S 0.75-0.98 %, the default's; at 100 MPa the P pulse moves the end by
+// 0.4 % of a cell off its grid line, and P returns 0.54 % (default 1.12 %). Bounds: P 0.1 % at
+// small amplitude and 0.6 % at 100 MPa, S 1.1 %.
 TEST(SilentLayer, DelayedClosureOnePpc) {
   for (const Scheme sc : {Scheme::MUSL, Scheme::USF})
     for (const double cfl : {0.3, 0.5})
@@ -1106,7 +1108,7 @@ TEST(SilentLayer, DelayedClosureOnePpc) {
           const double amp = std::sqrt(reflected_energy_ratio(c, 16, 0.01));
           std::printf("  [%s CFL %.1f %.0e Pa %s] reflected amplitude %.5f\n", scheme_name(sc), cfl,
                       amplitude, shear ? "S" : "P", amp);
-          const double bound = amplitude > 1e4 && !shear ? 6e-3 : 1e-3;
+          const double bound = shear ? 1.1e-2 : amplitude > 1e4 ? 6e-3 : 1e-3;
           EXPECT_LE(amp, bound) << scheme_name(sc) << " CFL " << cfl << " " << amplitude << " Pa "
                                 << (shear ? "S" : "P");
         }

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -108,6 +109,77 @@ TEST(MpmPml, LambHalfSpaceAgainstExtendedDomain) {
   for (int r = 0; r < 3; ++r) {
     EXPECT_LE(p[r], 0.015) << "receiver " << r;
     EXPECT_LE(p[r], 0.1 * l[r]) << "receiver " << r;
+  }
+  fs::remove_all(out);
+}
+
+namespace {
+
+// A steel square of 20 x 20 cells at 1 ppc (nu 0.3), a sin^2 line load 4 cells wide on the
+// middle of its free top, LK on the other three sides ("delayed": the closure at 1 ppc), run
+// to 12 ms (about 70 000 steps at CFL 0.5), a history row every 500 steps.
+std::string delayed_square(const std::string& scheme, bool delayed) {
+  std::string c = R"({"title": "delayed square", "time": {"end": 0.012, "cfl": 0.5},)";
+  c += R"("grid": {"origin": [0, 0], "size": [0.04, 0.042], "cell": 0.002},)";
+  c += R"("scheme": {"update": ")" + scheme + R"(", "threads": 1},)";
+  c += R"("materials": {"steel": {"model": "elastic", "young": 200e9, "poisson": 0.3, "density": 7850}},)";
+  c += R"("bodies": [{"name": "ground", "material": "steel", "box": [0, 0, 0.04, 0.04], "particles_per_cell": 1}],)";
+  c += R"("boundaries": [{"type": "traction", "body": "ground", "side": "top", "interval": [0.016, 0.024],)";
+  c += R"( "normal": -1e7, "time": {"shape": "sin2", "start": 0, "duration": 4e-6, "ramp": 2e-6}})";
+  for (const char* side : {"left", "right", "bottom"})
+    c += std::string(R"(, {"type": "silent", "body": "ground", "side": ")") + side + "\"" +
+         (delayed ? R"(, "edge_velocity": "delayed")" : "") + "}";
+  c += R"(], "output": {"history_every": 500, "snapshots": 0, "progress": false}})";
+  return c;
+}
+
+struct SquareRun {
+  double at2ms, later_max, last;  // kinetic + elastic energy over the external work
+  double imbalance;               // the account at the end over the external work
+};
+
+SquareRun square_run(const std::string& scheme, bool delayed, const fs::path& dir) {
+  const History h = run(delayed_square(scheme, delayed), dir);
+  const auto& ke = h.column("energy.kinetic");
+  const auto& el = h.column("energy.elastic");
+  const double ext = h.column("energy.external_work").back();
+  SquareRun r{0, 0, 0, h.column("energy.imbalance").back() / ext};
+  for (std::size_t i = 0; i < h.time.size(); ++i) {
+    const double e = (ke[i] + el[i]) / ext;
+    if (h.time[i] <= 2e-3) r.at2ms = e;
+    else r.later_max = std::max(r.later_max, e);
+    r.last = e;
+  }
+  return r;
+}
+
+}  // namespace
+
+// The delayed closure in two dimensions, where motion runs along the edges and into corners.
+// Measured (kinetic + elastic energy over the work put in): 3.2e-4 at 2 ms under MUSL and
+// 3.0e-4 under USF, never above that later, 3.0e-9 and 3.6e-9 at 12 ms; LK's default still holds
+// 4.8e-4 at 12 ms (1.3e-3 at 2 ms: the odd-even modes its edge feeds ring on). With the closure
+// on the tangential component as well, the run grew from the first wave on and stopped on the
+// energy check after 10 883 steps (MUSL; 18 147 at CFL 0.3, 7 020 for a square of 40 cells, USF
+// alike): along an edge the tangential motion has frequencies a dashpot acting with a velocity of
+// h/c_s ago feeds (docs/physics.md section 4). The closure's energy account is off by 2.0 %
+// (MUSL) and 1.0 % (USF) of the input here, against 0.2 % in the column. Bounds: no growth after
+// 2 ms, the end below 1e-6 of the input and below a hundredth of LK's, the account within 3 %.
+TEST(SilentStability, DelayedClosureSquareDecays) {
+  const fs::path out = fs::temp_directory_path() / ("smpm_dsq_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const SquareRun lk = square_run("MUSL", false, out / "lk");
+  std::printf("  [MUSL, LK] at 2 ms %.2e, largest later %.2e, at 12 ms %.2e; imbalance %.1e\n",
+              lk.at2ms, lk.later_max, lk.last, lk.imbalance);
+  for (const char* scheme : {"MUSL", "USF"}) {
+    const SquareRun d = square_run(scheme, true, out / scheme);
+    std::printf("  [%s, delayed] at 2 ms %.2e, largest later %.2e, at 12 ms %.2e; imbalance %.1e\n",
+                scheme, d.at2ms, d.later_max, d.last, d.imbalance);
+    EXPECT_LE(d.later_max, d.at2ms) << scheme;
+    EXPECT_LE(d.last, 1e-6) << scheme;
+    EXPECT_LE(d.last, 0.01 * lk.last) << scheme;
+    EXPECT_LE(std::abs(d.imbalance), 3e-2) << scheme;
   }
   fs::remove_all(out);
 }

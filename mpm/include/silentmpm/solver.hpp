@@ -290,6 +290,10 @@ class Solver {
   // How far an edge node's mass may be from half its layer's weight times h (an end that has
   // drifted by 5 % of a cell) and still take the delayed closure.
   static constexpr double kDelayMassTolerance = 0.1;
+  // Whether the closure takes the component whose block is c against the other's c_other: the
+  // normal one (c_d against c_s), and both at a corner, where the two are alike. Delayed, the
+  // tangential one fed energy into motion along the edge (docs/physics.md section 4).
+  static bool delayed_axis(double c, double c_other) { return !(c_other > c); }
   std::size_t delay_stride() const { return kDelayHead + 4 * static_cast<std::size_t>(delay_cap_); }
   double* delay_record(long n) {
     return delay_slot_[n] < 0 ? nullptr : delay_.data() + delay_stride() * delay_slot_[n];
