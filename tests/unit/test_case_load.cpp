@@ -341,3 +341,28 @@ TEST(CaseLoad, ReferenceExampleBuilds) {
 }
 
 }  // namespace
+
+// The note on the nodal silent edge under MUSL in long runs (docs/physics.md section 4): said
+// above CFL 0.4 at 4 ppc and 0.2 at 1 ppc, for more than 10^4 steps, not for "updated" edges.
+TEST(CaseLoad, NoteOnLongRunsOfNodalEdges) {
+  const fs::path file = write_file("valid_note.json", kValid);
+  const auto noted = [&](std::vector<std::string> ov) {
+    ov.push_back("boundaries.2.form=nodal");
+    const smpm::Case c = smpm::load_case(file.string(), ov);
+    std::string found;
+    for (const auto& n : c.notes)
+      if (n.find("where such edges meet free surfaces") != std::string::npos) found = n;
+    return found;
+  };
+  const std::string four = noted({"time.end=2e-3"});
+  EXPECT_NE(four.find("above CFL 0.4 at 4 particles per cell and more"), std::string::npos) << four;
+  EXPECT_NE(four.find("edge_velocity \"remapped\") under MUSL at CFL 0.5"), std::string::npos)
+      << four;
+  const std::string one =
+      noted({"time.end=2e-3", "bodies.0.particles_per_cell=1", "boundaries.1.width=0.001"});
+  EXPECT_NE(one.find("above CFL 0.2 at 1 particle per cell"), std::string::npos) << one;
+  EXPECT_EQ(noted({"time.end=2e-3", "time.cfl=0.4"}), "");
+  EXPECT_EQ(noted({"time.end=2e-3", "boundaries.2.edge_velocity=updated"}), "");
+  EXPECT_EQ(noted({}), "");  // 1e-6 s: a few steps
+  EXPECT_EQ(noted({"time.end=2e-3", "scheme.update=USL"}), "");
+}
