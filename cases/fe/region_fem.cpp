@@ -48,6 +48,7 @@ class FemRegion final : public Region {
     if (!energies_finite(s_.energy))
       throw std::runtime_error("the FEM run diverged at step " + std::to_string(s_.steps) +
                                ": energy is not finite");
+    check_energy_bound(s_.energy, "FEM", s_.steps, s_.t);
   }
 
   void save(StateWriter& w) const override { s_.save_state(w, "fem."); }

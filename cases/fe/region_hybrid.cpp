@@ -73,6 +73,7 @@ class HybridRegion final : public Region {
     if (!energies_finite(hy_.energy))
       throw std::runtime_error("the hybrid run diverged at step " + std::to_string(s_.steps) +
                                " (t = " + std::to_string(s_.t) + " s): energy is not finite");
+    check_energy_bound(hy_.energy, "hybrid", s_.steps, s_.t);
   }
 
   // Several ranks: one process's checkpoint, written by every rank at once (Hybrid::save_state).

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -147,6 +148,18 @@ std::vector<std::string> history_columns(const std::vector<ProbeSpec>& probes);
 void put_energies(const Energies& e, std::vector<double>& row, std::size_t& k);
 inline bool energies_finite(const Energies& e) {
   return std::isfinite(e.kinetic) && std::isfinite(e.elastic);
+}
+// The FE far field's and the hybrid's check at each history row, as the MPM step's own: a run
+// whose kinetic energy exceeds 10 times the energy put in (initial + |external work|) has blown
+// up. Throws naming the step and the time.
+inline void check_energy_bound(const Energies& e, const char* what, long step, double t) {
+  const double put_in = e.initial + std::abs(e.external_work);
+  if (!(e.kinetic > 10 * put_in)) return;
+  std::ostringstream o;
+  o << "the " << what << " run is unstable at step " << step << " (t = " << t << " s): kinetic energy "
+    << e.kinetic << " J exceeds 10 times the energy put in (" << put_in << " J: initial "
+    << e.initial << ", external work " << e.external_work << ") (reduce time.cfl or time.dt)";
+  throw std::runtime_error(o.str());
 }
 
 // One probe field ("sxx", "syy", "szz", "sxy", "J2", "vx", "vy"; FEM samples also "div", "curl").

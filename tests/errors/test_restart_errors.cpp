@@ -210,6 +210,47 @@ TEST(RestartErrors, RunFailureExitsTwoWithMarker) {
             std::string::npos) << again.err;
 }
 
+
+// An FE far field that blows up stops like an MPM run: exit 2, RUN_INCOMPLETE naming the step,
+// no summary. The trigger: a perfectly matched layer on the left and right sides of a square
+// whose top and bottom are free (a plate with absorbing ends), which grows within 2 000 steps
+// (docs/physics.md section 9.3). Before the check the run finished with a kinetic energy of
+// 8e55 J and a summary.
+TEST(RestartErrors, FemRunThatBlowsUpStops) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
+  const fs::path geo = scratch() / "fe_plate.geo";
+  std::ofstream(geo)
+      << "DefineConstant[ h = {0.002, Name \"Parameters/h\"} ];\n"
+         "Point(1) = {0, 0, 0}; Point(2) = {0.08, 0, 0}; Point(3) = {0.08, 0.08, 0};\n"
+         "Point(4) = {0, 0.08, 0};\n"
+         "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};\n"
+         "Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};\n"
+         "Transfinite Curve{1, 2, 3, 4} = Round(0.08 / h) + 1; Transfinite Surface{1}; Recombine Surface{1};\n"
+         "Physical Surface(\"body\", 1) = {1};\n"
+         "Physical Curve(\"bottom\", 11) = {1}; Physical Curve(\"right\", 12) = {2};\n"
+         "Physical Curve(\"top\", 13) = {3}; Physical Curve(\"left\", 14) = {4};\n";
+  json c = json::parse(R"({
+    "time": {"end": 1e-3, "cfl": 0.5},
+    "materials": {"steel": {"model": "elastic", "young": 200e9, "poisson": 0.3, "density": 7850}},
+    "fem": {"mesh": "", "size": 0.002, "degree": 1, "regions": {"body": "steel"},
+            "boundaries": [
+              {"type": "traction", "curve": "top", "normal": -1e7,
+               "time": {"shape": "sin2", "start": 0, "duration": 4e-6, "ramp": 2e-6}},
+              {"type": "pml", "curve": "right", "width": 0.02, "r0": 0.01},
+              {"type": "pml", "curve": "left", "width": 0.02, "r0": 0.01},
+              {"type": "dashpot", "curve": "right"}, {"type": "dashpot", "curve": "left"}]},
+    "output": {"snapshots": 0, "progress": false, "history_every": 100}
+  })");
+  c["fem"]["mesh"] = geo.string();
+  const std::string f = write_case("fe_blowup", c);
+  const fs::path out = scratch() / "fe_blowup_out";
+  const Cli r = cli("run " + f + " --out " + out.string(), "fe_blowup");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("the FEM run is unstable at step"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("exceeds 10 times the energy put in"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_NE(read_file(out / "RUN_INCOMPLETE").find("the FEM run is unstable"), std::string::npos);
+}
 }  // namespace
 }  // namespace smpm
 
