@@ -247,7 +247,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc, bool scatter, bool skeleto
           o.allow({"type", "name", "curve", "normal", "tangential", "vector", "time"}, where);
         if (type == "fixed") o.allow({"type", "name", "curve"}, where);
         if (type == "damping_layer") o.allow({"type", "name", "curve", "width", "r0", "power", "beta"}, where);
-        if (type == "pml") o.allow({"type", "name", "curve", "width", "r0", "power", "alpha"}, where);
+        if (type == "pml") o.allow({"type", "name", "curve", "width", "r0", "power", "alpha", "parallel"}, where);
         if (type == "roller") o.allow({"type", "name", "curve", "component"}, where);
         fem::Boundary bc;
         bc.name = o.has("name") ? o.str("name") : type + std::to_string(i);
@@ -305,6 +305,9 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc, bool scatter, bool skeleto
           if (type == "pml") {
             bc.alpha = o.num("alpha", 0.0);
             o.ge("alpha", bc.alpha, 0);
+            bc.parallel = o.num("parallel", 0.0);
+            o.ge("parallel", bc.parallel, 0);
+            o.lt("parallel", bc.parallel, 1);
           } else {
             bc.beta = o.num("beta", 0.0);
             o.ge("beta", bc.beta, 0);

@@ -1225,7 +1225,7 @@ class Builder {
     } else if (type == "damping_layer") {
       o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power", "beta"}, where);
     } else if (type == "pml") {
-      o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power", "alpha"}, where);
+      o.allow({"type", "name", "body", "side", "curve", "width", "r0", "power", "alpha", "parallel"}, where);
     } else if (type == "silent") {
       o.allow({"type", "name", "body", "side", "curve", "width", "a", "b", "form", "anchor",
                "edge_velocity"},
@@ -1316,6 +1316,9 @@ class Builder {
       o.ge("power", band.power, 0);
       band.alpha = o.num("alpha", 0.0);
       o.ge("alpha", band.alpha, 0);
+      band.parallel = o.num("parallel", 0.0);
+      o.ge("parallel", band.parallel, 0);
+      o.lt("parallel", band.parallel, 1);
       for (const PmlBand& other : s_->pml_bands)
         if (other.alpha != band.alpha)
           o.fail("alpha", "every pml must have the same alpha (\"" + other.name + "\" has " +

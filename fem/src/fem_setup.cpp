@@ -115,7 +115,7 @@ std::string num6(double v) {
 // side `side` (-1: the mesh lies at coordinates below c), with d = d0 s^power.
 struct PmlBand {
   int axis = 0;
-  double c = 0, width = 0, d0 = 0, power = 2;
+  double c = 0, width = 0, d0 = 0, power = 2, parallel = 0;
   int side = -1;
   double at(double x, double y) const {
     const double p = axis == 0 ? x : y;
@@ -166,6 +166,7 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
     band.c = c;
     band.width = bc.width;
     band.power = bc.power;
+    band.parallel = bc.parallel;
     band.side = (axis == 0 ? f0.cx : f0.cy) < c ? 1 : -1;
     const double extent = axis == 0 ? m.box[2] - m.box[0] : m.box[3] - m.box[1];
     if (bc.width > extent * (1 + 1e-12))
@@ -179,7 +180,11 @@ void setup_pml(Solver::Impl& m, Deal& d, const Spec& spec,
   if (bands.empty()) return;
   auto dxy = [&](double x, double y, double& dx, double& dy) {
     dx = dy = 0;
-    for (const auto& bd : bands) (bd.axis == 0 ? dx : dy) += bd.at(x, y);
+    for (const auto& bd : bands) {  // the normal stretching, and a multi-axial layer's share along
+      const double d = bd.at(x, y);
+      (bd.axis == 0 ? dx : dy) += d;
+      (bd.axis == 0 ? dy : dx) += bd.parallel * d;
+    }
   };
 
   Solver::Impl::Pml& P = m.pml;

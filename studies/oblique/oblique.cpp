@@ -3,7 +3,7 @@
 // traces OUT/trace_<P|SV>_<angle>.csv.
 //
 //   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N] [--shape bilinear|gimp|bspline]
-//           [--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N]
+//           [--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P]
 //           [--beta F] (damping: the band's stiffness part, F h / c_d seconds)
 //           (the right side of run A)
 #include <cstdlib>
@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
                          "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
-                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--beta F]\n");
+                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P] [--beta F]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -67,6 +67,8 @@ int main(int argc, char** argv) {
       base.alpha = std::atof(argv[i + 1]);
     } else if (a == "--power") {
       base.power = std::atof(argv[i + 1]);
+    } else if (a == "--parallel") {
+      base.parallel = std::atof(argv[i + 1]);
     } else if (a == "--beta") {
       base.beta = std::atof(argv[i + 1]);
     } else if (a == "--shape") {
@@ -106,6 +108,7 @@ int main(int argc, char** argv) {
       j["pml_r0"] = base.r0;
       j["pml_alpha"] = base.alpha;
       j["pml_power"] = base.power;
+      j["pml_parallel"] = base.parallel;
     }
     j["nu"] = base.nu;
     j["pulse_fwhm_cells"] = base.fwhm;

@@ -61,6 +61,7 @@ struct Setup {
   // With "damping", beta > 0 adds the band's stiffness-proportional part, beta h / c_d seconds.
   std::string boundary = "lk";
   double delta = 40, band = 10, r0 = 1e-3, alpha = 0, power = 2, beta = 0;
+  double parallel = 0;  // pml: the multi-axial layer's share of d along the edge
   // Cells before the boundary where the initial data ends (a layer's thickness plus 2), or -1:
   // not cut (LK, Kelvin-Voigt).
   double clear() const { return boundary == "damping" || boundary == "pml" ? band + 2 : -1.0; }
@@ -233,6 +234,7 @@ inline Result measure(const Setup& su) {
         fem::Boundary d;
         d.kind = su.boundary == "pml" ? fem::Boundary::Kind::Pml : fem::Boundary::Kind::Damping;
         d.alpha = su.alpha;
+        d.parallel = su.parallel;
         d.curves = {12};
         d.name = "band";
         d.width = su.band * h;

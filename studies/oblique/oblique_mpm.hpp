@@ -39,6 +39,7 @@ inline Result measure_mpm(const Setup& su) {
       band.r0 = su.r0;
       band.power = su.power;
       band.alpha = su.alpha;
+      band.parallel = su.parallel;
       s->pml_bands.push_back(band);
     }
     if (silent) {

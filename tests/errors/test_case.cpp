@@ -255,6 +255,20 @@ std::vector<Bad> bad_cases() {
          bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002}};
        },
        "boundaries[2].type: a pml on particles needs scheme.update \"USL\""},
+      {"pml_parallel_not_below_one",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002},
+                      {"parallel", 1.0}};
+       },
+       "boundaries[2].parallel: must be < 1, got 1"},
+      {"pml_parallel_negative",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002},
+                      {"parallel", -0.1}};
+       },
+       "boundaries[2].parallel: must be >= 0, got -0.1"},
       {"pml_thicker_than_body",
        [](ojson& j) {
          j["scheme"]["update"] = "USL";

@@ -149,6 +149,11 @@ TEST(FemErrors, BadInputs) {
   EXPECT_ERROR(error_of(c), "boundary \"pml2\"", "one straight edge parallel to the x or the y axis",
                "physical curve 12 (\"right\")");
   c["fem"]["boundaries"][2]["curve"] = "top";
+  c["fem"]["boundaries"][2]["parallel"] = 1.5;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].parallel", "must be < 1, got 1.5");
+  c["fem"]["boundaries"][2]["parallel"] = -0.5;
+  EXPECT_ERROR(error_of(c), "fem.boundaries[2].parallel", "must be >= 0, got -0.5");
+  c["fem"]["boundaries"][2].erase("parallel");
   c["fem"]["boundaries"].push_back({{"type", "pml"}, {"curve", "bottom"}, {"width", 0.002}, {"alpha", 1e5}});
   EXPECT_ERROR(error_of(c), "boundary \"pml3\"", "the same alpha");
 

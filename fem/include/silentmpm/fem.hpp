@@ -105,7 +105,9 @@ struct Boundary {
   // 0 at its inner edge), d0 = -(power + 1) c_d ln(r0) / (2 width) with c_d of the material next
   // to the curves, alpha the frequency shift (1/s; the same for every PML of a model). Layers on
   // two edges overlap in the corner, where both stretchings apply (docs/physics.md section 9.3).
-  double alpha = 0;
+  // parallel > 0: the multi-axial layer, the share `parallel` of d along the edge as well (the
+  // classical layer grows between two free surfaces; docs/physics.md section 9.3).
+  double alpha = 0, parallel = 0;
 };
 
 struct Spec {

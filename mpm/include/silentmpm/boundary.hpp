@@ -125,6 +125,7 @@ struct PmlBand {
   std::string name;
   int body = -1, axis = 0, side = 1;
   double c = 0, width = 0, r0 = 1e-3, power = 2, alpha = 0;
+  double parallel = 0;  // the multi-axial layer's share of d along the side (docs/physics.md 9.3)
 };
 
 // The power of the layer particles' PIC share in their depth (Solver::pml_pic).
