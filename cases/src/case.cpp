@@ -757,7 +757,7 @@ class Builder {
     // The nodal form with the re-mapped (MUSL) or start (USF) strain velocity, and the delayed
     // closure, grew in long runs in two dimensions, where the edges meet free surfaces, above
     // CFL 0.2 at 1 ppc (delayed: 0.3) and 0.4 at 4 and 9 ppc (docs/physics.md section 4).
-    // Said for runs of more than 10^4 steps (the earliest growth came after 1.9 * 10^4).
+    // Said for runs of more than 10^4 steps (the earliest stop came after 1.7 * 10^4).
     if (s_->opt.scheme != Scheme::USL && t_end_ > 1e4 * s_->dt)
       for (const auto& sb : s_->silents) {
         if (sb.form != SilentForm::Nodal || sb.updated_velocity || sb.layer.idx.empty()) continue;
@@ -1339,6 +1339,7 @@ class Builder {
       c.notes.push_back("pml \"" + name + "\" inside the " + side + " of body \"" + b.name +
                         "\": " + fmt(band.width) + " m, r0 " + fmt(band.r0) + ", power " +
                         fmt(band.power) + ", alpha " + fmt(band.alpha) + " 1/s, " +
+                        (band.parallel > 0 ? "multi-axial share " + fmt(band.parallel) + ", " : "") +
                         std::to_string(inside) + " particles");
       s_->pml_bands.push_back(std::move(band));
       return;

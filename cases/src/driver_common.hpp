@@ -158,7 +158,9 @@ inline void check_energy_bound(const Energies& e, const char* what, long step, d
   std::ostringstream o;
   o << "the " << what << " run is unstable at step " << step << " (t = " << t << " s): kinetic energy "
     << e.kinetic << " J exceeds 10 times the energy put in (" << put_in << " J: initial "
-    << e.initial << ", external work " << e.external_work << ") (reduce time.cfl or time.dt)";
+    << e.initial << ", external work " << e.external_work
+    << ") (reduce time.cfl or time.dt; a pml between two free surfaces needs \"parallel\", "
+       "docs/physics.md section 9.3)";
   throw std::runtime_error(o.str());
 }
 

@@ -872,6 +872,7 @@ std::vector<std::string> Solver::describe() const {
       case Boundary::Kind::Pml:
         s += "perfectly matched layer " + fmt(bc.width) + " m thick, r0 = " + fmt(bc.r0) +
              ", power " + fmt(bc.power) + ", alpha " + fmt(bc.alpha) + " 1/s";
+        if (bc.parallel > 0) s += ", multi-axial share " + fmt(bc.parallel);
         break;
       case Boundary::Kind::Roller: s += std::string("roller, ") + (bc.component ? "y" : "x") + " held"; break;
       case Boundary::Kind::Traction:

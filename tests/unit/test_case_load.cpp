@@ -365,4 +365,8 @@ TEST(CaseLoad, NoteOnLongRunsOfNodalEdges) {
   EXPECT_EQ(noted({"time.end=2e-3", "boundaries.2.edge_velocity=updated"}), "");
   EXPECT_EQ(noted({}), "");  // 1e-6 s: a few steps
   EXPECT_EQ(noted({"time.end=2e-3", "scheme.update=USL"}), "");
+  // The paper's particle form (kValid's own) is not concerned.
+  const smpm::Case particle = smpm::load_case(file.string(), {"time.end=2e-3"});
+  for (const auto& n : particle.notes)
+    EXPECT_EQ(n.find("where such edges meet free surfaces"), std::string::npos) << n;
 }
