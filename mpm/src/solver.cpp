@@ -1768,7 +1768,10 @@ void Solver::check_health() {
         << " times the energy put in (" << put_in << " J: initial " << energy.initial
         << ", external work " << energy.external_work << ") ";
       where(o);
-      o << "; the run is unstable (reduce time.cfl or time.dt)";
+      o << "; the run is unstable (reduce time.cfl or time.dt";
+      if (pml.active())
+        o << "; a pml between two free surfaces needs \"parallel\", docs/physics.md section 9.3";
+      o << ")";
       throw std::runtime_error(o.str());
     }
   }
