@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "silentmpm/boundary.hpp"
 #include "silentmpm/case.hpp"
 #include "silentmpm/decomposition.hpp"
 #include "silentmpm/driver.hpp"
@@ -159,8 +160,7 @@ inline void check_energy_bound(const Energies& e, const char* what, long step, d
   o << "the " << what << " run is unstable at step " << step << " (t = " << t << " s): kinetic energy "
     << e.kinetic << " J exceeds 10 times the energy put in (" << put_in << " J: initial "
     << e.initial << ", external work " << e.external_work
-    << ") (reduce time.cfl or time.dt; a pml between two free surfaces needs \"parallel\", "
-       "docs/physics.md section 9.3)";
+    << ") (reduce time.cfl or time.dt; " << kPmlGrowthHint << ")";
   throw std::runtime_error(o.str());
 }
 

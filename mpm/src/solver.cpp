@@ -1769,8 +1769,7 @@ void Solver::check_health() {
         << ", external work " << energy.external_work << ") ";
       where(o);
       o << "; the run is unstable (reduce time.cfl or time.dt";
-      if (pml.active())
-        o << "; a pml between two free surfaces needs \"parallel\", docs/physics.md section 9.3";
+      if (pml.active()) o << "; " << kPmlGrowthHint;
       o << ")";
       throw std::runtime_error(o.str());
     }

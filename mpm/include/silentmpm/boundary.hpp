@@ -128,6 +128,10 @@ struct PmlBand {
   double parallel = 0;  // the multi-axial layer's share of d along the side (docs/physics.md 9.3)
 };
 
+// What the energy checks of both methods add when a run with a PML blows up.
+inline constexpr const char* kPmlGrowthHint =
+    "a pml between two free surfaces needs \"parallel\", docs/physics.md section 9.3";
+
 // The power of the layer particles' PIC share in their depth (Solver::pml_pic).
 inline constexpr double kPmlPicPower = 5;
 
