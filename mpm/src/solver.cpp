@@ -56,6 +56,7 @@ std::size_t Solver::seed_rectangle(double x0, double y0, double x1, double y1, i
   if (seed_nothing) return cx * cy;
   const std::size_t first = p.size();
   p.resize(first + cx * cy);
+  ++order_version_;
   std::size_t k = first;
   for (long j = 0; j < cy; ++j)
     for (long i = 0; i < cx; ++i, ++k)
@@ -195,6 +196,16 @@ void Solver::finalize() {
             body_of_group_.empty();
   updated_weight_.assign(updated ? grid.nodes() : 0, 0.0);
   edge_velocity_.clear();
+  bool consistent = false;  // a nodal layer with the default edge velocity (MUSL or USF, one field)
+  for (const auto& s : silents)
+    consistent = consistent || (s.form == SilentForm::Nodal && !s.updated_velocity && !s.delayed);
+  consistent = consistent && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
+               body_of_group_.empty();
+  consistent_weight_.assign(consistent ? grid.nodes() : 0, 0.0);
+  cm_nodes_.clear();
+  cm_slot_.assign(consistent ? grid.nodes() : 0, -1);
+  cm_cell_.assign(consistent ? static_cast<std::size_t>(grid.nx) * grid.ny : 0, 0);
+  cm_cells_.clear();
   bool delayed = false;  // a layer with the delayed closure (MUSL or USF, one field)
   for (const auto& s : silents) delayed = delayed || (s.form == SilentForm::Nodal && s.delayed);
   delayed = delayed && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
@@ -323,6 +334,7 @@ void Solver::sort_particles() {
   std::vector<uint32_t> perm(n);
   for (std::size_t k = 0; k < n; ++k) perm[count[key[k]]++] = static_cast<uint32_t>(k);
   p.permute(perm);
+  ++order_version_;
   // Ids run over 0 .. n - 1, except on a rank of a decomposition, which holds some of them.
   uint32_t id_end = 0;
   for (std::size_t k = 0; k < n; ++k) id_end = std::max(id_end, p.id[k] + 1);
@@ -993,6 +1005,8 @@ void Solver::apply_loads() {
     for (long i : dashpot_nodes_) updated_weight_[i] = 0;
   if (!delay_rho_.empty())
     for (long i : dashpot_nodes_) delay_rho_[i] = 0;
+  if (!consistent_weight_.empty())
+    for (long i : dashpot_nodes_) consistent_weight_[i] = 0;
   dashpot_nodes_.clear();
   has_nodal_dashpot_ = false;
   for (auto& sl : silents) {
@@ -1023,6 +1037,7 @@ void Solver::apply_loads() {
     }
     const bool updated = !updated_weight_.empty() && sl.updated_velocity;
     const bool delayed = !delay_rho_.empty() && sl.delayed;
+    const bool consistent = !consistent_weight_.empty() && !sl.updated_velocity && !sl.delayed;
     for (long q = 0; q < n; ++q) {
       const long* nodes = sl.nodes.data() + K * q;
       const double* N = sl.N.data() + K * q;
@@ -1056,6 +1071,10 @@ void Solver::apply_loads() {
       if (delayed) {
         const Material& mq = materials[p.group[L.idx[q]]];
         for (int a = 0; a < K; ++a) delay_rho_[nodes[a]] += L.w[q] * N[a] * mq.rho;
+      }
+      if (consistent) {
+        const Material& mq = materials[p.group[L.idx[q]]];
+        for (int a = 0; a < K; ++a) consistent_weight_[nodes[a]] += L.w[q] * N[a] * mq.rho * mq.cd;
       }
     }
   }
@@ -1143,7 +1162,9 @@ void Solver::grid_update() {
   // or Inf anywhere in the particles' mass, momentum or stress reaches the nodes' updated
   // velocities this step (x - x is 0 only for finite x).
   int bad = 0;
-#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
+  double v2 = 0;  // the fastest updated velocity (consistent_dashpots' drift)
+  const bool track = !consistent_weight_.empty();
+#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad) reduction(max : v2)
   for (long i = 0; i < n; ++i) {
     const double mi = m[i];
     const bool heavy = mi > floor;
@@ -1155,8 +1176,10 @@ void Solver::grid_update() {
     ux[i] = (fix[i] & 1) ? 0.0 : vxi + DT * fx[i] / mi;
     uy[i] = (fix[i] & 2) ? 0.0 : vyi + DT * fy[i] / mi;
     bad |= !(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0);
+    if (track) v2 = std::max(v2, ux[i] * ux[i] + uy[i] * uy[i]);
   }
   if (bad) fail_nonfinite();
+  vmax2_ = v2;
   if (!has_nodal_dashpot_) return;
   const bool delayed = !delay_rho_.empty();
   if (delayed) delay_prepare();
@@ -1223,6 +1246,245 @@ void Solver::grid_update() {
     dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
                      fix[i], ux[i], uy[i]);
   }
+  if (consistent_weight_.empty()) return;
+  for (long k = 0; k < nd; ++k)  // the dashpots' updates (the delayed closure's too)
+    vmax2_ = std::max(vmax2_, ux[dnodes[k]] * ux[dnodes[k]] + uy[dnodes[k]] * uy[dnodes[k]]);
+}
+
+// MUSL and USF, in particle terms (positions held, one field, FLIP): the nodal velocity is
+// v = P v_p with P = M^-1 N^T m_p, the particles take the nodal increment, v_p' = v_p + N dv,
+// and the stress update strains them with P v_p' (MUSL) or P v_p (USF). The dashpot's force
+// on the particles is then -N M^-1 C vbar, and the step gives up energy to it, for every state,
+// only when vbar is the mean of what the particles map to the node before and after the step:
+//   vbar = (P v_p + P v_p')/2 = v + 1/2 M^-1 Mc dv,   Mc = N^T m_p N (the consistent mass),
+// dv = dt M^-1 (f - C vbar). grid_update's trapezoidal mean v + dv/2 takes M for Mc; at an
+// edge node, whose particles lie on one side, Mc_ii / M_i is a quarter at 1 ppc and the rest of
+// the row reaches the nodes inside, so that mean over-states the node's change. The difference
+// fed MUSL's and USF's odd-even modes where LK edges meet free surfaces: a 20 x 20-cell square
+// at 1 ppc and CFL 0.5 grew by 8.5e-5 per step (the step's largest eigenvalue), and every
+// eigenvalue is on or inside the unit circle with the consistent mean (docs/physics.md
+// section 4). So, at the dashpot nodes of the silent layers with the default edge velocity:
+//   (I + kappa_i C_i) vbar_i = v_i + 1/2 (Mc dv0)_i / m_i - 1/2 o_i / m_i,
+// dv0 the increment without those nodes' dashpots (dt f / m there; grid_update's v+ - v at
+// every other node), kappa_i = dt d_i / (2 m_i^2), d_i = sum m_p N_ip^2 the diagonal of Mc and
+// o_i = sum_{j != i} Mc_ij g_j, g_j = dt C_j vbar_j / m_j, solved by fixed-point iteration.
+// A node lighter than dt/2 times its block's largest eigenvalue keeps the trapezoidal update:
+// with that bound every other node's share of the row is below 1 - d_i / m_i, so the iteration
+// contracts. So does a node whose mass is not its particles' (a hook's share: the hybrid).
+// Slots: kCm values per node: (Mc dv0) x, y, d, sum m_p N, vbar x, y, (Mc g) x, y.
+template <class S>
+void Solver::consistent_dashpots() {
+  constexpr int K = S::kNodes;
+  const double DT = dt, floor = mass_floor_;
+  const double* m = grid.m.data();
+  const uint8_t* fix = grid.fix.data();
+  const long nnx = grid.nnx;
+  // The nodes: a block from such a layer, heavy enough (the same choice on every copy of a
+  // shared node: it reads only values summed over the halo). A node whose mass is not its
+  // particles' is dropped and the choice made again (the same on every rank).
+  std::vector<long> dropped;
+  const long ncx = grid.nx, ncy = grid.ny;
+  for (;;) {
+    for (const long i : cm_nodes_) cm_slot_[i] = -1;
+    cm_nodes_.clear();
+    for (const long i : dashpot_nodes_) {
+      if (consistent_weight_[i] <= 0 || m[i] <= floor) continue;
+      if (!updated_weight_.empty() && updated_weight_[i] > 0) continue;  // strained with v+
+      const double cxx = grid.cxx[i], cxy = grid.cxy[i], cyy = grid.cyy[i];
+      const double lmax =
+          0.5 * (cxx + cyy) + std::sqrt(0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy);
+      if (0.5 * DT * lmax > m[i]) continue;
+      if (std::binary_search(dropped.begin(), dropped.end(), i)) continue;
+      cm_slot_[i] = static_cast<int>(cm_nodes_.size());
+      cm_nodes_.push_back(i);
+    }
+    // The particles whose shape functions reach those nodes, from a zone of particles kept
+    // between steps: those in the cells whose particles can reach a listed node, and two more
+    // around them (one so that a particle on a cell's edge passes whichever cell round-off puts
+    // it in, one for the particles' drift). The zone is found again by a pass over every
+    // particle when the nodes change, the particles were re-ordered, or the particles may have
+    // drifted a cell since (cm_drift_, the sum over the steps of dt times the fastest nodal
+    // velocity they moved with), and every step when hooks may change that velocity.
+    const bool scan = !hooks_.empty() || cm_scan_version_ != order_version_ ||
+                      cm_scan_size_ != p.size() || cm_scan_nodes_ != cm_nodes_ ||
+                      !(cm_drift_ < grid.h);
+    if (scan) {
+      for (const long c : cm_cells_) cm_cell_[c] = 0;
+      cm_cells_.clear();
+      for (const long i : cm_nodes_) {
+        const long ni = i % nnx, nj = i / nnx;
+        for (long cj = std::max<long>(0, nj - S::kRowsAbove - 2);
+             cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow + 2); ++cj)
+          for (long ci = std::max<long>(0, ni - S::kRowsAbove - 2);
+               ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow + 2); ++ci) {
+            const long c = cj * ncx + ci;
+            if (!cm_cell_[c]) {
+              cm_cell_[c] = 1;
+              cm_cells_.push_back(c);
+            }
+          }
+      }
+      cm_zone_.clear();
+      if (!cm_nodes_.empty()) {
+        const std::size_t n = p.size();
+        for (std::size_t k = 0; k < n; ++k) {
+          const long ci = static_cast<long>(std::floor((p.x[k] - grid.x0) * grid.inv_h));
+          const long cj = static_cast<long>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
+          if (ci < 0 || cj < 0 || ci >= ncx || cj >= ncy || !cm_cell_[cj * ncx + ci]) continue;
+          cm_zone_.push_back(static_cast<std::uint32_t>(k));
+        }
+      }
+      cm_scan_version_ = order_version_;
+      cm_scan_size_ = p.size();
+      cm_scan_nodes_ = cm_nodes_;
+      cm_drift_ = 0;
+    }
+    cm_particles_.clear();
+    cm_pn_.clear();
+    cm_pN_.clear();
+    for (const std::uint32_t k : cm_zone_) {
+      S sf;
+      if constexpr (S::kSized) sf.size(p.mass[k], inv_rho(p.group[k]), grid.inv_h);
+      sf.eval(grid, p.x[k], p.y[k]);
+      long nodes[K];
+      sf.node_indices(nnx, nodes);
+      bool reaches = false;
+      for (int a = 0; a < K; ++a) reaches = reaches || (sf.N[a] != 0 && cm_slot_[nodes[a]] >= 0);
+      if (!reaches) continue;
+      cm_particles_.push_back(k);
+      for (int a = 0; a < K; ++a) {
+        cm_pn_.push_back(nodes[a]);
+        cm_pN_.push_back(sf.N[a]);
+      }
+    }
+    const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
+    cm_.assign(kCm * ns, 0.0);
+    // dv0 at a particle's nodes, and its sums: Mc dv0, d and the particles' mass at each slot.
+    auto dv0 = [&](long j, double& ax, double& ay) {
+      if (cm_slot_[j] >= 0) {
+        ax = (fix[j] & 1) ? 0.0 : DT * grid.fx[j] / m[j];
+        ay = (fix[j] & 2) ? 0.0 : DT * grid.fy[j] / m[j];
+      } else {
+        ax = grid.vnx[j] - grid.vx[j];
+        ay = grid.vny[j] - grid.vy[j];
+      }
+    };
+    for (std::size_t q = 0; q < np; ++q) {
+      const long* nodes = cm_pn_.data() + K * q;
+      const double* N = cm_pN_.data() + K * q;
+      const double mp = p.mass[cm_particles_[q]];
+      double sx = 0, sy = 0;
+      for (int a = 0; a < K; ++a) {
+        if (N[a] == 0) continue;
+        double ax, ay;
+        dv0(nodes[a], ax, ay);
+        sx += N[a] * ax;
+        sy += N[a] * ay;
+      }
+      for (int a = 0; a < K; ++a) {
+        const int sl = cm_slot_[nodes[a]];
+        if (sl < 0) continue;
+        double* c = cm_.data() + kCm * sl;
+        c[0] += mp * N[a] * sx;
+        c[1] += mp * N[a] * sy;
+        c[2] += mp * N[a] * N[a];
+        c[3] += mp * N[a];
+      }
+    }
+    cm_sum(0, 4);
+    double more = 0;
+    for (std::size_t k = 0; k < ns; ++k) {
+      const long i = cm_nodes_[k];
+      if (std::abs(cm_[kCm * k + 3] - m[i]) > 1e-9 * m[i]) {
+        dropped.push_back(i);
+        more = 1;
+      }
+    }
+    if (dist_) dist_->max(&more, 1);
+    if (more == 0) break;
+    std::sort(dropped.begin(), dropped.end());
+  }
+  const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
+  // Start from the trapezoidal mean.
+  for (std::size_t k = 0; k < ns; ++k) {
+    const long i = cm_nodes_[k];
+    double* c = cm_.data() + kCm * k;
+    c[4] = 0.5 * (grid.vx[i] + grid.vnx[i]);
+    c[5] = 0.5 * (grid.vy[i] + grid.vny[i]);
+  }
+  std::vector<double> g(2 * ns);
+  int it = 0;
+  for (;; ++it) {
+    for (std::size_t k = 0; k < ns; ++k) {
+      const long i = cm_nodes_[k];
+      const double* c = cm_.data() + kCm * k;
+      g[2 * k] = (fix[i] & 1) ? 0.0 : DT * (grid.cxx[i] * c[4] + grid.cxy[i] * c[5]) / m[i];
+      g[2 * k + 1] = (fix[i] & 2) ? 0.0 : DT * (grid.cxy[i] * c[4] + grid.cyy[i] * c[5]) / m[i];
+      cm_[kCm * k + 6] = cm_[kCm * k + 7] = 0;
+    }
+    for (std::size_t q = 0; q < np; ++q) {
+      const long* nodes = cm_pn_.data() + K * q;
+      const double* N = cm_pN_.data() + K * q;
+      const double mp = p.mass[cm_particles_[q]];
+      double sx = 0, sy = 0;
+      for (int a = 0; a < K; ++a) {
+        const int sl = cm_slot_[nodes[a]];
+        if (sl < 0) continue;
+        sx += N[a] * g[2 * sl];
+        sy += N[a] * g[2 * sl + 1];
+      }
+      for (int a = 0; a < K; ++a) {
+        const int sl = cm_slot_[nodes[a]];
+        if (sl < 0) continue;
+        cm_[kCm * sl + 6] += mp * N[a] * sx;
+        cm_[kCm * sl + 7] += mp * N[a] * sy;
+      }
+    }
+    cm_sum(6, 2);
+    double change = 0, scale = 0;
+    for (std::size_t k = 0; k < ns; ++k) {
+      const long i = cm_nodes_[k];
+      double* c = cm_.data() + kCm * k;
+      const double mi = m[i], d = c[2];
+      const double rx = grid.vx[i] + 0.5 * (c[0] - (c[6] - d * g[2 * k])) / mi;
+      const double ry = grid.vy[i] + 0.5 * (c[1] - (c[7] - d * g[2 * k + 1])) / mi;
+      const double kap = 0.5 * DT * d / (mi * mi);
+      const double A = 1 + kap * grid.cxx[i], B = kap * grid.cxy[i], D = 1 + kap * grid.cyy[i];
+      double bx = 0, by = 0;
+      switch (fix[i] & 3) {
+        case 0: {
+          const double det = A * D - B * B;
+          bx = (D * rx - B * ry) / det;
+          by = (A * ry - B * rx) / det;
+          break;
+        }
+        case 1: by = ry / D; break;
+        case 2: bx = rx / A; break;
+        default: break;
+      }
+      change = std::max(change, std::max(std::abs(bx - c[4]), std::abs(by - c[5])));
+      scale = std::max(scale, std::max(std::abs(bx), std::abs(by)));
+      c[4] = bx;
+      c[5] = by;
+    }
+    if (dist_) {
+      double v[2] = {change, scale};
+      dist_->max(v, 2);
+      change = v[0];
+      scale = v[1];
+    }
+    if (change <= 1e-14 * scale || it >= 200) break;
+  }
+  cm_iterations_ = it + 1;
+  double v2 = vmax2_;
+  for (std::size_t k = 0; k < ns; ++k) {
+    const long i = cm_nodes_[k];
+    const double* c = cm_.data() + kCm * k;
+    grid.vnx[i] = (fix[i] & 1) ? 0.0 : grid.vx[i] + DT * (grid.fx[i] - grid.cxx[i] * c[4] - grid.cxy[i] * c[5]) / m[i];
+    grid.vny[i] = (fix[i] & 2) ? 0.0 : grid.vy[i] + DT * (grid.fy[i] - grid.cxy[i] * c[4] - grid.cyy[i] * c[5]) / m[i];
+    v2 = std::max(v2, grid.vnx[i] * grid.vnx[i] + grid.vny[i] * grid.vny[i]);
+  }
+  cm_drift_ += DT * std::sqrt(v2);  // this step's move, with the velocities as they now are
 }
 
 // Work of tractions and energy absorbed by dashpots over the step. The forces act with the
@@ -1239,6 +1501,11 @@ void Solver::boundary_work(bool remapped) {
   const std::vector<double>& ux = remapped ? grid.qx : grid.vnx;
   const std::vector<double>& uy = remapped ? grid.qy : grid.vny;
   auto vbar = [&](long i, double& ax, double& ay) {  // the forces' velocity
+    if (!cm_slot_.empty() && cm_slot_[i] >= 0) {  // consistent_dashpots
+      ax = cm_[kCm * cm_slot_[i] + 4];
+      ay = cm_[kCm * cm_slot_[i] + 5];
+      return;
+    }
     ax = 0.5 * (grid.vx[i] + grid.vnx[i]);
     ay = 0.5 * (grid.vy[i] + grid.vny[i]);
   };
@@ -1637,6 +1904,7 @@ void Solver::step_with() {
   apply_loads<S>();
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
+  if (!consistent_weight_.empty()) consistent_dashpots<S>();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
   bool remapped_power = sc == Scheme::MUSL || (sc == Scheme::USF && usf_remapped_power());
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });

@@ -49,6 +49,13 @@ void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool das
   halo_dashpots_ = dashpots;
   dashpot_nodes_.clear();
   dashpot_mark_.assign(grid.nodes(), 0);
+  if (!consistent_weight_.empty()) {  // the window's nodes and cells
+    consistent_weight_.assign(grid.nodes(), 0.0);
+    cm_slot_.assign(grid.nodes(), -1);
+    cm_cell_.assign(static_cast<std::size_t>(grid.nx) * grid.ny, 0);
+    cm_nodes_.clear();
+    cm_cells_.clear();
+  }
   if (!delay_rho_.empty()) {  // the window's nodes
     delay_rho_.assign(grid.nodes(), 0.0);
     delay_map();
@@ -92,6 +99,7 @@ void Solver::sum_halo(bool momentum, bool force) {
     if (halo_dashpots_) {
       for (auto* v : {&grid.cxx, &grid.cxy, &grid.cyy}) f.push_back(v->data());
       if (!updated_weight_.empty()) f.push_back(updated_weight_.data());
+      if (!consistent_weight_.empty()) f.push_back(consistent_weight_.data());
       if (!delay_rho_.empty()) f.push_back(delay_rho_.data());
     }
   }
@@ -120,6 +128,26 @@ void Solver::sum_halo(bool momentum, bool force) {
       has_nodal_dashpot_ = true;
     }
   });
+}
+
+// consistent_dashpots: the slots' values [first, first + count) summed over the ranks that
+// share their nodes, through grid-sized arrays (zero but at this rank's slots).
+void Solver::cm_sum(int first, int count) {
+  if (!dist_) return;
+  // Every copy of a shared slot node is a slot on its other ranks too (the choice reads only
+  // values summed over the halo), so the arrays are zero again once the slots are read back.
+  const std::size_t nn = grid.nodes();
+  if (cm_halo_.size() < nn * count) cm_halo_.assign(nn * count, 0.0);
+  std::vector<double*> f(count);
+  for (int c = 0; c < count; ++c) f[c] = cm_halo_.data() + nn * c;
+  for (std::size_t k = 0; k < cm_nodes_.size(); ++k)
+    for (int c = 0; c < count; ++c) f[c][cm_nodes_[k]] = cm_[kCm * k + first + c];
+  dist_->sum_halo(f.data(), count);
+  for (std::size_t k = 0; k < cm_nodes_.size(); ++k)
+    for (int c = 0; c < count; ++c) {
+      cm_[kCm * k + first + c] = f[c][cm_nodes_[k]];
+      f[c][cm_nodes_[k]] = 0;
+    }
 }
 
 void Solver::keep_particles(const std::vector<std::uint8_t>& keep) {
@@ -152,6 +180,7 @@ void Solver::compact(const std::vector<std::uint8_t>& keep) {
     for (auto& [v, st] : a) v->resize(st * out);
   });
   p.permute(perm);
+  ++order_version_;
   pml.dt_coef = 0;
   strips_ok_ = false;
 }
@@ -207,6 +236,7 @@ std::vector<std::size_t> Solver::group_by_rank(std::vector<int>& rank, int P) {
     for (auto& i : L.idx) i = now[i];
   });
   p.permute(perm);
+  ++order_version_;
   std::vector<int> sorted(n);
   for (std::size_t k = 0; k < n; ++k) sorted[k] = rank[perm[k]];
   rank.swap(sorted);
@@ -231,6 +261,7 @@ void Solver::import_particles(const std::vector<double>& in) {
   while (r < in.size()) {
     const std::size_t k = p.size();
     r += p.unpack(in.data() + r);
+    ++order_version_;
     const auto ne = static_cast<std::size_t>(in[r++]);
     for (std::size_t e = 0; e < ne; ++e) {
       const int want = static_cast<int>(in[r++]);

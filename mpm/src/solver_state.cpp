@@ -198,6 +198,7 @@ bool Solver::load_state(const StateReader& r, const std::string& pre) {
     r.fail("the film model's history is " + std::string(p.has_film() ? "absent" : "present") +
            " in the checkpoint and the opposite in this case (a checkpoint of another case)");
   particle_arrays(p, [&](const char* name, auto& v) { r.get(pre + "p." + name, v, n); });
+  ++order_version_;  // positions and order from the file
   for (std::size_t k = 0; k < silents.size(); ++k) {
     if (!silents[k].springs()) continue;
     const std::size_t m = silents[k].layer.ids.size();

@@ -414,10 +414,11 @@ void expect_checkpoint_restarts(const std::string& args, const std::string& tag,
     EXPECT_EQ(summary(r)["restart"]["from_step"].get<long>(), (steps - 1) / every * every) << t;
     for (const auto& [c, d] : differences(r, a)) EXPECT_LE(d, bound) << t << ", column " << c;
     // The per-step traffic is over the steps the restart made: on 2 ranks the halo's bytes per
-    // step (a fixed halo) are the full run's.
+    // step are the full run's, to the sums of the silent edges' dashpot solve, whose iterations
+    // vary from step to step (Solver::consistent_dashpots; measured 0.3 % on the pulse plate).
     if (np == 2 && summary(b).contains("mpi")) {
       const double full = summary(b)["mpi"]["halo_bytes_per_step"].get<double>();
-      EXPECT_NEAR(summary(r)["mpi"]["halo_bytes_per_step"].get<double>(), full, 1e-12 * full) << t;
+      EXPECT_NEAR(summary(r)["mpi"]["halo_bytes_per_step"].get<double>(), full, 1e-2 * full) << t;
     }
     for (const char* e : {"kinetic", "elastic", "absorbed", "external_work"})
       EXPECT_NEAR(summary(r)["energy"][e].get<double>(), summary(a)["energy"][e].get<double>(),

@@ -841,11 +841,12 @@ TEST(Column, LayerFlagsMarkTheLayers) {
 // front of the last fifth of the column, i.e. it travels back: a reflection, not a residue at
 // the end). Measured, P / S:
 //   USL   0.19 / 0.11 % (1 ppc), 0.10 / 0.17 % (4), 0.11 / 0.17 % (9)
-//   MUSL  1.12 / 0.75 % (1 ppc), 0.39 / 0.33 % (4), 0.35 / 0.31 % (9); USF within 1 % of MUSL.
-// USL meets 0.3 % everywhere; MUSL and USF, which strain the particles with their own velocities
-// mapped to the nodes, do not at 1 ppc (docs/physics.md section 4: two changes at the edge
-// nodes that were tried and why they were not kept). The 1-ppc MUSL energy account closes to
-// 1.1 % here (1 % on 8-cell pulses).
+//   MUSL  0.74 / 0.58 % (1 ppc), 0.26 / 0.26 % (4), 0.24 / 0.25 % (9); USF within 1 % of MUSL.
+// USL meets 0.3 % everywhere, MUSL and USF from 4 ppc on; at 1 ppc they strain each particle
+// with its two neighbours' velocities, whose odd-even pattern the end excites (docs/physics.md
+// section 4). With the trapezoidal mean of the lumped mass at the dashpot nodes instead of the
+// particles' own (Solver::consistent_dashpots), MUSL and USF gave 1.12 / 0.75 %, 0.39 / 0.33 %
+// and 0.35 / 0.31 %. The 1-ppc MUSL energy account closes to 1.1 % here (1 % on 8-cell pulses).
 TEST(SilentLayer, NormalIncidence16CellPulsesEveryScheme) {
   for (const Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF})
     for (const int ppc : {1, 2, 3})
@@ -859,7 +860,7 @@ TEST(SilentLayer, NormalIncidence16CellPulsesEveryScheme) {
         const double amp = std::sqrt(reflected_energy_ratio(c, 16, 0.015));
         std::printf("  [%s %d ppc %s] reflected amplitude %.4f\n", scheme_name(sc), ppc * ppc,
                     shear ? "S" : "P", amp);
-        const double bound = sc == Scheme::USL ? 3e-3 : ppc == 1 ? 1.2e-2 : 4e-3;
+        const double bound = sc == Scheme::USL || ppc > 1 ? 3e-3 : 8e-3;
         EXPECT_LE(amp, bound) << scheme_name(sc) << " " << ppc * ppc << " ppc " << (shear ? "S" : "P");
       }
 }
@@ -883,9 +884,10 @@ double sawtooth_energy_fraction(const Solver& s, int cells) {
 // At 1 ppc both strain a particle with the difference of its neighbours' velocities over two
 // cells, so the odd-even velocity pattern is nearly free of stress, and any end excites it.
 // Measured, P, 16-cell pulses, small amplitude (1e4 Pa, the pulse moves the end 1e-10 h):
-//   * on a grid line the silent end reflects 1.03 % (16 cells) and 0.45 % (32): first order;
+//   * on a grid line the silent end reflects 0.57 % (16 cells) and 0.14 % (32): second order
+//     (with the lumped trapezoidal mean at the dashpot nodes 1.03 and 0.45 %, first order);
 //     at the usual 100 MPa the 32-cell pulse moves the end by ~0.8 % of a cell, which is
-//     enough for 1.34 % (why the reflection seemed to grow with the pulse width);
+//     enough for 1.28 % (why the reflection seemed to grow with the pulse width);
 //   * a free end returns 3.3e-3 of the input energy in the odd-even pattern under MUSL (amplitude
 //     5.7 %), 2.8e-5 under USL (the smooth pulse's own share); the silent end on a grid line 6e-6;
 //   * with the end 0.03 h off the grid line the silent end reflects 7.1 % under MUSL, 0.27 %
@@ -904,9 +906,9 @@ TEST(SilentLayer, MuslOnePpcEndsExciteTheOddEvenMode) {
   const double big32 = refl(Scheme::MUSL, 32, 100e6, 0);
   std::printf("  [MUSL 1 ppc, 1e4 Pa] reflected amplitude %.4f (16 cells), %.4f (32); 100 MPa "
               "%.4f (32)\n", a16, a32, big32);
-  EXPECT_LE(a16, 0.012);
-  EXPECT_GE(a32 / a16, 0.35);
-  EXPECT_LE(a32 / a16, 0.55);
+  EXPECT_LE(a16, 0.007);
+  EXPECT_GE(a32 / a16, 0.15);
+  EXPECT_LE(a32 / a16, 0.35);
   EXPECT_GE(big32, 2.5 * a32);
   const double off_musl = refl(Scheme::MUSL, 16, 1e4, 0.03), off_usl = refl(Scheme::USL, 16, 1e4, 0.03);
   std::printf("  [end 0.03 h off a grid line] MUSL %.4f, USL %.4f\n", off_musl, off_usl);
@@ -1017,8 +1019,9 @@ TEST(SilentLayer, EdgeOffTheGridLinesReflectsAtFirstOrderUsl) {
 // MUSL with the updated velocity at the dashpots' nodes (`edge_velocity` "updated";
 // docs/physics.md section 4), P pulses. An edge off the grid lines reflects as under USL, at
 // first order in kh: measured 1.42 / 0.72 % (0.25 h) and 1.71 / 0.86 % (0.75 h) for 16- /
-// 32-cell pulses, where the re-mapped velocity gives 1.46 / 0.72 % and 7.6 / 7.3 %. On a grid
-// line at 4 ppc: 0.13 % (P) and 0.18 % (S), against 0.39 / 0.33 % re-mapped.
+// 32-cell pulses; the re-mapped velocity gives 2.33 % at 0.75 h (7.6 % with the lumped
+// trapezoidal mean at the dashpot nodes). On a grid line at 4 ppc: 0.13 % (P) and 0.18 % (S),
+// against 0.26 / 0.26 % re-mapped.
 TEST(SilentLayer, UpdatedEdgeVelocityMusl) {
   ColumnSpec u;
   u.updated_edge = true;
@@ -1031,7 +1034,8 @@ TEST(SilentLayer, UpdatedEdgeVelocityMusl) {
     const double updated = std::sqrt(reflected_energy_ratio(u, 16, 0.02));
     std::printf("  [MUSL, edge 0.75 h off] reflected amplitude %.4f re-mapped, %.4f updated\n",
                 remapped, updated);
-    EXPECT_LE(updated, remapped / 3) << "the updated velocity reflects less than a third";
+    EXPECT_LE(remapped, 0.03) << "the re-mapped velocity with the particles' mean";
+    EXPECT_LE(updated, 0.8 * remapped) << "the updated velocity reflects less";
   }
   for (const bool shear : {false, true}) {
     ColumnSpec c;
@@ -1047,9 +1051,9 @@ TEST(SilentLayer, UpdatedEdgeVelocityMusl) {
 
 // USF with the updated velocity at the dashpots' nodes (`edge_velocity` "updated"): USF strains
 // the particles with the start-of-step nodal velocity, so at those nodes it takes the last step's
-// v+ (docs/physics.md section 4). On a grid line at 4 and 9 ppc, measured 0.13 % (P) and 0.19 %
-// (S) against 0.39 / 0.33 % (4 ppc) and 0.35 / 0.31 % (9 ppc) with the default; off the grid
-// line at 1 ppc, first order as under MUSL. Bounds: 0.25 % on the grid line, below half the
+// v+ (docs/physics.md section 4). On a grid line at 4 and 9 ppc, measured 0.13 % (P) and 0.18 %
+// (S) against 0.26 / 0.26 % (4 ppc) and 0.24 / 0.25 % (9 ppc) with the default; off the grid
+// line at 1 ppc, first order as under MUSL. Bounds: 0.25 % on the grid line, below 0.6 of the
 // default for P; the 1-ppc edge as the MUSL test's.
 TEST(SilentLayer, UpdatedEdgeVelocityUsf) {
   for (const int ppc : {2, 3})
@@ -1066,7 +1070,7 @@ TEST(SilentLayer, UpdatedEdgeVelocityUsf) {
                   "default\n", ppc * ppc, shear ? "S" : "P", amp, dflt);
       EXPECT_LE(amp, 2.5e-3) << ppc * ppc << " ppc " << (shear ? "S" : "P");
       if (!shear) {
-        EXPECT_LE(amp, 0.5 * dflt) << ppc * ppc << " ppc";
+        EXPECT_LE(amp, 0.6 * dflt) << ppc * ppc << " ppc";
       }
     }
   ColumnSpec u;

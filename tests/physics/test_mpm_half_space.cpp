@@ -173,14 +173,15 @@ EnergyLeft square_run(const std::string& text, const fs::path& dir) {
 
 // The delayed closure in two dimensions, where motion runs along the edges and into corners.
 // Measured (kinetic + elastic energy over the work put in): 3.2e-4 at 2 ms under MUSL and
-// 3.0e-4 under USF, never above that later, 3.0e-9 and 3.6e-9 at 12 ms; LK's default still holds
-// 4.8e-4 at 12 ms (1.3e-3 at 2 ms: the odd-even modes its edge feeds ring on). With the closure
+// 3.0e-4 under USF, never above that later, 3.0e-9 and 3.6e-9 at 12 ms; LK's default holds
+// 3.7e-8 at 12 ms (4.7e-5 at 2 ms; 4.8e-4 and 1.3e-3 with the lumped trapezoidal mean at its
+// dashpot nodes, the odd-even modes its edge fed ringing on). With the closure
 // on the tangential component as well, the run grew from the first wave on and stopped on the
 // energy check after 10 883 steps (MUSL; 18 147 at CFL 0.3, 7 020 for a square of 40 cells, USF
 // alike): along an edge the tangential motion has frequencies a dashpot acting with a velocity of
 // h/c_s ago feeds (docs/physics.md section 4). The closure's energy account is off by 2.0 %
 // (MUSL) and 1.0 % (USF) of the input here, against 0.2 % in the column. Bounds: no growth after
-// 2 ms, the end below 1e-6 of the input and below a hundredth of LK's, the account within 3 %.
+// 2 ms, the end below 1e-6 of the input and below a fifth of LK's, the account within 3 %.
 TEST(SilentStability, DelayedClosureSquareDecays) {
   const fs::path out = fs::temp_directory_path() / ("smpm_dsq_" + std::to_string(::getpid()));
   fs::remove_all(out);
@@ -194,23 +195,22 @@ TEST(SilentStability, DelayedClosureSquareDecays) {
                 scheme, d.at_ref, d.later_max, d.last, d.imbalance);
     EXPECT_LE(d.later_max, d.at_ref) << scheme;
     EXPECT_LE(d.last, 1e-6) << scheme;
-    EXPECT_LE(d.last, 0.01 * lk.last) << scheme;
+    EXPECT_LE(d.last, 0.2 * lk.last) << scheme;
     EXPECT_LE(std::abs(d.imbalance), 3e-2) << scheme;
   }
   fs::remove_all(out);
 }
 
-// The nodal LK edge under MUSL on the square's two sides, its top and bottom free: where the
-// edges meet free surfaces, long runs grew above CFL 0.2 at 1 ppc and 0.4 at 4 ppc (MUSL, 1 ppc:
-// growing at 0.3 over 3 * 10^5 steps, stopped on the energy check after 1.7 * 10^4 at 0.4 and
-// 0.5; 4 ppc: after 1.9 * 10^4 at 0.5; 9 ppc alike; USF alike), and never with the updated edge
-// velocity (1 and 4 ppc, CFL 0.5-0.8) or under USL (docs/physics.md section 4; check and run say
-// so for runs of more than 10^4 steps). Measured at the bounds over 15 ms (kinetic + elastic
-// energy over the work put in, at 2 ms and at the end; never above the first later): 1 ppc,
-// CFL 0.2: 2.1e-3, 3.8e-5; 4 ppc, CFL 0.4: 5.4e-5, 2.6e-7; "updated", 1 ppc, CFL 0.5: 6.6e-4,
-// 1.2e-6 (its energy account off by 16 %, as under USL). Bounds: no growth after 2 ms, the end
-// below 5 % of the level at 2 ms.
-TEST(SilentStability, NodalEdgesAtTheirLongRunBounds) {
+// The nodal LK edge under MUSL on the square's two sides, its top and bottom free. With the
+// trapezoidal mean of the lumped mass at the dashpot nodes, long runs grew where the edges meet
+// free surfaces (1 ppc: growing at CFL 0.3, stopped on the energy check after 1.7 * 10^4 steps
+// at 0.4 and 0.5; 4 ppc: after 1.9 * 10^4 at 0.5; USF alike). With the particles' mean
+// (Solver::consistent_dashpots; docs/physics.md section 4) measured over 15 ms (kinetic +
+// elastic energy over the work put in, at 2 ms and at the end; never above the first later):
+// 1 ppc, CFL 0.5: 5.5e-4, 7.9e-6; 4 ppc, CFL 0.5: 7.3e-5, 8.1e-7; the account closes to 1.4e-5.
+// "updated", 1 ppc, CFL 0.5: 6.6e-4, 1.2e-6 (its account off by 16 %, as under USL). Bounds: no
+// growth after 2 ms, the end below 5 % of the level at 2 ms, the default's account within 1e-3.
+TEST(SilentStability, NodalEdgesLongRunsDecay) {
   const fs::path out = fs::temp_directory_path() / ("smpm_nsq_" + std::to_string(::getpid()));
   fs::remove_all(out);
   fs::create_directories(out);
@@ -219,7 +219,7 @@ TEST(SilentStability, NodalEdgesAtTheirLongRunBounds) {
     int ppc;
     double cfl;
   };
-  for (const Variant v : {Variant{"", 1, 0.2}, Variant{"", 4, 0.4}, Variant{"updated", 1, 0.5}}) {
+  for (const Variant v : {Variant{"", 1, 0.5}, Variant{"", 4, 0.5}, Variant{"updated", 1, 0.5}}) {
     const EnergyLeft r = square_run(square("MUSL", v.edge, v.ppc, v.cfl, true, 0.015),
                                    out / (std::to_string(v.ppc) + v.edge));
     std::printf("  [MUSL, edge \"%s\", %d ppc, CFL %.1f] at 2 ms %.2e, largest later %.2e, at 15 ms "
@@ -227,7 +227,52 @@ TEST(SilentStability, NodalEdgesAtTheirLongRunBounds) {
                 r.imbalance);
     EXPECT_LE(r.later_max, r.at_ref) << v.edge << " " << v.ppc << " ppc";
     EXPECT_LE(r.last, 0.05 * r.at_ref) << v.edge << " " << v.ppc << " ppc";
+    if (*v.edge == 0) {
+      EXPECT_LE(std::abs(r.imbalance), 1e-3) << v.ppc << " ppc";
+    }
   }
+  fs::remove_all(out);
+}
+
+// The smallest body where the lumped trapezoidal mean grew: a steel strip of 20 x 2 cells (1 ppc),
+// LK on its ends, its long sides free, a line load on the top. The step's linearised map (the
+// particles' velocities and stresses, positions held) had its largest eigenvalue at 1 + 1.1e-3
+// (CFL 0.5): MUSL's odd-even mode along the strip, fed by the ends; with the particles' mean
+// every eigenvalue lies on or inside the unit circle, at CFL 0.5 and 0.9, MUSL and USF
+// (docs/physics.md section 4). Measured over 3.4 ms (2 * 10^4 steps at CFL 0.5), kinetic +
+// elastic energy over the work put in: largest 1.78-1.85e-3 over 0.85-1.7 ms, 6.2-6.5e-4 over
+// 2.55-3.4 ms (MUSL, USF, CFL 0.5, 0.9). With the lumped mean the run stopped on the energy
+// check. Bound: the largest over the last quarter below half the largest over the second.
+TEST(SilentStability, StripOfTwoCellsDecays) {
+  const fs::path out = fs::temp_directory_path() / ("smpm_strip_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  for (const char* scheme : {"MUSL", "USF"})
+    for (const double cfl : {0.5, 0.9}) {
+      std::string c = R"({"title": "strip", "time": {"end": 3.4e-3, "cfl": )" + num(cfl) + "},";
+      c += R"("grid": {"origin": [0, 0], "size": [0.04, 0.006], "cell": 0.002},)";
+      c += R"("scheme": {"update": ")" + std::string(scheme) + R"(", "threads": 1},)";
+      c += R"("materials": {"steel": {"model": "elastic", "young": 200e9, "poisson": 0.3, "density": 7850}},)";
+      c += R"("bodies": [{"name": "s", "material": "steel", "box": [0, 0, 0.04, 0.004], "particles_per_cell": 1}],)";
+      c += R"("boundaries": [{"type": "traction", "body": "s", "side": "top", "interval": [0.016, 0.024],)";
+      c += R"( "normal": -1e7, "time": {"shape": "sin2", "start": 0, "duration": 4e-6, "ramp": 2e-6}},)";
+      c += R"( {"type": "silent", "body": "s", "side": "left"}, {"type": "silent", "body": "s", "side": "right"}],)";
+      c += R"("output": {"history_every": 200, "snapshots": 0, "progress": false}})";
+      const History h = run(c, out / (std::string(scheme) + num(cfl)));
+      const auto& ke = h.column("energy.kinetic");
+      const auto& el = h.column("energy.elastic");
+      const double ext = h.column("energy.external_work").back();
+      double second = 0, last = 0;  // the largest over 0.85-1.7 ms and over 2.55-3.4 ms
+      for (std::size_t i = 0; i < h.time.size(); ++i) {
+        const double e = (ke[i] + el[i]) / ext;
+        if (h.time[i] >= 0.85e-3 && h.time[i] < 1.7e-3) second = std::max(second, e);
+        if (h.time[i] >= 2.55e-3) last = std::max(last, e);
+      }
+      std::printf("  [%s, CFL %.1f] largest over 0.85-1.7 ms %.2e, over 2.55-3.4 ms %.2e\n",
+                  scheme, cfl, second, last);
+      EXPECT_GT(second, 0) << scheme << " " << cfl;
+      EXPECT_LE(last, 0.5 * second) << scheme << " " << cfl;
+    }
   fs::remove_all(out);
 }
 

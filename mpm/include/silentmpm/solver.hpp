@@ -258,6 +258,33 @@ class Solver {
   // (SilentBoundary::updated_velocity; summed over the halo with the blocks); empty when no
   // layer is.
   std::vector<double> updated_weight_;
+  // MUSL and USF, one velocity field: the dashpot blocks of the silent layers with the default
+  // edge velocity act on the mean of the velocities the particles map to the node at the start
+  // and at the end of the step (consistent_dashpots; docs/physics.md section 4). Per grid node,
+  // the weight (w N rho c_d) those layers put on it this step, summed over the halo with the
+  // blocks (empty when the scheme or the layers do not take it); the nodes solved so this step,
+  // the particles whose shape functions reach them, and per node its slot (-1: none).
+  std::vector<double> consistent_weight_;
+  std::vector<long> cm_nodes_;
+  std::vector<int> cm_slot_;
+  std::vector<std::uint8_t> cm_cell_;   // per cell: within reach of a listed node this step
+  std::vector<long> cm_cells_;          // the cells marked
+  std::vector<std::uint32_t> cm_particles_;
+  std::vector<long> cm_pn_;             // their nodes (K per particle)
+  std::vector<double> cm_pN_;           // and shape values
+  static constexpr int kCm = 8;
+  std::vector<double> cm_;              // per slot: kCm values (see consistent_dashpots)
+  std::vector<double> cm_halo_;         // several ranks: grid-sized arrays for the halo sums
+  int cm_iterations_ = 0;               // the last step's fixed-point iterations
+  std::vector<std::uint32_t> cm_zone_;  // the particles of the zone around the nodes
+  std::vector<long> cm_scan_nodes_;     // the nodes, the particles' order and count, when the
+  long cm_scan_version_ = -1;           // zone was last found
+  std::size_t cm_scan_size_ = 0;
+  double cm_drift_ = 0;                 // how far a particle may have moved since (m)
+  double vmax2_ = 0;                    // the step's fastest updated nodal velocity, squared
+  long order_version_ = 0;              // bumped whenever the particles' order or count changes
+  template <class S> void consistent_dashpots();
+  void cm_sum(int first, int count);    // sum slot values [first, first + count) over the halo
   // USF with such layers: the last step's updated velocity at their dashpot nodes, which the
   // next step strains the particles with (start_velocities). Per node: the whole grid's node
   // (i, j), its weight (updated_weight_) and v+ (x, y); part of a checkpoint.
