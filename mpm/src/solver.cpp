@@ -1299,24 +1299,24 @@ void Solver::consistent_dashpots() {
       cm_nodes_.push_back(i);
     }
     // The particles whose shape functions reach those nodes, from a zone of particles kept
-    // between steps: those in the cells whose particles can reach a listed node, and two more
-    // around them (one so that a particle on a cell's edge passes whichever cell round-off puts
-    // it in, one for the particles' drift). The zone is found again by a pass over every
-    // particle when the nodes change, the particles were re-ordered, or the particles may have
-    // drifted a cell since (cm_drift_, the sum over the steps of dt times the fastest nodal
-    // velocity they moved with), and every step when hooks may change that velocity.
+    // between steps: those in the cells whose particles can reach a listed node, and one more
+    // around them. The zone is found again by a pass over every particle when the nodes
+    // change, the particles were re-ordered, or the particles may have drifted half a cell since
+    // (cm_drift_, the sum over the steps of dt times the fastest nodal velocity they moved
+    // with; a particle outside the zone was a cell away from the reaching cells, less
+    // round-off), and every step when hooks may change that velocity.
     const bool scan = !hooks_.empty() || cm_scan_version_ != order_version_ ||
                       cm_scan_size_ != p.size() || cm_scan_nodes_ != cm_nodes_ ||
-                      !(cm_drift_ < grid.h);
+                      !(cm_drift_ < 0.5 * grid.h);
     if (scan) {
       for (const long c : cm_cells_) cm_cell_[c] = 0;
       cm_cells_.clear();
       for (const long i : cm_nodes_) {
         const long ni = i % nnx, nj = i / nnx;
-        for (long cj = std::max<long>(0, nj - S::kRowsAbove - 2);
-             cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow + 2); ++cj)
-          for (long ci = std::max<long>(0, ni - S::kRowsAbove - 2);
-               ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow + 2); ++ci) {
+        for (long cj = std::max<long>(0, nj - S::kRowsAbove - 1);
+             cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow + 1); ++cj)
+          for (long ci = std::max<long>(0, ni - S::kRowsAbove - 1);
+               ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow + 1); ++ci) {
             const long c = cj * ncx + ci;
             if (!cm_cell_[c]) {
               cm_cell_[c] = 1;
@@ -1339,24 +1339,24 @@ void Solver::consistent_dashpots() {
       cm_scan_nodes_ = cm_nodes_;
       cm_drift_ = 0;
     }
-    cm_particles_.clear();
-    cm_pn_.clear();
-    cm_pN_.clear();
+    cm_particles_.resize(cm_zone_.size());
+    cm_pn_.resize(K * cm_zone_.size());
+    cm_pN_.resize(K * cm_zone_.size());
+    std::size_t nc = 0;
     for (const std::uint32_t k : cm_zone_) {
       S sf;
       if constexpr (S::kSized) sf.size(p.mass[k], inv_rho(p.group[k]), grid.inv_h);
       sf.eval(grid, p.x[k], p.y[k]);
-      long nodes[K];
+      long* nodes = cm_pn_.data() + K * nc;
       sf.node_indices(nnx, nodes);
       bool reaches = false;
       for (int a = 0; a < K; ++a) reaches = reaches || (sf.N[a] != 0 && cm_slot_[nodes[a]] >= 0);
       if (!reaches) continue;
-      cm_particles_.push_back(k);
-      for (int a = 0; a < K; ++a) {
-        cm_pn_.push_back(nodes[a]);
-        cm_pN_.push_back(sf.N[a]);
-      }
+      cm_particles_[nc] = k;
+      for (int a = 0; a < K; ++a) cm_pN_[K * nc + a] = sf.N[a];
+      ++nc;
     }
+    cm_particles_.resize(nc);
     const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
     cm_.assign(kCm * ns, 0.0);
     // dv0 at a particle's nodes, and its sums: Mc dv0, d and the particles' mass at each slot.
