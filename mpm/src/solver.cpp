@@ -1339,27 +1339,16 @@ void Solver::consistent_dashpots() {
       cm_scan_nodes_ = cm_nodes_;
       cm_drift_ = 0;
     }
-    cm_particles_.resize(cm_zone_.size());
-    cm_pn_.resize(K * cm_zone_.size());
-    cm_pN_.resize(K * cm_zone_.size());
-    std::size_t nc = 0;
-    for (const std::uint32_t k : cm_zone_) {
-      S sf;
-      if constexpr (S::kSized) sf.size(p.mass[k], inv_rho(p.group[k]), grid.inv_h);
-      sf.eval(grid, p.x[k], p.y[k]);
-      long* nodes = cm_pn_.data() + K * nc;
-      sf.node_indices(nnx, nodes);
-      bool reaches = false;
-      for (int a = 0; a < K; ++a) reaches = reaches || (sf.N[a] != 0 && cm_slot_[nodes[a]] >= 0);
-      if (!reaches) continue;
-      cm_particles_[nc] = k;
-      for (int a = 0; a < K; ++a) cm_pN_[K * nc + a] = sf.N[a];
-      ++nc;
-    }
-    cm_particles_.resize(nc);
-    const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
-    cm_.assign(kCm * ns, 0.0);
-    // dv0 at a particle's nodes, and its sums: Mc dv0, d and the particles' mass at each slot.
+    // Each zone particle's shape functions, its nodes' slots and this step's dv0 . N (in
+    // parallel, each its own), then those that reach a listed node kept in zone order.
+    const long nz = static_cast<long>(cm_zone_.size());
+    cm_pn_.resize(K * nz);
+    cm_pN_.resize(K * nz);
+    cm_ps_.resize(K * nz);
+    cm_pm_.resize(nz);
+    cm_s_.resize(2 * nz);
+    std::vector<std::uint8_t> reaches(nz);
+    // dv0 at a node: without the listed nodes' dashpots.
     auto dv0 = [&](long j, double& ax, double& ay) {
       if (cm_slot_[j] >= 0) {
         ax = (fix[j] & 1) ? 0.0 : DT * grid.fx[j] / m[j];
@@ -1369,20 +1358,58 @@ void Solver::consistent_dashpots() {
         ay = grid.vny[j] - grid.vy[j];
       }
     };
-    for (std::size_t q = 0; q < np; ++q) {
-      const long* nodes = cm_pn_.data() + K * q;
-      const double* N = cm_pN_.data() + K * q;
-      const double mp = p.mass[cm_particles_[q]];
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nz >= 512)
+    for (long e = 0; e < nz; ++e) {
+      const std::uint32_t k = cm_zone_[e];
+      S sf;
+      if constexpr (S::kSized) sf.size(p.mass[k], inv_rho(p.group[k]), grid.inv_h);
+      sf.eval(grid, p.x[k], p.y[k]);
+      long* nodes = cm_pn_.data() + K * e;
+      sf.node_indices(nnx, nodes);
+      bool r = false;
       double sx = 0, sy = 0;
       for (int a = 0; a < K; ++a) {
-        if (N[a] == 0) continue;
+        const int sl = sf.N[a] != 0 ? cm_slot_[nodes[a]] : -1;
+        cm_ps_[K * e + a] = sl;
+        cm_pN_[K * e + a] = sf.N[a];
+        r = r || sl >= 0;
+        if (sf.N[a] == 0) continue;
         double ax, ay;
         dv0(nodes[a], ax, ay);
-        sx += N[a] * ax;
-        sy += N[a] * ay;
+        sx += sf.N[a] * ax;
+        sy += sf.N[a] * ay;
       }
+      reaches[e] = r;
+      cm_pm_[e] = p.mass[k];
+      cm_s_[2 * e] = sx;
+      cm_s_[2 * e + 1] = sy;
+    }
+    std::size_t nc = 0;
+    cm_particles_.resize(nz);
+    for (long e = 0; e < nz; ++e) {
+      if (!reaches[e]) continue;
+      if (static_cast<long>(nc) != e) {
+        for (int a = 0; a < K; ++a) {
+          cm_pn_[K * nc + a] = cm_pn_[K * e + a];
+          cm_pN_[K * nc + a] = cm_pN_[K * e + a];
+          cm_ps_[K * nc + a] = cm_ps_[K * e + a];
+        }
+        cm_pm_[nc] = cm_pm_[e];
+        cm_s_[2 * nc] = cm_s_[2 * e];
+        cm_s_[2 * nc + 1] = cm_s_[2 * e + 1];
+      }
+      cm_particles_[nc++] = cm_zone_[e];
+    }
+    cm_particles_.resize(nc);
+    const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
+    cm_.assign(kCm * ns, 0.0);
+    // The sums at each slot, in particle order: Mc dv0, d and the particles' mass.
+    for (std::size_t q = 0; q < np; ++q) {
+      const double* N = cm_pN_.data() + K * q;
+      const int* sls = cm_ps_.data() + K * q;
+      const double mp = cm_pm_[q], sx = cm_s_[2 * q], sy = cm_s_[2 * q + 1];
       for (int a = 0; a < K; ++a) {
-        const int sl = cm_slot_[nodes[a]];
+        const int sl = sls[a];
         if (sl < 0) continue;
         double* c = cm_.data() + kCm * sl;
         c[0] += mp * N[a] * sx;
@@ -1422,19 +1449,27 @@ void Solver::consistent_dashpots() {
       g[2 * k + 1] = (fix[i] & 2) ? 0.0 : DT * (grid.cxy[i] * c[4] + grid.cyy[i] * c[5]) / m[i];
       cm_[kCm * k + 6] = cm_[kCm * k + 7] = 0;
     }
-    for (std::size_t q = 0; q < np; ++q) {
-      const long* nodes = cm_pn_.data() + K * q;
+    const long npl = static_cast<long>(np);
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (npl >= 512)
+    for (long q = 0; q < npl; ++q) {
       const double* N = cm_pN_.data() + K * q;
-      const double mp = p.mass[cm_particles_[q]];
+      const int* sls = cm_ps_.data() + K * q;
       double sx = 0, sy = 0;
       for (int a = 0; a < K; ++a) {
-        const int sl = cm_slot_[nodes[a]];
+        const int sl = sls[a];
         if (sl < 0) continue;
         sx += N[a] * g[2 * sl];
         sy += N[a] * g[2 * sl + 1];
       }
+      cm_s_[2 * q] = sx;
+      cm_s_[2 * q + 1] = sy;
+    }
+    for (std::size_t q = 0; q < np; ++q) {
+      const double* N = cm_pN_.data() + K * q;
+      const int* sls = cm_ps_.data() + K * q;
+      const double mp = cm_pm_[q], sx = cm_s_[2 * q], sy = cm_s_[2 * q + 1];
       for (int a = 0; a < K; ++a) {
-        const int sl = cm_slot_[nodes[a]];
+        const int sl = sls[a];
         if (sl < 0) continue;
         cm_[kCm * sl + 6] += mp * N[a] * sx;
         cm_[kCm * sl + 7] += mp * N[a] * sy;

@@ -272,6 +272,9 @@ class Solver {
   std::vector<std::uint32_t> cm_particles_;
   std::vector<long> cm_pn_;             // their nodes (K per particle)
   std::vector<double> cm_pN_;           // and shape values
+  std::vector<int> cm_ps_;              // and their nodes' slots (-1: none)
+  std::vector<double> cm_pm_;           // their masses
+  std::vector<double> cm_s_;            // 2 per particle: its sum N . dv (scratch)
   static constexpr int kCm = 8;
   std::vector<double> cm_;              // per slot: kCm values (see consistent_dashpots)
   std::vector<double> cm_halo_;         // several ranks: grid-sized arrays for the halo sums
