@@ -204,6 +204,8 @@ void Solver::finalize() {
   consistent_weight_.assign(consistent ? grid.nodes() : 0, 0.0);
   cm_nodes_.clear();
   cm_slot_.assign(consistent ? grid.nodes() : 0, -1);
+  cm_cover_.assign(consistent ? grid.nodes() : 0, 0);
+  cm_covered_.clear();
   cm_cell_.assign(consistent ? static_cast<std::size_t>(grid.nx) * grid.ny : 0, 0);
   cm_cells_.clear();
   bool delayed = false;  // a layer with the delayed closure (MUSL or USF, one field)
@@ -1299,24 +1301,37 @@ void Solver::consistent_dashpots() {
       cm_nodes_.push_back(i);
     }
     // The particles whose shape functions reach those nodes, from a zone of particles kept
-    // between steps: those in the cells whose particles can reach a listed node, and one more
-    // around them. The zone is found again by a pass over every particle when the nodes
-    // change, the particles were re-ordered, or the particles may have drifted half a cell since
-    // (cm_drift_, the sum over the steps of dt times the fastest nodal velocity they moved
-    // with; a particle outside the zone was a cell away from the reaching cells, less
-    // round-off), and every step when hooks may change that velocity.
-    const bool scan = !hooks_.empty() || cm_scan_version_ != order_version_ ||
-                      cm_scan_size_ != p.size() || cm_scan_nodes_ != cm_nodes_ ||
-                      !(cm_drift_ < 0.5 * grid.h);
+    // between steps: those in the cells whose particles can reach a listed node or one next to
+    // it (the nodes it covers), and one more cell around them. The zone is found again by a
+    // pass over every particle when a listed node is not covered (a node along the edge enters
+    // and leaves the list as the edge's points cross a grid line: its neighbours are covered),
+    // the particles were re-ordered, or they may have drifted half a cell since (cm_drift_, the
+    // sum over the steps of dt times the fastest nodal velocity they moved with; a particle
+    // outside the zone was a cell away from a covered node's cells, less round-off), and every
+    // step when hooks may change that velocity.
+    bool scan = !hooks_.empty() || cm_scan_version_ != order_version_ ||
+                cm_scan_size_ != p.size() || !(cm_drift_ < 0.5 * grid.h);
+    for (std::size_t k = 0; k < cm_nodes_.size() && !scan; ++k) scan = !cm_cover_[cm_nodes_[k]];
     if (scan) {
       for (const long c : cm_cells_) cm_cell_[c] = 0;
       cm_cells_.clear();
+      for (const long i : cm_covered_) cm_cover_[i] = 0;
+      cm_covered_.clear();
+      const long nnyl = grid.nny;
       for (const long i : cm_nodes_) {
         const long ni = i % nnx, nj = i / nnx;
-        for (long cj = std::max<long>(0, nj - S::kRowsAbove - 1);
-             cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow + 1); ++cj)
-          for (long ci = std::max<long>(0, ni - S::kRowsAbove - 1);
-               ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow + 1); ++ci) {
+        for (long j = std::max<long>(0, nj - 1); j <= std::min<long>(nnyl - 1, nj + 1); ++j)
+          for (long ii = std::max<long>(0, ni - 1); ii <= std::min<long>(nnx - 1, ni + 1); ++ii) {
+            const long c = j * nnx + ii;
+            if (!cm_cover_[c]) {
+              cm_cover_[c] = 1;
+              cm_covered_.push_back(c);
+            }
+          }
+        for (long cj = std::max<long>(0, nj - S::kRowsAbove - 2);
+             cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow + 2); ++cj)
+          for (long ci = std::max<long>(0, ni - S::kRowsAbove - 2);
+               ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow + 2); ++ci) {
             const long c = cj * ncx + ci;
             if (!cm_cell_[c]) {
               cm_cell_[c] = 1;
@@ -1336,7 +1351,6 @@ void Solver::consistent_dashpots() {
       }
       cm_scan_version_ = order_version_;
       cm_scan_size_ = p.size();
-      cm_scan_nodes_ = cm_nodes_;
       cm_drift_ = 0;
     }
     // Each zone particle's shape functions, its nodes' slots and this step's dv0 . N (in
@@ -1432,75 +1446,99 @@ void Solver::consistent_dashpots() {
     std::sort(dropped.begin(), dropped.end());
   }
   const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
-  // Start from the trapezoidal mean.
+  // The consistent mass between the slots, row by row (the diagonal left out; in each row the
+  // entries in the order their first particle met them, each summed in particle order):
+  // (Mc)_ij = sum_p m_p N_ip N_jp. A row holds at most the slots a particle's stencil shares
+  // with it, kCmRow of them.
+  cm_cnt_.assign(ns, 0);
+  cm_col_.resize(kCmRow * ns);
+  cm_w_.resize(kCmRow * ns);
+  for (std::size_t q = 0; q < np; ++q) {
+    const double* N = cm_pN_.data() + K * q;
+    const int* sls = cm_ps_.data() + K * q;
+    for (int a = 0; a < K; ++a) {
+      const int i = sls[a];
+      if (i < 0) continue;
+      int* col = cm_col_.data() + kCmRow * i;
+      double* w = cm_w_.data() + kCmRow * i;
+      for (int b = 0; b < K; ++b) {
+        const int j = sls[b];
+        if (j < 0 || j == i) continue;
+        int e = 0;
+        while (e < cm_cnt_[i] && col[e] != j) ++e;
+        if (e == cm_cnt_[i]) {
+          if (e == kCmRow) throw std::logic_error("consistent_dashpots: a row of more than 24 slots");
+          col[e] = j;
+          w[e] = 0;
+          ++cm_cnt_[i];
+        }
+        w[e] += cm_pm_[q] * N[a] * N[b];
+      }
+    }
+  }
+  // The slots' node values, and the start: the trapezoidal mean.
+  cm_node_.resize(kCmNode * ns);
   for (std::size_t k = 0; k < ns; ++k) {
     const long i = cm_nodes_[k];
     double* c = cm_.data() + kCm * k;
+    double* n = cm_node_.data() + kCmNode * k;
+    n[0] = m[i];
+    n[1] = (fix[i] & 1) ? 0.0 : 1.0;
+    n[2] = (fix[i] & 2) ? 0.0 : 1.0;
+    n[3] = grid.cxx[i];
+    n[4] = grid.cxy[i];
+    n[5] = grid.cyy[i];
+    n[6] = grid.vx[i];
+    n[7] = grid.vy[i];
     c[4] = 0.5 * (grid.vx[i] + grid.vnx[i]);
     c[5] = 0.5 * (grid.vy[i] + grid.vny[i]);
   }
   std::vector<double> g(2 * ns);
+  auto g_of = [&](std::size_t k) {  // dt C vbar / m at slot k, on its free components
+    const double* c = cm_.data() + kCm * k;
+    const double* n = cm_node_.data() + kCmNode * k;
+    g[2 * k] = n[1] * DT * (n[3] * c[4] + n[4] * c[5]) / n[0];
+    g[2 * k + 1] = n[2] * DT * (n[4] * c[4] + n[5] * c[5]) / n[0];
+  };
+  for (std::size_t k = 0; k < ns; ++k) g_of(k);
   int it = 0;
   for (;; ++it) {
-    for (std::size_t k = 0; k < ns; ++k) {
-      const long i = cm_nodes_[k];
-      const double* c = cm_.data() + kCm * k;
-      g[2 * k] = (fix[i] & 1) ? 0.0 : DT * (grid.cxx[i] * c[4] + grid.cxy[i] * c[5]) / m[i];
-      g[2 * k + 1] = (fix[i] & 2) ? 0.0 : DT * (grid.cxy[i] * c[4] + grid.cyy[i] * c[5]) / m[i];
-      cm_[kCm * k + 6] = cm_[kCm * k + 7] = 0;
-    }
-    const long npl = static_cast<long>(np);
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (npl >= 512)
-    for (long q = 0; q < npl; ++q) {
-      const double* N = cm_pN_.data() + K * q;
-      const int* sls = cm_ps_.data() + K * q;
-      double sx = 0, sy = 0;
-      for (int a = 0; a < K; ++a) {
-        const int sl = sls[a];
-        if (sl < 0) continue;
-        sx += N[a] * g[2 * sl];
-        sy += N[a] * g[2 * sl + 1];
+    for (std::size_t k = 0; k < ns; ++k) {  // o_k = sum over the other slots of (Mc)_kj g_j
+      const int* col = cm_col_.data() + kCmRow * k;
+      const double* w = cm_w_.data() + kCmRow * k;
+      double ox = 0, oy = 0;
+      for (int e = 0; e < cm_cnt_[k]; ++e) {
+        ox += w[e] * g[2 * col[e]];
+        oy += w[e] * g[2 * col[e] + 1];
       }
-      cm_s_[2 * q] = sx;
-      cm_s_[2 * q + 1] = sy;
-    }
-    for (std::size_t q = 0; q < np; ++q) {
-      const double* N = cm_pN_.data() + K * q;
-      const int* sls = cm_ps_.data() + K * q;
-      const double mp = cm_pm_[q], sx = cm_s_[2 * q], sy = cm_s_[2 * q + 1];
-      for (int a = 0; a < K; ++a) {
-        const int sl = sls[a];
-        if (sl < 0) continue;
-        cm_[kCm * sl + 6] += mp * N[a] * sx;
-        cm_[kCm * sl + 7] += mp * N[a] * sy;
-      }
+      cm_[kCm * k + 6] = ox;
+      cm_[kCm * k + 7] = oy;
     }
     cm_sum(6, 2);
     double change = 0, scale = 0;
     for (std::size_t k = 0; k < ns; ++k) {
-      const long i = cm_nodes_[k];
       double* c = cm_.data() + kCm * k;
-      const double mi = m[i], d = c[2];
-      const double rx = grid.vx[i] + 0.5 * (c[0] - (c[6] - d * g[2 * k])) / mi;
-      const double ry = grid.vy[i] + 0.5 * (c[1] - (c[7] - d * g[2 * k + 1])) / mi;
+      const double* n = cm_node_.data() + kCmNode * k;
+      const double mi = n[0], d = c[2];
+      const double rx = n[6] + 0.5 * (c[0] - c[6]) / mi;
+      const double ry = n[7] + 0.5 * (c[1] - c[7]) / mi;
       const double kap = 0.5 * DT * d / (mi * mi);
-      const double A = 1 + kap * grid.cxx[i], B = kap * grid.cxy[i], D = 1 + kap * grid.cyy[i];
+      const double A = 1 + kap * n[3], B = kap * n[4], D = 1 + kap * n[5];
       double bx = 0, by = 0;
-      switch (fix[i] & 3) {
-        case 0: {
-          const double det = A * D - B * B;
-          bx = (D * rx - B * ry) / det;
-          by = (A * ry - B * rx) / det;
-          break;
-        }
-        case 1: by = ry / D; break;
-        case 2: bx = rx / A; break;
-        default: break;
+      if (n[1] != 0 && n[2] != 0) {
+        const double det = A * D - B * B;
+        bx = (D * rx - B * ry) / det;
+        by = (A * ry - B * rx) / det;
+      } else if (n[2] != 0) {
+        by = ry / D;  // x held
+      } else if (n[1] != 0) {
+        bx = rx / A;  // y held
       }
       change = std::max(change, std::max(std::abs(bx - c[4]), std::abs(by - c[5])));
       scale = std::max(scale, std::max(std::abs(bx), std::abs(by)));
       c[4] = bx;
       c[5] = by;
+      g_of(k);
     }
     if (dist_) {
       double v[2] = {change, scale};
@@ -1508,7 +1546,7 @@ void Solver::consistent_dashpots() {
       change = v[0];
       scale = v[1];
     }
-    if (change <= 1e-14 * scale || it >= 200) break;
+    if (change <= 1e-13 * scale || it >= 200) break;
   }
   cm_iterations_ = it + 1;
   double v2 = vmax2_;

@@ -52,6 +52,8 @@ void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool das
   if (!consistent_weight_.empty()) {  // the window's nodes and cells
     consistent_weight_.assign(grid.nodes(), 0.0);
     cm_slot_.assign(grid.nodes(), -1);
+    cm_cover_.assign(grid.nodes(), 0);
+    cm_covered_.clear();
     cm_cell_.assign(static_cast<std::size_t>(grid.nx) * grid.ny, 0);
     cm_nodes_.clear();
     cm_cells_.clear();

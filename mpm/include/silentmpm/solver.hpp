@@ -275,13 +275,19 @@ class Solver {
   std::vector<int> cm_ps_;              // and their nodes' slots (-1: none)
   std::vector<double> cm_pm_;           // their masses
   std::vector<double> cm_s_;            // 2 per particle: its sum N . dv (scratch)
+  static constexpr int kCmRow = 24;     // the slots a row of the consistent mass can hold
+  std::vector<int> cm_cnt_, cm_col_;    // the consistent mass between slots, kCmRow per row
+  std::vector<double> cm_w_;
+  static constexpr int kCmNode = 8;     // per slot: m, free x, free y, cxx, cxy, cyy, vx, vy
+  std::vector<double> cm_node_;
   static constexpr int kCm = 8;
   std::vector<double> cm_;              // per slot: kCm values (see consistent_dashpots)
   std::vector<double> cm_halo_;         // several ranks: grid-sized arrays for the halo sums
   int cm_iterations_ = 0;               // the last step's fixed-point iterations
   std::vector<std::uint32_t> cm_zone_;  // the particles of the zone around the nodes
-  std::vector<long> cm_scan_nodes_;     // the nodes, the particles' order and count, when the
-  long cm_scan_version_ = -1;           // zone was last found
+  std::vector<std::uint8_t> cm_cover_;  // per node: covered by the zone (see consistent_dashpots)
+  std::vector<long> cm_covered_;        // the nodes marked
+  long cm_scan_version_ = -1;           // the particles' order and count when the zone was found
   std::size_t cm_scan_size_ = 0;
   double cm_drift_ = 0;                 // how far a particle may have moved since (m)
   double vmax2_ = 0;                    // the step's fastest updated nodal velocity, squared
