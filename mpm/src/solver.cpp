@@ -1269,11 +1269,12 @@ void Solver::grid_update() {
 //   (I + kappa_i C_i) vbar_i = v_i + 1/2 (Mc dv0)_i / m_i - 1/2 o_i / m_i,
 // dv0 the increment without those nodes' dashpots (dt f / m there; grid_update's v+ - v at
 // every other node), kappa_i = dt d_i / (2 m_i^2), d_i = sum m_p N_ip^2 the diagonal of Mc and
-// o_i = sum_{j != i} Mc_ij g_j, g_j = dt C_j vbar_j / m_j, solved by fixed-point iteration.
+// o_i = sum_{j != i} Mc_ij g_j, g_j = dt C_j vbar_j / m_j, solved by fixed-point iteration to
+// 1e-13 of the largest vbar.
 // A node lighter than dt/2 times its block's largest eigenvalue keeps the trapezoidal update:
 // with that bound every other node's share of the row is below 1 - d_i / m_i, so the iteration
 // contracts. So does a node whose mass is not its particles' (a hook's share: the hybrid).
-// Slots: kCm values per node: (Mc dv0) x, y, d, sum m_p N, vbar x, y, (Mc g) x, y.
+// Slots: kCm values per node: (Mc dv0) x, y, d, sum m_p N, vbar x, y, o x, y.
 template <class S>
 void Solver::consistent_dashpots() {
   constexpr int K = S::kNodes;
