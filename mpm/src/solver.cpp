@@ -1293,10 +1293,13 @@ void Solver::consistent_dashpots() {
     for (const long i : dashpot_nodes_) {
       if (consistent_weight_[i] <= 0 || m[i] <= floor) continue;
       if (!updated_weight_.empty() && updated_weight_[i] > 0) continue;  // strained with v+
+      if (!delay_rho_.empty() && delay_rho_[i] > 0) continue;  // the delayed closure's own
       const double cxx = grid.cxx[i], cxy = grid.cxy[i], cyy = grid.cyy[i];
       const double lmax =
           0.5 * (cxx + cyy) + std::sqrt(0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy);
-      if (0.5 * DT * lmax > m[i]) continue;
+      // No block (a = b = 0: a rank that shares the node lists it only with a block), or one
+      // too strong for the node's mass.
+      if (!(lmax > 0) || 0.5 * DT * lmax > m[i]) continue;
       if (std::binary_search(dropped.begin(), dropped.end(), i)) continue;
       cm_slot_[i] = static_cast<int>(cm_nodes_.size());
       cm_nodes_.push_back(i);
