@@ -1360,7 +1360,6 @@ void Solver::consistent_dashpots() {
     // Each zone particle's shape functions, its nodes' slots and this step's dv0 . N (in
     // parallel, each its own), then those that reach a listed node kept in zone order.
     const long nz = static_cast<long>(cm_zone_.size());
-    cm_pn_.resize(K * nz);
     cm_pN_.resize(K * nz);
     cm_ps_.resize(K * nz);
     cm_pm_.resize(nz);
@@ -1382,7 +1381,7 @@ void Solver::consistent_dashpots() {
       S sf;
       if constexpr (S::kSized) sf.size(p.mass[k], inv_rho(p.group[k]), grid.inv_h);
       sf.eval(grid, p.x[k], p.y[k]);
-      long* nodes = cm_pn_.data() + K * e;
+      long nodes[K];
       sf.node_indices(nnx, nodes);
       bool r = false;
       double sx = 0, sy = 0;
@@ -1408,7 +1407,6 @@ void Solver::consistent_dashpots() {
       if (!reaches[e]) continue;
       if (static_cast<long>(nc) != e) {
         for (int a = 0; a < K; ++a) {
-          cm_pn_[K * nc + a] = cm_pn_[K * e + a];
           cm_pN_[K * nc + a] = cm_pN_[K * e + a];
           cm_ps_[K * nc + a] = cm_ps_[K * e + a];
         }
@@ -1552,7 +1550,6 @@ void Solver::consistent_dashpots() {
     }
     if (change <= 1e-13 * scale || it >= 200) break;
   }
-  cm_iterations_ = it + 1;
   double v2 = vmax2_;
   for (std::size_t k = 0; k < ns; ++k) {
     const long i = cm_nodes_[k];

@@ -270,8 +270,7 @@ class Solver {
   std::vector<std::uint8_t> cm_cell_;   // per cell: within reach of a listed node this step
   std::vector<long> cm_cells_;          // the cells marked
   std::vector<std::uint32_t> cm_particles_;
-  std::vector<long> cm_pn_;             // their nodes (K per particle)
-  std::vector<double> cm_pN_;           // and shape values
+  std::vector<double> cm_pN_;           // their shape values (K per particle)
   std::vector<int> cm_ps_;              // and their nodes' slots (-1: none)
   std::vector<double> cm_pm_;           // their masses
   std::vector<double> cm_s_;            // 2 per particle: its sum N . dv (scratch)
@@ -283,7 +282,6 @@ class Solver {
   static constexpr int kCm = 8;
   std::vector<double> cm_;              // per slot: kCm values (see consistent_dashpots)
   std::vector<double> cm_halo_;         // several ranks: grid-sized arrays for the halo sums
-  int cm_iterations_ = 0;               // the last step's fixed-point iterations
   std::vector<std::uint32_t> cm_zone_;  // the particles of the zone around the nodes
   std::vector<std::uint8_t> cm_cover_;  // per node: covered by the zone (see consistent_dashpots)
   std::vector<long> cm_covered_;        // the nodes marked
