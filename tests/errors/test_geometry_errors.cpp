@@ -61,6 +61,24 @@ Physical Surface("plate", 1) = {1};
 Physical Curve("bottom", 13) = {1, 2}; Physical Curve("bottom_left", 17) = {1};
 )";
 
+// An annulus with a curve embedded on its hole: gmsh cannot mesh it (it fails inside its
+// parallel surface meshing, which must still come back as an error, not end the process).
+const char* kRingOnHole = R"(
+DefineConstant[ h = 0.001 ];
+Point(1) = {0.01, 0.01, 0, h};
+Point(2) = {0.018, 0.01, 0, h}; Point(3) = {0.002, 0.01, 0, h};
+Point(4) = {0.013, 0.01, 0, h}; Point(5) = {0.007, 0.01, 0, h};
+Circle(1) = {2, 1, 3}; Circle(2) = {3, 1, 2};
+Circle(3) = {4, 1, 5}; Circle(4) = {5, 1, 4};
+Curve Loop(1) = {1, 2}; Curve Loop(2) = {3, 4};
+Plane Surface(1) = {1, 2};
+Point(6) = {0.013, 0.01, 0, h}; Point(7) = {0.007, 0.01, 0, h};
+Circle(5) = {6, 1, 7}; Circle(6) = {7, 1, 6};
+Curve{5, 6} In Surface{1};
+Physical Surface("plate", 1) = {1};
+Physical Curve("hole", 15) = {3, 4};
+)";
+
 // A case under USL (the particle pml needs it).
 std::string usl(std::string json) {
   const std::string at = R"("time": {)";
@@ -110,6 +128,10 @@ std::vector<Bad> bad_cases() {
                {"geometry.file", "empty.msh", "the file is empty"}});
   v.push_back({"syntax_error", "broken.geo", "Point(1) = {0, 0, 0\n", case_json("broken.geo", kBody),
                {"geometry.file", "broken.geo", "gmsh could not read the geometry"}});
+  v.push_back({"unmeshable", "ring_on_hole.geo", kRingOnHole,
+               case_json("ring_on_hole.geo", kBody, "", "[0.03, 0.03]"),
+               {"geometry.file", "ring_on_hole.geo", "gmsh could not mesh the geometry",
+                "on curve 3"}});
   v.push_back({"no_groups", "nogroups.geo",
                "Point(1) = {0,0,0,1e-3}; Point(2) = {1e-2,0,0,1e-3}; Line(1) = {1,2};\n",
                case_json("nogroups.geo", kBody),
