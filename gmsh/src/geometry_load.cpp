@@ -148,9 +148,6 @@ Geometry load(const std::string& file, double size,
     if (size > 0) gmsh::option::setNumber("Mesh.MeshSizeMax", size);
     if (const std::string e = gmsh_mesh_size_problem(size, max_cells); !e.empty())
       throw GeometryError(file + ": " + e);
-    // gmsh meshes the surfaces in an OpenMP region, out of which an error it throws cannot pass
-    // (the process would end). It only logs errors there; gmsh_call reads them from the log.
-    gmsh::option::setNumber("General.AbortOnError", 0);
     gmsh_call(session, file, "mesh the geometry", [&] { gmsh::model::mesh::generate(2); });
   }
 

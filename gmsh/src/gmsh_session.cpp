@@ -61,6 +61,10 @@ GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threa
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);  // gmsh's defaults
     gmsh::option::setNumber("Mesh.MeshSizeMin", 0);
+    // gmsh meshes surfaces in an OpenMP region (also when a .geo says "Mesh 2;"), out of which an
+    // error it throws cannot pass: the process would end. So gmsh only logs its errors, and the
+    // calls below read them from the log.
+    gmsh::option::setNumber("General.AbortOnError", 0);
     gmsh::logger::start();
   } catch (...) {  // no destructor runs: restore the thread count here
     omp_set_num_threads(omp_threads_);

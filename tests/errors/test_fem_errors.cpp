@@ -113,6 +113,21 @@ TEST(FemErrors, BadMeshes) {
                                                        "Physical Surface(\"body\", 1) = {1};\n"),
                           0.002),
                "nosize.geo", "Parameters/h");
+  // A geometry gmsh cannot mesh (a curve embedded on a hole's edge): it fails inside gmsh's
+  // parallel surface meshing, and must still come back as an error.
+  EXPECT_ERROR(mesh_error(write_file("ring_on_hole.geo",
+                                     "Point(1) = {0.01, 0.01, 0, 1e-3};\n"
+                                     "Point(2) = {0.018, 0.01, 0, 1e-3}; Point(3) = {0.002, 0.01, 0, 1e-3};\n"
+                                     "Point(4) = {0.013, 0.01, 0, 1e-3}; Point(5) = {0.007, 0.01, 0, 1e-3};\n"
+                                     "Circle(1) = {2, 1, 3}; Circle(2) = {3, 1, 2};\n"
+                                     "Circle(3) = {4, 1, 5}; Circle(4) = {5, 1, 4};\n"
+                                     "Curve Loop(1) = {1, 2}; Curve Loop(2) = {3, 4};\n"
+                                     "Plane Surface(1) = {1, 2};\n"
+                                     "Point(6) = {0.013, 0.01, 0, 1e-3}; Point(7) = {0.007, 0.01, 0, 1e-3};\n"
+                                     "Circle(5) = {6, 1, 7}; Circle(6) = {7, 1, 6};\n"
+                                     "Curve{5, 6} In Surface{1};\n"
+                                     "Physical Surface(\"body\", 1) = {1};\n")),
+               "ring_on_hole.geo", "Unable to recover the edge");
   // A file that is not a mesh.
   EXPECT_ERROR(mesh_error(write_file("junk.msh", "$MeshFormat\nnot a mesh\n")), "junk.msh");
 }
