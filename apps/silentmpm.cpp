@@ -252,6 +252,12 @@ int run_main(int argc, char** argv) {
       std::printf("%s: %ld steps, %zu particles, %.2f s, %.3g particle-updates/s -> %s\n",
                   case_path.c_str(), r.steps, r.particles, r.wall_seconds,
                   r.particle_updates_per_second, out_dir.c_str());
+    if (root() && s.dashpot_solve.unconverged > 0)
+      std::fprintf(stderr,
+                   "note: the silent layers' dashpot mean did not converge in %d iterations on %ld "
+                   "of %ld steps (their last iterate was used; summary.json \"dashpot_solve\")\n",
+                   smpm::Solver::kCmMaxIterations, s.dashpot_solve.unconverged,
+                   s.dashpot_solve.steps);
     return 0;
   } catch (const smpm::RunInterrupted& e) {
     if (root()) std::fprintf(stderr, "silentmpm: %s\n", e.what());

@@ -295,6 +295,12 @@ void put_mpm_blocks(nlohmann::ordered_json& j, const Case& c, const Solver& s, c
   j["bodies"] = bodies_json(c, s);
   ranks.total_counts(j);
   j["curve_probes"] = curve_probes_json(c.probes);
+  if (const auto& d = s.dashpot_solve; d.steps > 0)  // the silent layers' consistent mean
+    j["dashpot_solve"] = {{"steps", d.steps},
+                          {"iterations_per_step", static_cast<double>(d.iterations) / d.steps},
+                          {"max_iterations", d.max_iterations},
+                          {"unconverged_steps", d.unconverged},
+                          {"zone_rescans", d.rescans}};
 }
 
 void write_probe_table(const fs::path& dir, const std::vector<ProbeSpec>& probes) {

@@ -208,6 +208,7 @@ void Solver::finalize() {
   cm_covered_.clear();
   cm_cell_.assign(consistent ? static_cast<std::size_t>(grid.nx) * grid.ny : 0, 0);
   cm_cells_.clear();
+  cm_reach_.clear();
   bool delayed = false;  // a layer with the delayed closure (MUSL or USF, one field)
   for (const auto& s : silents) delayed = delayed || (s.form == SilentForm::Nodal && s.delayed);
   delayed = delayed && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
@@ -1284,9 +1285,12 @@ void Solver::consistent_dashpots() {
   const long nnx = grid.nnx;
   // The nodes: a block from such a layer, heavy enough (the same choice on every copy of a
   // shared node: it reads only values summed over the halo). A node whose mass is not its
-  // particles' is dropped and the choice made again (the same on every rank).
-  std::vector<long> dropped;
+  // particles' is dropped and the choice made again (the same on every rank), once the zone
+  // was found this step: a node that a particle missing from an older zone left short asks for
+  // a new one first.
+  std::vector<long> dropped, short_nodes;
   const long ncx = grid.nx, ncy = grid.ny;
+  bool scanned = false, rescan = false;
   for (;;) {
     for (const long i : cm_nodes_) cm_slot_[i] = -1;
     cm_nodes_.clear();
@@ -1312,12 +1316,12 @@ void Solver::consistent_dashpots() {
     // the particles were re-ordered, or they may have drifted half a cell since (cm_drift_, the
     // sum over the steps of dt times the fastest nodal velocity they moved with; a particle
     // outside the zone was a cell away from a covered node's cells, less round-off), and every
-    // step when hooks may change that velocity.
-    bool scan = !hooks_.empty() || cm_scan_version_ != order_version_ ||
+    // step when hooks may change that velocity (once).
+    bool scan = rescan || (!hooks_.empty() && !scanned) || cm_scan_version_ != order_version_ ||
                 cm_scan_size_ != p.size() || !(cm_drift_ < 0.5 * grid.h);
     for (std::size_t k = 0; k < cm_nodes_.size() && !scan; ++k) scan = !cm_cover_[cm_nodes_[k]];
     if (scan) {
-      for (const long c : cm_cells_) cm_cell_[c] = 0;
+      for (const long c : cm_cells_) cm_cell_[c] &= 2;
       cm_cells_.clear();
       for (const long i : cm_covered_) cm_cover_[i] = 0;
       cm_covered_.clear();
@@ -1337,8 +1341,8 @@ void Solver::consistent_dashpots() {
           for (long ci = std::max<long>(0, ni - S::kRowsAbove - 2);
                ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow + 2); ++ci) {
             const long c = cj * ncx + ci;
-            if (!cm_cell_[c]) {
-              cm_cell_[c] = 1;
+            if (!(cm_cell_[c] & 1)) {
+              cm_cell_[c] |= 1;
               cm_cells_.push_back(c);
             }
           }
@@ -1349,13 +1353,15 @@ void Solver::consistent_dashpots() {
         for (std::size_t k = 0; k < n; ++k) {
           const long ci = static_cast<long>(std::floor((p.x[k] - grid.x0) * grid.inv_h));
           const long cj = static_cast<long>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
-          if (ci < 0 || cj < 0 || ci >= ncx || cj >= ncy || !cm_cell_[cj * ncx + ci]) continue;
+          if (ci < 0 || cj < 0 || ci >= ncx || cj >= ncy || !(cm_cell_[cj * ncx + ci] & 1)) continue;
           cm_zone_.push_back(static_cast<std::uint32_t>(k));
         }
       }
       cm_scan_version_ = order_version_;
       cm_scan_size_ = p.size();
       cm_drift_ = 0;
+      scanned = true;
+      rescan = false;
     }
     // Each zone particle's shape functions, its nodes' slots and this step's dv0 . N (in
     // parallel, each its own), then those that reach a listed node kept in zone order.
@@ -1366,18 +1372,46 @@ void Solver::consistent_dashpots() {
     cm_s_.resize(2 * nz);
     std::vector<std::uint8_t> reaches(nz);
     // dv0 at a node: without the listed nodes' dashpots.
+    cm_dv_.resize(2 * cm_nodes_.size());
+    for (std::size_t k = 0; k < cm_nodes_.size(); ++k) {
+      const long j = cm_nodes_[k];
+      cm_dv_[2 * k] = (fix[j] & 1) ? 0.0 : DT * grid.fx[j] / m[j];
+      cm_dv_[2 * k + 1] = (fix[j] & 2) ? 0.0 : DT * grid.fy[j] / m[j];
+    }
     auto dv0 = [&](long j, double& ax, double& ay) {
-      if (cm_slot_[j] >= 0) {
-        ax = (fix[j] & 1) ? 0.0 : DT * grid.fx[j] / m[j];
-        ay = (fix[j] & 2) ? 0.0 : DT * grid.fy[j] / m[j];
+      if (const int sl = cm_slot_[j]; sl >= 0) {
+        ax = cm_dv_[2 * sl];
+        ay = cm_dv_[2 * sl + 1];
       } else {
         ax = grid.vnx[j] - grid.vx[j];
         ay = grid.vny[j] - grid.vy[j];
       }
     };
+    // The cells whose particles can reach a listed node: a zone particle elsewhere reaches none.
+    for (const long c : cm_reach_) cm_cell_[c] &= 1;
+    cm_reach_.clear();
+    for (const long i : cm_nodes_) {
+      const long ni = i % nnx, nj = i / nnx;
+      for (long cj = std::max<long>(0, nj - S::kRowsAbove); cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow); ++cj)
+        for (long ci = std::max<long>(0, ni - S::kRowsAbove); ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow); ++ci) {
+          const long c = cj * ncx + ci;
+          if (!(cm_cell_[c] & 2)) {
+            cm_cell_[c] |= 2;
+            cm_reach_.push_back(c);
+          }
+        }
+    }
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nz >= 512)
     for (long e = 0; e < nz; ++e) {
       const std::uint32_t k = cm_zone_[e];
+      {
+        const long ci = static_cast<long>(std::floor((p.x[k] - grid.x0) * grid.inv_h));
+        const long cj = static_cast<long>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
+        if (ci < 0 || cj < 0 || ci >= ncx || cj >= ncy || !(cm_cell_[cj * ncx + ci] & 2)) {
+          reaches[e] = 0;
+          continue;
+        }
+      }
       S sf;
       if constexpr (S::kSized) sf.size(p.mass[k], inv_rho(p.group[k]), grid.inv_h);
       sf.eval(grid, p.x[k], p.y[k]);
@@ -1435,16 +1469,20 @@ void Solver::consistent_dashpots() {
       }
     }
     cm_sum(0, 4);
-    double more = 0;
+    short_nodes.clear();
     for (std::size_t k = 0; k < ns; ++k) {
       const long i = cm_nodes_[k];
-      if (std::abs(cm_[kCm * k + 3] - m[i]) > 1e-9 * m[i]) {
-        dropped.push_back(i);
-        more = 1;
-      }
+      if (std::abs(cm_[kCm * k + 3] - m[i]) > 1e-9 * m[i]) short_nodes.push_back(i);
     }
-    if (dist_) dist_->max(&more, 1);
-    if (more == 0) break;
+    double more[2] = {short_nodes.empty() ? 0.0 : 1.0, short_nodes.empty() || scanned ? 0.0 : 1.0};
+    if (dist_) dist_->max(more, 2);
+    if (more[0] == 0) break;
+    if (more[1] != 0) {  // every rank finds its zone again before any node is dropped
+      rescan = true;
+      ++dashpot_solve.rescans;
+      continue;
+    }
+    dropped.insert(dropped.end(), short_nodes.begin(), short_nodes.end());
     std::sort(dropped.begin(), dropped.end());
   }
   const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
@@ -1478,31 +1516,48 @@ void Solver::consistent_dashpots() {
       }
     }
   }
-  // The slots' node values, and the start: the trapezoidal mean.
+  // Each slot's equation as an affine map, vbar = b - Q o (Q = P / (2 m), P the inverse of
+  // I + kappa C on the free components, b = P (v + 1/2 Mc dv0 / m)), and its g = G vbar
+  // (G = dt C / m on the free components); the start is the trapezoidal mean.
   cm_node_.resize(kCmNode * ns);
+  std::vector<double> g(2 * ns), vb(2 * ns);
   for (std::size_t k = 0; k < ns; ++k) {
     const long i = cm_nodes_[k];
-    double* c = cm_.data() + kCm * k;
     double* n = cm_node_.data() + kCmNode * k;
-    n[0] = m[i];
-    n[1] = (fix[i] & 1) ? 0.0 : 1.0;
-    n[2] = (fix[i] & 2) ? 0.0 : 1.0;
-    n[3] = grid.cxx[i];
-    n[4] = grid.cxy[i];
-    n[5] = grid.cyy[i];
-    n[6] = grid.vx[i];
-    n[7] = grid.vy[i];
-    c[4] = 0.5 * (grid.vx[i] + grid.vnx[i]);
-    c[5] = 0.5 * (grid.vy[i] + grid.vny[i]);
-  }
-  std::vector<double> g(2 * ns);
-  auto g_of = [&](std::size_t k) {  // dt C vbar / m at slot k, on its free components
     const double* c = cm_.data() + kCm * k;
-    const double* n = cm_node_.data() + kCmNode * k;
-    g[2 * k] = n[1] * DT * (n[3] * c[4] + n[4] * c[5]) / n[0];
-    g[2 * k + 1] = n[2] * DT * (n[4] * c[4] + n[5] * c[5]) / n[0];
-  };
-  for (std::size_t k = 0; k < ns; ++k) g_of(k);
+    const double mi = m[i], fx = (fix[i] & 1) ? 0.0 : 1.0, fy = (fix[i] & 2) ? 0.0 : 1.0;
+    const double cxx = grid.cxx[i], cxy = grid.cxy[i], cyy = grid.cyy[i];
+    const double kap = 0.5 * DT * c[2] / (mi * mi);
+    const double A = 1 + kap * cxx, B = kap * cxy, D = 1 + kap * cyy;
+    double pxx = 0, pxy = 0, pyy = 0;
+    if (fx != 0 && fy != 0) {
+      const double det = A * D - B * B;
+      pxx = D / det;
+      pxy = -B / det;
+      pyy = A / det;
+    } else if (fy != 0) {
+      pyy = 1 / D;  // x held
+    } else if (fx != 0) {
+      pxx = 1 / A;  // y held
+    }
+    const double rx = grid.vx[i] + 0.5 * c[0] / mi, ry = grid.vy[i] + 0.5 * c[1] / mi;
+    n[0] = pxx * rx + pxy * ry;
+    n[1] = pxy * rx + pyy * ry;
+    const double q = 0.5 / mi;
+    n[2] = q * pxx;
+    n[3] = q * pxy;
+    n[4] = q * pyy;
+    const double gs = DT / mi;
+    n[5] = fx * gs;
+    n[6] = fy * gs;
+    n[7] = cxx;
+    n[8] = cxy;
+    n[9] = cyy;
+    vb[2 * k] = 0.5 * (grid.vx[i] + grid.vnx[i]);
+    vb[2 * k + 1] = 0.5 * (grid.vy[i] + grid.vny[i]);
+    g[2 * k] = n[5] * (cxx * vb[2 * k] + cxy * vb[2 * k + 1]);
+    g[2 * k + 1] = n[6] * (cxy * vb[2 * k] + cyy * vb[2 * k + 1]);
+  }
   int it = 0;
   for (;; ++it) {
     for (std::size_t k = 0; k < ns; ++k) {  // o_k = sum over the other slots of (Mc)_kj g_j
@@ -1519,28 +1574,16 @@ void Solver::consistent_dashpots() {
     cm_sum(6, 2);
     double change = 0, scale = 0;
     for (std::size_t k = 0; k < ns; ++k) {
-      double* c = cm_.data() + kCm * k;
       const double* n = cm_node_.data() + kCmNode * k;
-      const double mi = n[0], d = c[2];
-      const double rx = n[6] + 0.5 * (c[0] - c[6]) / mi;
-      const double ry = n[7] + 0.5 * (c[1] - c[7]) / mi;
-      const double kap = 0.5 * DT * d / (mi * mi);
-      const double A = 1 + kap * n[3], B = kap * n[4], D = 1 + kap * n[5];
-      double bx = 0, by = 0;
-      if (n[1] != 0 && n[2] != 0) {
-        const double det = A * D - B * B;
-        bx = (D * rx - B * ry) / det;
-        by = (A * ry - B * rx) / det;
-      } else if (n[2] != 0) {
-        by = ry / D;  // x held
-      } else if (n[1] != 0) {
-        bx = rx / A;  // y held
-      }
-      change = std::max(change, std::max(std::abs(bx - c[4]), std::abs(by - c[5])));
+      const double ox = cm_[kCm * k + 6], oy = cm_[kCm * k + 7];
+      const double bx = n[0] - (n[2] * ox + n[3] * oy);
+      const double by = n[1] - (n[3] * ox + n[4] * oy);
+      change = std::max(change, std::max(std::abs(bx - vb[2 * k]), std::abs(by - vb[2 * k + 1])));
       scale = std::max(scale, std::max(std::abs(bx), std::abs(by)));
-      c[4] = bx;
-      c[5] = by;
-      g_of(k);
+      vb[2 * k] = bx;
+      vb[2 * k + 1] = by;
+      g[2 * k] = n[5] * (n[7] * bx + n[8] * by);
+      g[2 * k + 1] = n[6] * (n[8] * bx + n[9] * by);
     }
     if (dist_) {
       double v[2] = {change, scale};
@@ -1548,7 +1591,18 @@ void Solver::consistent_dashpots() {
       change = v[0];
       scale = v[1];
     }
-    if (change <= 1e-13 * scale || it >= 200) break;
+    if (change <= 1e-13 * scale) break;
+    if (it + 1 == kCmMaxIterations) {  // the last iterate stands; the run's summary counts it
+      ++dashpot_solve.unconverged;
+      break;
+    }
+  }
+  ++dashpot_solve.steps;
+  dashpot_solve.iterations += it + 1;
+  dashpot_solve.max_iterations = std::max(dashpot_solve.max_iterations, static_cast<long>(it + 1));
+  for (std::size_t k = 0; k < ns; ++k) {
+    cm_[kCm * k + 4] = vb[2 * k];
+    cm_[kCm * k + 5] = vb[2 * k + 1];
   }
   double v2 = vmax2_;
   for (std::size_t k = 0; k < ns; ++k) {

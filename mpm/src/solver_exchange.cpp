@@ -57,6 +57,7 @@ void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool das
     cm_cell_.assign(static_cast<std::size_t>(grid.nx) * grid.ny, 0);
     cm_nodes_.clear();
     cm_cells_.clear();
+    cm_reach_.clear();
   }
   if (!delay_rho_.empty()) {  // the window's nodes
     delay_rho_.assign(grid.nodes(), 0.0);

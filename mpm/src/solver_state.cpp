@@ -114,6 +114,7 @@ void Solver::save_state(StateWriter& w, const std::string& pre) const {
   std::vector<std::int32_t> boxes;
   for (const auto& F : fields_) boxes.insert(boxes.end(), F.box.begin(), F.box.end());
   w.put(pre + "field_boxes", boxes);
+  put_dashpot_solve(w, pre);
   if (usf_edges())
     w.put(pre + "edge_velocity", own_node_records(edge_velocity_, 5, NodeBox{0, -1, 0, -1},
                                                   window_origin()));
@@ -145,6 +146,7 @@ void Solver::save_state_parts(StateWriter& w, const std::string& pre) const {
   w.put(pre + "strips", static_cast<std::int32_t>(0));  // no strips: the reader re-sorts
   w.put(pre + "ranges", std::vector<std::uint32_t>{});
   w.put(pre + "field_boxes", std::vector<std::int32_t>{});
+  put_dashpot_solve(w, pre);
   // USF's kept edge velocities: each node's from its owner.
   if (usf_edges())
     w.put_part(pre + "edge_velocity", own_node_records(edge_velocity_, 5, own_, window_origin()));
@@ -157,6 +159,15 @@ std::vector<std::string> Solver::particle_blocks(const std::string& pre) {
   return {pre + "p.", pre + "silent", pre + "damper", pre + "pml"};
 }
 
+// The counts of the dashpots' solve (dashpot_solve), the same on every rank: a restarted run's
+// summary counts the whole run.
+void Solver::put_dashpot_solve(StateWriter& w, const std::string& pre) const {
+  if (consistent_weight_.empty()) return;
+  const auto& d = dashpot_solve;
+  w.put(pre + "dashpot_solve",
+        std::vector<std::int64_t>{d.steps, d.iterations, d.max_iterations, d.unconverged, d.rescans});
+}
+
 void Solver::load_clock(const StateReader& r, const std::string& pre) {
   const double dt_saved = r.get<double>(pre + "dt");
   if (dt_saved != dt)
@@ -166,6 +177,12 @@ void Solver::load_clock(const StateReader& r, const std::string& pre) {
   steps = static_cast<long>(r.get<std::int64_t>(pre + "steps"));
   energy = r.get<Energies>(pre + "energy");
   contact.dissipated = r.get<double>(pre + "contact_dissipated");
+  dashpot_solve = {};
+  if (!consistent_weight_.empty() && r.has(pre + "dashpot_solve")) {
+    std::vector<std::int64_t> d;
+    r.get(pre + "dashpot_solve", d, 5);
+    dashpot_solve = {d[0], d[1], d[2], d[3], d[4]};
+  }
   edge_velocity_.clear();
   if (usf_edges()) read_node_records(r, pre, "edge_velocity", 5, edge_velocity_);
   delay_.clear();

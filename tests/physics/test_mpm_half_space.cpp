@@ -16,6 +16,8 @@
 #include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "silentmpm/case.hpp"
 #include "silentmpm/driver.hpp"
 #include "silentmpm/geo_box.hpp"
@@ -272,6 +274,17 @@ TEST(SilentStability, StripOfTwoCellsDecays) {
                   scheme, cfl, second, last);
       EXPECT_GT(second, 0) << scheme << " " << cfl;
       EXPECT_LE(last, 0.5 * second) << scheme << " " << cfl;
+      // summary.json counts the solve for the dashpots' mean: every step solved, converged,
+      // within 4-40 iterations a step (its contraction is about CFL/4: 1e-13 in 20-30 at most).
+      std::ifstream sf(out / (std::string(scheme) + num(cfl)) / "summary.json");
+      const auto sum = nlohmann::json::parse(sf);
+      const auto& d = sum.at("dashpot_solve");
+      std::printf("  [%s, CFL %.1f] dashpot solve: %.2f iterations per step, at most %ld\n", scheme,
+                  cfl, d.at("iterations_per_step").get<double>(), d.at("max_iterations").get<long>());
+      EXPECT_EQ(d.at("steps").get<long>(), sum.at("steps").get<long>()) << scheme << " " << cfl;
+      EXPECT_EQ(d.at("unconverged_steps").get<long>(), 0) << scheme << " " << cfl;
+      EXPECT_GE(d.at("iterations_per_step").get<double>(), 4) << scheme << " " << cfl;
+      EXPECT_LE(d.at("max_iterations").get<long>(), 40) << scheme << " " << cfl;
     }
   fs::remove_all(out);
 }

@@ -165,6 +165,14 @@ class Solver {
   // layer, 16 perfectly matched layer (the snapshot field "layer").
   std::vector<std::uint8_t> layer_flags() const;
   int thread_count() const { return nthreads_; }
+  // The consistent dashpot mean of the silent layers under MUSL and USF (docs/physics.md
+  // section 4), over the run (kept in checkpoints): the steps that solved for it, their
+  // iterations (sum and largest), the steps left unconverged after kCmMaxIterations (their last
+  // iterate stands) and the zones of particles found again because a node's particles were short.
+  struct DashpotSolveStats {
+    long steps = 0, iterations = 0, max_iterations = 0, unconverged = 0, rescans = 0;
+  } dashpot_solve;
+  static constexpr int kCmMaxIterations = 200;
   // Nodes lighter than this are void (opt.mass_tolerance times the lightest particle).
   double mass_floor() const { return mass_floor_; }
   // Cell rows the particles occupied after the last step that moved them (lo > hi: none).
@@ -267,17 +275,19 @@ class Solver {
   std::vector<double> consistent_weight_;
   std::vector<long> cm_nodes_;
   std::vector<int> cm_slot_;
-  std::vector<std::uint8_t> cm_cell_;   // per cell: within reach of a listed node this step
-  std::vector<long> cm_cells_;          // the cells marked
+  std::vector<std::uint8_t> cm_cell_;   // per cell: 1 in the zone, 2 reaches a listed node
+  std::vector<long> cm_cells_;          // the cells marked 1
+  std::vector<long> cm_reach_;          // and 2
   std::vector<std::uint32_t> cm_particles_;
   std::vector<double> cm_pN_;           // their shape values (K per particle)
   std::vector<int> cm_ps_;              // and their nodes' slots (-1: none)
   std::vector<double> cm_pm_;           // their masses
   std::vector<double> cm_s_;            // 2 per particle: its sum N . dv (scratch)
+  std::vector<double> cm_dv_;           // 2 per slot: dt f / m (scratch)
   static constexpr int kCmRow = 24;     // the slots a row of the consistent mass can hold
   std::vector<int> cm_cnt_, cm_col_;    // the consistent mass between slots, kCmRow per row
   std::vector<double> cm_w_;
-  static constexpr int kCmNode = 8;     // per slot: m, free x, free y, cxx, cxy, cyy, vx, vy
+  static constexpr int kCmNode = 10;    // per slot: its equation (see consistent_dashpots)
   std::vector<double> cm_node_;
   static constexpr int kCm = 8;
   std::vector<double> cm_;              // per slot: kCm values (see consistent_dashpots)
@@ -292,6 +302,7 @@ class Solver {
   long order_version_ = 0;              // bumped whenever the particles' order or count changes
   template <class S> void consistent_dashpots();
   void cm_sum(int first, int count);    // sum slot values [first, first + count) over the halo
+  void put_dashpot_solve(StateWriter& w, const std::string& pre) const;
   // USF with such layers: the last step's updated velocity at their dashpot nodes, which the
   // next step strains the particles with (start_velocities). Per node: the whole grid's node
   // (i, j), its weight (updated_weight_) and v+ (x, y); part of a checkpoint.
