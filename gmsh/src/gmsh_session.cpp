@@ -32,18 +32,44 @@ std::string last_error() {
   return e;
 }
 
-// First "Error" line of the gmsh log since the session started, without its prefix.
-std::string first_logged_error() {
-  std::vector<std::string> log;
-  gmsh::logger::get(log);
+// The "Error" lines of the gmsh log since the session started, without their prefix.
+std::vector<std::string> logged_errors() {
+  std::vector<std::string> log, out;
+  try {
+    gmsh::logger::get(log);
+  } catch (...) {
+  }
   for (const auto& l : log)
     if (l.rfind("Error", 0) == 0) {
       std::size_t p = l.find(':');
       std::string m = p == std::string::npos ? l : l.substr(p + 1);
       m.erase(0, m.find_first_not_of(' '));
-      return m;
+      out.push_back(m);
     }
-  return "";
+  return out;
+}
+
+// Runs a checked call with gmsh logging its errors instead of throwing them: gmsh meshes
+// surfaces in an OpenMP region (also when a .geo says "Mesh 2;"), out of which a thrown error
+// cannot pass (the process would end). The option is restored after the call.
+void logging_errors(const std::function<void()>& call) {
+  double abort_on_error = 0;
+  gmsh::option::getNumber("General.AbortOnError", abort_on_error);
+  gmsh::option::setNumber("General.AbortOnError", 0);
+  struct Restore {
+    double v;
+    ~Restore() {
+      try {
+        gmsh::option::setNumber("General.AbortOnError", v);
+      } catch (...) {
+      }
+    }
+  } restore{abort_on_error};
+  call();
+}
+
+std::string first_of(const std::vector<std::string>& errors, std::size_t from) {
+  return errors.size() > from ? errors[from] : std::string();
 }
 
 }  // namespace
@@ -61,10 +87,6 @@ GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threa
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);  // gmsh's defaults
     gmsh::option::setNumber("Mesh.MeshSizeMin", 0);
-    // gmsh meshes surfaces in an OpenMP region (also when a .geo says "Mesh 2;"), out of which an
-    // error it throws cannot pass: the process would end. So gmsh only logs its errors, and the
-    // calls below read them from the log.
-    gmsh::option::setNumber("General.AbortOnError", 0);
     gmsh::logger::start();
   } catch (...) {  // no destructor runs: restore the thread count here
     omp_set_num_threads(omp_threads_);
@@ -83,22 +105,24 @@ GmshSession::~GmshSession() {
 }
 
 std::string GmshSession::call_error(const std::function<void()>& call) const {
-  const std::string before = last_error();
+  const std::size_t before = logged_errors().size();
   bool threw = false;
   try {
-    call();
+    logging_errors(call);
   } catch (...) {
     threw = true;
   }
-  const std::string after = last_error();
-  if (threw) return after.empty() ? std::string("unknown gmsh error") : after;
-  return after != before ? after : std::string();
+  const std::string first = first_of(logged_errors(), before);
+  if (!first.empty()) return first;
+  if (!threw) return "";
+  const std::string last = last_error();
+  return last.empty() ? std::string("unknown gmsh error") : last;
 }
 
 std::string GmshSession::load_error(const std::function<void()>& call) const {
   std::string err;
   try {
-    call();
+    logging_errors(call);
   } catch (const std::string& s) {
     err = s;
   } catch (const std::exception& e) {
@@ -106,7 +130,7 @@ std::string GmshSession::load_error(const std::function<void()>& call) const {
   } catch (...) {
     err = "unknown gmsh error";
   }
-  if (err.empty()) err = first_logged_error();
+  if (err.empty()) err = first_of(logged_errors(), 0);
   return err;
 }
 
@@ -127,7 +151,7 @@ std::string gmsh_input_problem(const std::string& file) {
 
 std::string gmsh_mesh_size_problem(double h, double max_cells) {
   if (!(h > 0)) return {};
-  double x0, y0, z0, x1, y1, z1;
+  double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;
   try {
     gmsh::model::getBoundingBox(-1, -1, x0, y0, z0, x1, y1, z1);
   } catch (...) {

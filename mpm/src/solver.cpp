@@ -1291,6 +1291,7 @@ void Solver::consistent_dashpots() {
   std::vector<long> dropped, short_nodes;
   const long ncx = grid.nx, ncy = grid.ny;
   bool scanned = false, rescan = false;
+  double more[3];  // a node short of its particles' mass, a new zone asked, any node listed
   for (;;) {
     for (const long i : cm_nodes_) cm_slot_[i] = -1;
     cm_nodes_.clear();
@@ -1474,8 +1475,10 @@ void Solver::consistent_dashpots() {
       const long i = cm_nodes_[k];
       if (std::abs(cm_[kCm * k + 3] - m[i]) > 1e-9 * m[i]) short_nodes.push_back(i);
     }
-    double more[2] = {short_nodes.empty() ? 0.0 : 1.0, short_nodes.empty() || scanned ? 0.0 : 1.0};
-    if (dist_) dist_->max(more, 2);
+    more[0] = short_nodes.empty() ? 0.0 : 1.0;
+    more[1] = short_nodes.empty() || scanned ? 0.0 : 1.0;
+    more[2] = ns > 0 ? 1.0 : 0.0;
+    if (dist_) dist_->max(more, 3);
     if (more[0] == 0) break;
     if (more[1] != 0) {  // every rank finds its zone again before any node is dropped
       rescan = true;
@@ -1597,9 +1600,11 @@ void Solver::consistent_dashpots() {
       break;
     }
   }
-  ++dashpot_solve.steps;
-  dashpot_solve.iterations += it + 1;
-  dashpot_solve.max_iterations = std::max(dashpot_solve.max_iterations, static_cast<long>(it + 1));
+  if (more[2] != 0) {  // a node listed on some rank
+    ++dashpot_solve.steps;
+    dashpot_solve.iterations += it + 1;
+    dashpot_solve.max_iterations = std::max(dashpot_solve.max_iterations, static_cast<long>(it + 1));
+  }
   for (std::size_t k = 0; k < ns; ++k) {
     cm_[kCm * k + 4] = vb[2 * k];
     cm_[kCm * k + 5] = vb[2 * k + 1];

@@ -28,11 +28,12 @@ class GmshSession {
   GmshSession(const GmshSession&) = delete;
   GmshSession& operator=(const GmshSession&) = delete;
 
-  // Two ways of telling that a gmsh call failed ("" if it did not); with abort on error (the
-  // API's default) both give the text of the error gmsh threw.
+  // Two ways of telling that a gmsh call failed ("" if it did not). Both run the call with gmsh
+  // logging its errors rather than throwing them (an error thrown inside gmsh's parallel surface
+  // meshing would end the process); every other gmsh call of the session throws as the API does.
   //
-  // The error of one call: gmsh's last error if the call threw (else "unknown gmsh error"), or
-  // the last error it recorded without throwing.
+  // The error of one call: the first "Error" line it logged, else, if it threw, gmsh's last
+  // error (else "unknown gmsh error").
   std::string call_error(const std::function<void()>& call) const;
   // The error of a load that stops at its first failure: the text of what the call threw
   // ("unknown gmsh error" for anything but a string or an exception), else the first "Error"
