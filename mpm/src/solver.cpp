@@ -1292,6 +1292,14 @@ void Solver::consistent_dashpots() {
   const long ncx = grid.nx, ncy = grid.ny;
   bool scanned = false, rescan = false;
   double more[3];  // a node short of its particles' mass, a new zone asked, any node listed
+  // fn(index) for the cells (or nodes) of rows and columns [n - lo, n + hi] around node i, in a
+  // w x ht array.
+  auto around = [nnx](long i, long lo, long hi, long w, long ht, auto&& fn) {
+    const long ni = i % nnx, nj = i / nnx;
+    for (long j = std::max<long>(0, nj - lo); j <= std::min<long>(ht - 1, nj + hi); ++j)
+      for (long ii = std::max<long>(0, ni - lo); ii <= std::min<long>(w - 1, ni + hi); ++ii)
+        fn(j * w + ii);
+  };
   for (;;) {
     for (const long i : cm_nodes_) cm_slot_[i] = -1;
     cm_nodes_.clear();
@@ -1326,34 +1334,25 @@ void Solver::consistent_dashpots() {
       cm_cells_.clear();
       for (const long i : cm_covered_) cm_cover_[i] = 0;
       cm_covered_.clear();
-      const long nnyl = grid.nny;
       for (const long i : cm_nodes_) {
-        const long ni = i % nnx, nj = i / nnx;
-        for (long j = std::max<long>(0, nj - 1); j <= std::min<long>(nnyl - 1, nj + 1); ++j)
-          for (long ii = std::max<long>(0, ni - 1); ii <= std::min<long>(nnx - 1, ni + 1); ++ii) {
-            const long c = j * nnx + ii;
-            if (!cm_cover_[c]) {
-              cm_cover_[c] = 1;
-              cm_covered_.push_back(c);
-            }
+        around(i, 1, 1, nnx, grid.nny, [&](long c) {
+          if (!cm_cover_[c]) {
+            cm_cover_[c] = 1;
+            cm_covered_.push_back(c);
           }
-        for (long cj = std::max<long>(0, nj - S::kRowsAbove - 2);
-             cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow + 2); ++cj)
-          for (long ci = std::max<long>(0, ni - S::kRowsAbove - 2);
-               ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow + 2); ++ci) {
-            const long c = cj * ncx + ci;
-            if (!(cm_cell_[c] & 1)) {
-              cm_cell_[c] |= 1;
-              cm_cells_.push_back(c);
-            }
+        });
+        around(i, S::kRowsAbove + 2, S::kRowsBelow + 2, ncx, ncy, [&](long c) {
+          if (!(cm_cell_[c] & 1)) {
+            cm_cell_[c] |= 1;
+            cm_cells_.push_back(c);
           }
+        });
       }
       cm_zone_.clear();
       if (!cm_nodes_.empty()) {
         const std::size_t n = p.size();
         for (std::size_t k = 0; k < n; ++k) {
-          const long ci = static_cast<long>(std::floor((p.x[k] - grid.x0) * grid.inv_h));
-          const long cj = static_cast<long>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
+          const long ci = cell_column(k), cj = cell_row(k);
           if (ci < 0 || cj < 0 || ci >= ncx || cj >= ncy || !(cm_cell_[cj * ncx + ci] & 1)) continue;
           cm_zone_.push_back(static_cast<std::uint32_t>(k));
         }
@@ -1391,27 +1390,20 @@ void Solver::consistent_dashpots() {
     // The cells whose particles can reach a listed node: a zone particle elsewhere reaches none.
     for (const long c : cm_reach_) cm_cell_[c] &= 1;
     cm_reach_.clear();
-    for (const long i : cm_nodes_) {
-      const long ni = i % nnx, nj = i / nnx;
-      for (long cj = std::max<long>(0, nj - S::kRowsAbove); cj <= std::min<long>(ncy - 1, nj + S::kRowsBelow); ++cj)
-        for (long ci = std::max<long>(0, ni - S::kRowsAbove); ci <= std::min<long>(ncx - 1, ni + S::kRowsBelow); ++ci) {
-          const long c = cj * ncx + ci;
-          if (!(cm_cell_[c] & 2)) {
-            cm_cell_[c] |= 2;
-            cm_reach_.push_back(c);
-          }
+    for (const long i : cm_nodes_)
+      around(i, S::kRowsAbove, S::kRowsBelow, ncx, ncy, [&](long c) {
+        if (!(cm_cell_[c] & 2)) {
+          cm_cell_[c] |= 2;
+          cm_reach_.push_back(c);
         }
-    }
+      });
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nz >= 512)
     for (long e = 0; e < nz; ++e) {
       const std::uint32_t k = cm_zone_[e];
-      {
-        const long ci = static_cast<long>(std::floor((p.x[k] - grid.x0) * grid.inv_h));
-        const long cj = static_cast<long>(std::floor((p.y[k] - grid.y0) * grid.inv_h));
-        if (ci < 0 || cj < 0 || ci >= ncx || cj >= ncy || !(cm_cell_[cj * ncx + ci] & 2)) {
-          reaches[e] = 0;
-          continue;
-        }
+      if (const long ci = cell_column(k), cj = cell_row(k);
+          ci < 0 || cj < 0 || ci >= ncx || cj >= ncy || !(cm_cell_[cj * ncx + ci] & 2)) {
+        reaches[e] = 0;
+        continue;
       }
       S sf;
       if constexpr (S::kSized) sf.size(p.mass[k], inv_rho(p.group[k]), grid.inv_h);
