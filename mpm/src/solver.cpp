@@ -1183,75 +1183,108 @@ void Solver::grid_update() {
   }
   if (bad) fail_nonfinite();
   vmax2_ = v2;
+  // For consistent_dashpots, each dashpot node's values in one record (kDn per node, in the
+  // order of dashpot_nodes_): along an edge every node lies on its own cache lines of a dozen
+  // grid-sized arrays, which the whole-grid pass above has evicted by now.
+  if (track) dn_rec_.resize(kDn * dashpot_nodes_.size());
   if (!has_nodal_dashpot_) return;
   const bool delayed = !delay_rho_.empty();
   if (delayed) delay_prepare();
   const long nd = static_cast<long>(dashpot_nodes_.size());
   const long* dnodes = dashpot_nodes_.data();
   const double gx = opt.gravity_x, gy = opt.gravity_y;
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
+  double* rec_all = dn_rec_.data();
+  double vd2 = 0;
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024) reduction(max : vd2)
   for (long k = 0; k < nd; ++k) {  // each node its own: in parallel, the same values
     const long i = dnodes[k];
-    if (delayed && delay_rho_[i] > 0) {
-      // The delayed closure (delay_strain_velocities): the ring takes this step's start
-      // velocity and force less gravity. An edge node on its grid line holds half its layer's
-      // weight times h (w N rho h against rho h^2 / 2). A node whose mass is off that by more
-      // than kDelayMassTolerance (the layer reaches it only through points moved into the last
-      // cell, or the end has drifted off the grid line: the closure's premise is gone), one
-      // lighter than dt/2 times its block (the explicit dashpot's limit), one with a block off
-      // the axes, or one whose ring does not yet reach back the delay takes the trapezoidal
-      // update.
-      double* rec = delay_.data() + delay_stride() * delay_slot_[i];
-      // A node whose ring missed a step (not reached by the layer then) starts its history anew.
-      if (rec[kDelayWritten] != static_cast<double>(steps - 1))
-        rec[kDelayRunFrom] = static_cast<double>(steps);
-      rec[kDelayWritten] = static_cast<double>(steps);
-      const long s = steps % delay_cap_;
-      double* ring = rec + kDelayHead + 4 * s;
-      const double frx = fx[i] - m[i] * gx, fry = fy[i] - m[i] * gy;
-      ring[0] = vx[i];
-      ring[1] = vy[i];
-      ring[2] = frx;
-      ring[3] = fry;
-      const double cxx = grid.cxx[i], cyy = grid.cyy[i];
-      rec[kDelayCxx] = cxx;
-      rec[kDelayCyy] = cyy;
-      rec[kDelayRho] = delay_rho_[i];
-      rec[kDelayAt] = -1;
-      const bool blocks = cxx > 0 && cyy > 0;
-      // The closure takes the normal component (delayed_axis); the tangential one keeps the
-      // trapezoidal update.
-      const bool on_x = delayed_axis(cxx, cyy), on_y = delayed_axis(cyy, cxx);
-      const double dx = blocks ? grid.h / (cxx / rec[kDelayRho] * DT) - 0.5 : 0.0;
-      const double dy = blocks ? grid.h / (cyy / rec[kDelayRho] * DT) - 0.5 : 0.0;
-      const double reach = std::max(on_x ? dx : 0.0, on_y ? dy : 0.0);
-      const double history = static_cast<double>(steps) - rec[kDelayRunFrom];  // entries before
-      const double half = 0.5 * rec[kDelayRho] * grid.h;  // an edge node's mass on its line
-      if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
-          std::abs(m[i] - half) <= kDelayMassTolerance * half && std::floor(reach) + 1 <= history) {
-        const double vdx = on_x ? delay_value(rec, 0, dx, 0) : 0.0;
-        const double vdy = on_y ? delay_value(rec, 1, dy, 0) : 0.0;
-        const double M = rec[kDelayRho] * grid.h;  // a whole node's mass: rho h times its edge length
-        double tx = 0, ty = 0;  // the trapezoidal update, for the tangential component
-        if (!(on_x && on_y))
-          dashpot_velocity(m[i], cxx, 0.0, cyy, vx[i], vy[i], fx[i], fy[i], DT, fix[i], tx, ty);
-        ux[i] = !on_x ? tx : (fix[i] & 1) ? 0.0 : vx[i] + DT * gx + DT * (frx - cxx * vdx) / M;
-        uy[i] = !on_y ? ty : (fix[i] & 2) ? 0.0 : vy[i] + DT * gy + DT * (fry - cyy * vdy) / M;
-        rec[kDelayAt] = static_cast<double>(steps);
-        rec[kDelayFx] = frx;
-        rec[kDelayFy] = fry;
-        rec[kDelayVx] = vdx;
-        rec[kDelayVy] = vdy;
-        continue;
-      }
-    }
-    if (m[i] <= floor) continue;
-    dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
-                     fix[i], ux[i], uy[i]);
+    update_dashpot_node(i, delayed, gx, gy);
+    if (!track) continue;
+    double* r = rec_all + kDn * k;
+    r[0] = m[i];
+    r[1] = fx[i];
+    r[2] = fy[i];
+    r[3] = vx[i];
+    r[4] = vy[i];
+    r[5] = ux[i];
+    r[6] = uy[i];
+    r[7] = grid.cxx[i];
+    r[8] = grid.cxy[i];
+    r[9] = grid.cyy[i];
+    r[10] = consistent_weight_[i];
+    const bool other = (!updated_weight_.empty() && updated_weight_[i] > 0) ||
+                       (!delay_rho_.empty() && delay_rho_[i] > 0);
+    r[11] = static_cast<double>((fix[i] & 3) | (other ? 4 : 0));
+    vd2 = std::max(vd2, ux[i] * ux[i] + uy[i] * uy[i]);  // the dashpots' updates
   }
-  if (consistent_weight_.empty()) return;
-  for (long k = 0; k < nd; ++k)  // the dashpots' updates (the delayed closure's too)
-    vmax2_ = std::max(vmax2_, ux[dnodes[k]] * ux[dnodes[k]] + uy[dnodes[k]] * uy[dnodes[k]]);
+  if (track) vmax2_ = std::max(vmax2_, vd2);
+}
+
+// One dashpot node's updated velocity in grid_update: the delayed closure's, or the
+// trapezoidal update of its block.
+void Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
+  const double floor = mass_floor_, DT = dt;
+  const double* m = grid.m.data();
+  const uint8_t* fix = grid.fix.data();
+  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
+  const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
+  double* ux = grid.vnx.data(); double* uy = grid.vny.data();
+  if (delayed && delay_rho_[i] > 0) {
+    // The delayed closure (delay_strain_velocities): the ring takes this step's start
+    // velocity and force less gravity. An edge node on its grid line holds half its layer's
+    // weight times h (w N rho h against rho h^2 / 2). A node whose mass is off that by more
+    // than kDelayMassTolerance (the layer reaches it only through points moved into the last
+    // cell, or the end has drifted off the grid line: the closure's premise is gone), one
+    // lighter than dt/2 times its block (the explicit dashpot's limit), one with a block off
+    // the axes, or one whose ring does not yet reach back the delay takes the trapezoidal
+    // update.
+    double* rec = delay_.data() + delay_stride() * delay_slot_[i];
+    // A node whose ring missed a step (not reached by the layer then) starts its history anew.
+    if (rec[kDelayWritten] != static_cast<double>(steps - 1))
+      rec[kDelayRunFrom] = static_cast<double>(steps);
+    rec[kDelayWritten] = static_cast<double>(steps);
+    const long s = steps % delay_cap_;
+    double* ring = rec + kDelayHead + 4 * s;
+    const double frx = fx[i] - m[i] * gx, fry = fy[i] - m[i] * gy;
+    ring[0] = vx[i];
+    ring[1] = vy[i];
+    ring[2] = frx;
+    ring[3] = fry;
+    const double cxx = grid.cxx[i], cyy = grid.cyy[i];
+    rec[kDelayCxx] = cxx;
+    rec[kDelayCyy] = cyy;
+    rec[kDelayRho] = delay_rho_[i];
+    rec[kDelayAt] = -1;
+    const bool blocks = cxx > 0 && cyy > 0;
+    // The closure takes the normal component (delayed_axis); the tangential one keeps the
+    // trapezoidal update.
+    const bool on_x = delayed_axis(cxx, cyy), on_y = delayed_axis(cyy, cxx);
+    const double dx = blocks ? grid.h / (cxx / rec[kDelayRho] * DT) - 0.5 : 0.0;
+    const double dy = blocks ? grid.h / (cyy / rec[kDelayRho] * DT) - 0.5 : 0.0;
+    const double reach = std::max(on_x ? dx : 0.0, on_y ? dy : 0.0);
+    const double history = static_cast<double>(steps) - rec[kDelayRunFrom];  // entries before
+    const double half = 0.5 * rec[kDelayRho] * grid.h;  // an edge node's mass on its line
+    if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
+        std::abs(m[i] - half) <= kDelayMassTolerance * half && std::floor(reach) + 1 <= history) {
+      const double vdx = on_x ? delay_value(rec, 0, dx, 0) : 0.0;
+      const double vdy = on_y ? delay_value(rec, 1, dy, 0) : 0.0;
+      const double M = rec[kDelayRho] * grid.h;  // a whole node's mass: rho h times its edge length
+      double tx = 0, ty = 0;  // the trapezoidal update, for the tangential component
+      if (!(on_x && on_y))
+        dashpot_velocity(m[i], cxx, 0.0, cyy, vx[i], vy[i], fx[i], fy[i], DT, fix[i], tx, ty);
+      ux[i] = !on_x ? tx : (fix[i] & 1) ? 0.0 : vx[i] + DT * gx + DT * (frx - cxx * vdx) / M;
+      uy[i] = !on_y ? ty : (fix[i] & 2) ? 0.0 : vy[i] + DT * gy + DT * (fry - cyy * vdy) / M;
+      rec[kDelayAt] = static_cast<double>(steps);
+      rec[kDelayFx] = frx;
+      rec[kDelayFy] = fry;
+      rec[kDelayVx] = vdx;
+      rec[kDelayVy] = vdy;
+      return;
+    }
+  }
+  if (m[i] <= floor) return;
+  dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
+                   fix[i], ux[i], uy[i]);
 }
 
 // MUSL and USF, in particle terms (positions held, one field, FLIP): the nodal velocity is
@@ -1280,14 +1313,14 @@ template <class S>
 void Solver::consistent_dashpots() {
   constexpr int K = S::kNodes;
   const double DT = dt, floor = mass_floor_;
-  const double* m = grid.m.data();
-  const uint8_t* fix = grid.fix.data();
   const long nnx = grid.nnx;
   // The nodes: a block from such a layer, heavy enough (the same choice on every copy of a
   // shared node: it reads only values summed over the halo). A node whose mass is not its
   // particles' is dropped and the choice made again (the same on every rank), once the zone
   // was found this step: a node that a particle missing from an older zone left short asks for
   // a new one first.
+  if (dn_rec_.size() != kDn * dashpot_nodes_.size())
+    throw std::logic_error("consistent_dashpots: grid_update left no record of the dashpot nodes");
   std::vector<long> dropped, short_nodes;
   const long ncx = grid.nx, ncy = grid.ny;
   bool scanned = false, rescan = false;
@@ -1303,19 +1336,23 @@ void Solver::consistent_dashpots() {
   for (;;) {
     for (const long i : cm_nodes_) cm_slot_[i] = -1;
     cm_nodes_.clear();
-    for (const long i : dashpot_nodes_) {
-      if (consistent_weight_[i] <= 0 || m[i] <= floor) continue;
-      if (!updated_weight_.empty() && updated_weight_[i] > 0) continue;  // strained with v+
-      if (!delay_rho_.empty() && delay_rho_[i] > 0) continue;  // the delayed closure's own
-      const double cxx = grid.cxx[i], cxy = grid.cxy[i], cyy = grid.cyy[i];
+    cm_dk_.clear();
+    for (std::size_t k = 0; k < dashpot_nodes_.size(); ++k) {
+      const long i = dashpot_nodes_[k];
+      const double* r = dn_rec_.data() + kDn * k;
+      if (r[10] <= 0 || r[0] <= floor) continue;
+      // strained with v+, or the delayed closure's own
+      if (static_cast<int>(r[11]) & 4) continue;
+      const double cxx = r[7], cxy = r[8], cyy = r[9];
       const double lmax =
           0.5 * (cxx + cyy) + std::sqrt(0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy);
       // No block (a = b = 0: a rank that shares the node lists it only with a block), or one
       // too strong for the node's mass.
-      if (!(lmax > 0) || 0.5 * DT * lmax > m[i]) continue;
+      if (!(lmax > 0) || 0.5 * DT * lmax > r[0]) continue;
       if (std::binary_search(dropped.begin(), dropped.end(), i)) continue;
       cm_slot_[i] = static_cast<int>(cm_nodes_.size());
       cm_nodes_.push_back(i);
+      cm_dk_.push_back(static_cast<long>(k));
     }
     // The particles whose shape functions reach those nodes, from a zone of particles kept
     // between steps: those in the cells whose particles can reach a listed node or one next to
@@ -1374,9 +1411,10 @@ void Solver::consistent_dashpots() {
     // dv0 at a node: without the listed nodes' dashpots.
     cm_dv_.resize(2 * cm_nodes_.size());
     for (std::size_t k = 0; k < cm_nodes_.size(); ++k) {
-      const long j = cm_nodes_[k];
-      cm_dv_[2 * k] = (fix[j] & 1) ? 0.0 : DT * grid.fx[j] / m[j];
-      cm_dv_[2 * k + 1] = (fix[j] & 2) ? 0.0 : DT * grid.fy[j] / m[j];
+      const double* r = dn_rec_.data() + kDn * cm_dk_[k];
+      const int fj = static_cast<int>(r[11]);
+      cm_dv_[2 * k] = (fj & 1) ? 0.0 : DT * r[1] / r[0];
+      cm_dv_[2 * k + 1] = (fj & 2) ? 0.0 : DT * r[2] / r[0];
     }
     auto dv0 = [&](long j, double& ax, double& ay) {
       if (const int sl = cm_slot_[j]; sl >= 0) {
@@ -1464,8 +1502,8 @@ void Solver::consistent_dashpots() {
     cm_sum(0, 4);
     short_nodes.clear();
     for (std::size_t k = 0; k < ns; ++k) {
-      const long i = cm_nodes_[k];
-      if (std::abs(cm_[kCm * k + 3] - m[i]) > 1e-9 * m[i]) short_nodes.push_back(i);
+      const double mi = dn_rec_[kDn * cm_dk_[k]];
+      if (std::abs(cm_[kCm * k + 3] - mi) > 1e-9 * mi) short_nodes.push_back(cm_nodes_[k]);
     }
     more[0] = short_nodes.empty() ? 0.0 : 1.0;
     more[1] = short_nodes.empty() || scanned ? 0.0 : 1.0;
@@ -1517,11 +1555,12 @@ void Solver::consistent_dashpots() {
   cm_node_.resize(kCmNode * ns);
   std::vector<double> g(2 * ns), vb(2 * ns);
   for (std::size_t k = 0; k < ns; ++k) {
-    const long i = cm_nodes_[k];
+    const double* r = dn_rec_.data() + kDn * cm_dk_[k];
     double* n = cm_node_.data() + kCmNode * k;
     const double* c = cm_.data() + kCm * k;
-    const double mi = m[i], fx = (fix[i] & 1) ? 0.0 : 1.0, fy = (fix[i] & 2) ? 0.0 : 1.0;
-    const double cxx = grid.cxx[i], cxy = grid.cxy[i], cyy = grid.cyy[i];
+    const int fi = static_cast<int>(r[11]);
+    const double mi = r[0], fx = (fi & 1) ? 0.0 : 1.0, fy = (fi & 2) ? 0.0 : 1.0;
+    const double cxx = r[7], cxy = r[8], cyy = r[9];
     const double kap = 0.5 * DT * c[2] / (mi * mi);
     const double A = 1 + kap * cxx, B = kap * cxy, D = 1 + kap * cyy;
     double pxx = 0, pxy = 0, pyy = 0;
@@ -1535,7 +1574,7 @@ void Solver::consistent_dashpots() {
     } else if (fx != 0) {
       pxx = 1 / A;  // y held
     }
-    const double rx = grid.vx[i] + 0.5 * c[0] / mi, ry = grid.vy[i] + 0.5 * c[1] / mi;
+    const double rx = r[3] + 0.5 * c[0] / mi, ry = r[4] + 0.5 * c[1] / mi;
     n[0] = pxx * rx + pxy * ry;
     n[1] = pxy * rx + pyy * ry;
     const double q = 0.5 / mi;
@@ -1548,8 +1587,8 @@ void Solver::consistent_dashpots() {
     n[7] = cxx;
     n[8] = cxy;
     n[9] = cyy;
-    vb[2 * k] = 0.5 * (grid.vx[i] + grid.vnx[i]);
-    vb[2 * k + 1] = 0.5 * (grid.vy[i] + grid.vny[i]);
+    vb[2 * k] = 0.5 * (r[3] + r[5]);
+    vb[2 * k + 1] = 0.5 * (r[4] + r[6]);
     g[2 * k] = n[5] * (cxx * vb[2 * k] + cxy * vb[2 * k + 1]);
     g[2 * k + 1] = n[6] * (cxy * vb[2 * k] + cyy * vb[2 * k + 1]);
   }
@@ -1605,9 +1644,13 @@ void Solver::consistent_dashpots() {
   for (std::size_t k = 0; k < ns; ++k) {
     const long i = cm_nodes_[k];
     const double* c = cm_.data() + kCm * k;
-    grid.vnx[i] = (fix[i] & 1) ? 0.0 : grid.vx[i] + DT * (grid.fx[i] - grid.cxx[i] * c[4] - grid.cxy[i] * c[5]) / m[i];
-    grid.vny[i] = (fix[i] & 2) ? 0.0 : grid.vy[i] + DT * (grid.fy[i] - grid.cxy[i] * c[4] - grid.cyy[i] * c[5]) / m[i];
-    v2 = std::max(v2, grid.vnx[i] * grid.vnx[i] + grid.vny[i] * grid.vny[i]);
+    const double* r = dn_rec_.data() + kDn * cm_dk_[k];
+    const int fi = static_cast<int>(r[11]);
+    const double ux = (fi & 1) ? 0.0 : r[3] + DT * (r[1] - r[7] * c[4] - r[8] * c[5]) / r[0];
+    const double uy = (fi & 2) ? 0.0 : r[4] + DT * (r[2] - r[8] * c[4] - r[9] * c[5]) / r[0];
+    grid.vnx[i] = ux;
+    grid.vny[i] = uy;
+    v2 = std::max(v2, ux * ux + uy * uy);
   }
   cm_drift_ += DT * std::sqrt(v2);  // this step's move, with the velocities as they now are
 }

@@ -274,6 +274,7 @@ class Solver {
   // the particles whose shape functions reach them, and per node its slot (-1: none).
   std::vector<double> consistent_weight_;
   std::vector<long> cm_nodes_;
+  std::vector<long> cm_dk_;             // per slot: its node's place in dashpot_nodes_
   std::vector<int> cm_slot_;
   std::vector<std::uint8_t> cm_cell_;   // per cell: 1 in the zone, 2 reaches a listed node
   std::vector<long> cm_cells_;          // the cells marked 1
@@ -299,6 +300,11 @@ class Solver {
   std::size_t cm_scan_size_ = 0;
   double cm_drift_ = 0;                 // how far a particle may have moved since (m)
   double vmax2_ = 0;                    // the step's fastest updated nodal velocity, squared
+  // grid_update's record of each dashpot node for consistent_dashpots (kDn values per node, in
+  // the order of dashpot_nodes_): m, f x y, v x y, v+ x y, the block xx xy yy, the consistent
+  // weight, and the flags (the fix bits; 4: strained with v+ or the delayed closure's).
+  static constexpr int kDn = 12;
+  std::vector<double> dn_rec_;
   long order_version_ = 0;              // bumped whenever the particles' order or count changes
   template <class S> void consistent_dashpots();
   void cm_sum(int first, int count);    // sum slot values [first, first + count) over the halo
@@ -412,6 +418,7 @@ class Solver {
   template <class S> void pml_pic();
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
+  void update_dashpot_node(long i, bool delayed, double gx, double gy);
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
