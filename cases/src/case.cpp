@@ -754,29 +754,25 @@ class Builder {
                           "time.cfl if the run blows up");
         break;
       }
-    // The delayed closure grew in long runs in two dimensions, where its edges meet free
-    // surfaces, above CFL 0.3 (docs/physics.md section 4); so did the default edge velocity
-    // with the lumped trapezoidal mean, which multi-field contact keeps (the particles' mean
-    // needs one velocity field), above CFL 0.2 at 1 ppc and 0.4 at 4 ppc and more. Said for
-    // runs of more than 10^4 steps (the earliest stop came after 1.1 * 10^4 at CFL 0.5).
-    if (s_->opt.scheme != Scheme::USL && t_end_ > 1e4 * s_->dt)
+    // The default edge velocity with the lumped trapezoidal mean, which multi-field contact
+    // keeps (the particles' mean needs one velocity field), grew in long runs in two
+    // dimensions, where its edges meet free surfaces, above CFL 0.2 at 1 ppc and 0.4 at 4 ppc
+    // and more (docs/physics.md section 4). Said for runs of more than 10^4 steps (the
+    // earliest stop came after 1.7 * 10^4).
+    if (s_->opt.scheme != Scheme::USL && t_end_ > 1e4 * s_->dt && s_->contact.multi())
       for (const auto& sb : s_->silents) {
         if (sb.form != SilentForm::Nodal || sb.updated_velocity || sb.layer.idx.empty()) continue;
-        const bool lumped = !sb.delayed && s_->contact.multi();
-        if (!sb.delayed && !lumped) continue;
         const double h2 = s_->grid.h * s_->grid.h;
         const bool fine = s_->p.vol[sb.layer.idx[0]] < 0.5 * h2;  // 4 ppc and more
-        const double bound = sb.delayed ? 0.3 : fine ? 0.4 : 0.2;
+        const double bound = fine ? 0.4 : 0.2;
         if (cfl <= bound + 1e-12) continue;
         c.notes.push_back(
-            "note: silent boundary \"" + sb.layer.name + "\" (edge_velocity \"" +
-            (sb.delayed ? "delayed\")" : "remapped\", multi-field contact)") + " under " +
-            scheme_name(s_->opt.scheme) + " at CFL " + fmt(cfl) + ": in two dimensions, where "
-            "such edges meet free surfaces, runs grew after 10^4-10^5 steps above CFL " +
-            fmt(bound) + (sb.delayed ? "" : fine ? " at 4 particles per cell and more"
-                                                 : " at 1 particle per cell") +
-            " (docs/physics.md section 4); for long runs lower time.cfl" +
-            (sb.delayed ? " or use the default edge velocity" : ""));
+            "note: silent boundary \"" + sb.layer.name + "\" (edge_velocity \"remapped\", "
+            "multi-field contact) under " + scheme_name(s_->opt.scheme) + " at CFL " + fmt(cfl) +
+            ": in two dimensions, where such edges meet free surfaces, runs grew after "
+            "10^4-10^5 steps above CFL " + fmt(bound) +
+            (fine ? " at 4 particles per cell and more" : " at 1 particle per cell") +
+            " (docs/physics.md section 4); for long runs lower time.cfl");
         break;
       }
     c.solver = std::move(s_);

@@ -198,7 +198,7 @@ void Solver::finalize() {
   edge_velocity_.clear();
   bool consistent = false;  // a nodal layer with the default edge velocity (MUSL or USF, one field)
   for (const auto& s : silents)
-    consistent = consistent || (s.form == SilentForm::Nodal && !s.updated_velocity && !s.delayed);
+    consistent = consistent || (s.form == SilentForm::Nodal && !s.updated_velocity);
   consistent = consistent && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
                body_of_group_.empty();
   consistent_weight_.assign(consistent ? grid.nodes() : 0, 0.0);
@@ -1040,7 +1040,7 @@ void Solver::apply_loads() {
     }
     const bool updated = !updated_weight_.empty() && sl.updated_velocity;
     const bool delayed = !delay_rho_.empty() && sl.delayed;
-    const bool consistent = !consistent_weight_.empty() && !sl.updated_velocity && !sl.delayed;
+    const bool consistent = !consistent_weight_.empty() && !sl.updated_velocity;
     for (long q = 0; q < n; ++q) {
       const long* nodes = sl.nodes.data() + K * q;
       const double* N = sl.N.data() + K * q;
@@ -1212,12 +1212,23 @@ void Solver::grid_update() {
     r[8] = grid.cxy[i];
     r[9] = grid.cyy[i];
     r[10] = consistent_weight_[i];
-    const bool other = (!updated_weight_.empty() && updated_weight_[i] > 0) ||
-                       (!delay_rho_.empty() && delay_rho_[i] > 0);
-    r[11] = static_cast<double>((fix[i] & 3) | (other ? 4 : 0));
+    r[11] = static_cast<double>((fix[i] & 3) | dashpot_solve_flags(i));
     vd2 = std::max(vd2, ux[i] * ux[i] + uy[i] * uy[i]);  // the dashpots' updates
   }
   if (track) vmax2_ = std::max(vmax2_, vd2);
+}
+
+// How the dashpot solve takes dashpot node i (grid_update's record): 4 not at all (strained with
+// v+, or a delayed closure's node that kept the trapezoidal update or whose two components the
+// closure took, at a corner); 8 (16): its x (y) component is the closure's, held in the solve.
+int Solver::dashpot_solve_flags(long i) {
+  if (!updated_weight_.empty() && updated_weight_[i] > 0) return 4;
+  if (delay_rho_.empty() || !(delay_rho_[i] > 0)) return 0;
+  const double* rec = delay_record(i);
+  if (!rec || rec[kDelayAt] != static_cast<double>(steps)) return 4;
+  const bool on_x = delayed_axis(rec[kDelayCxx], rec[kDelayCyy]);
+  const bool on_y = delayed_axis(rec[kDelayCyy], rec[kDelayCxx]);
+  return on_x && on_y ? 4 : on_x ? 8 : 16;
 }
 
 // One dashpot node's updated velocity in grid_update: the delayed closure's, or the
@@ -1408,13 +1419,14 @@ void Solver::consistent_dashpots() {
     cm_pm_.resize(nz);
     cm_s_.resize(2 * nz);
     std::vector<std::uint8_t> reaches(nz);
-    // dv0 at a node: without the listed nodes' dashpots.
+    // dv0 at a node: without the listed nodes' dashpots (a delayed closure's component: its
+    // update, whose dashpot is explicit).
     cm_dv_.resize(2 * cm_nodes_.size());
     for (std::size_t k = 0; k < cm_nodes_.size(); ++k) {
       const double* r = dn_rec_.data() + kDn * cm_dk_[k];
       const int fj = static_cast<int>(r[11]);
-      cm_dv_[2 * k] = (fj & 1) ? 0.0 : DT * r[1] / r[0];
-      cm_dv_[2 * k + 1] = (fj & 2) ? 0.0 : DT * r[2] / r[0];
+      cm_dv_[2 * k] = (fj & 8) ? r[5] - r[3] : (fj & 1) ? 0.0 : DT * r[1] / r[0];
+      cm_dv_[2 * k + 1] = (fj & 16) ? r[6] - r[4] : (fj & 2) ? 0.0 : DT * r[2] / r[0];
     }
     auto dv0 = [&](long j, double& ax, double& ay) {
       if (const int sl = cm_slot_[j]; sl >= 0) {
@@ -1558,8 +1570,8 @@ void Solver::consistent_dashpots() {
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
     double* n = cm_node_.data() + kCmNode * k;
     const double* c = cm_.data() + kCm * k;
-    const int fi = static_cast<int>(r[11]);
-    const double mi = r[0], fx = (fi & 1) ? 0.0 : 1.0, fy = (fi & 2) ? 0.0 : 1.0;
+    const int fi = static_cast<int>(r[11]);  // a held component: fixed, or the closure's
+    const double mi = r[0], fx = (fi & 9) ? 0.0 : 1.0, fy = (fi & 18) ? 0.0 : 1.0;
     const double cxx = r[7], cxy = r[8], cyy = r[9];
     const double kap = 0.5 * DT * c[2] / (mi * mi);
     const double A = 1 + kap * cxx, B = kap * cxy, D = 1 + kap * cyy;
@@ -1646,8 +1658,8 @@ void Solver::consistent_dashpots() {
     const double* c = cm_.data() + kCm * k;
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
     const int fi = static_cast<int>(r[11]);
-    const double ux = (fi & 1) ? 0.0 : r[3] + DT * (r[1] - r[7] * c[4] - r[8] * c[5]) / r[0];
-    const double uy = (fi & 2) ? 0.0 : r[4] + DT * (r[2] - r[8] * c[4] - r[9] * c[5]) / r[0];
+    const double ux = (fi & 8) ? r[5] : (fi & 1) ? 0.0 : r[3] + DT * (r[1] - r[7] * c[4] - r[8] * c[5]) / r[0];
+    const double uy = (fi & 16) ? r[6] : (fi & 2) ? 0.0 : r[4] + DT * (r[2] - r[8] * c[4] - r[9] * c[5]) / r[0];
     grid.vnx[i] = ux;
     grid.vny[i] = uy;
     v2 = std::max(v2, ux * ux + uy * uy);

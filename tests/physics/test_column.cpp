@@ -1096,12 +1096,13 @@ static ColumnSpec delayed_column(Scheme sc, double cfl, bool shear, int cells) {
 // node's dashpot acts on its normal component with its start velocity of h/c_d - dt/2 earlier,
 // on the node weighed as a whole one, and its normal strain velocity is the mean of the
 // re-mapped one and the force of as long ago over the dashpot's coefficient; the tangential
-// component keeps LK's trapezoidal update (delayed, it made a two-dimensional body unstable:
-// SilentStability.DelayedClosureSquareDecays). 16-cell pulses on a grid line, MUSL and USF, P
-// and S. Measured at 1e4 Pa (the end moves 1e-10 h): P 0.070-0.079 % at CFL 0.3 and 0.5 (the
-// default 1.03-1.54 %), S 0.75-0.98 %, the default's; at 100 MPa the P pulse moves the end by
-// 0.4 % of a cell off its grid line, and P returns 0.54 % (default 1.12 %). Bounds: P 0.1 % at
-// small amplitude and 0.6 % at 100 MPa, S 1.1 %.
+// component keeps LK's dashpot on the particles' mean, solved with the other dashpot nodes
+// (delayed, it made a two-dimensional body unstable: SilentStability.DelayedClosureSquareDecays).
+// 16-cell pulses on a grid line, MUSL and USF, P and S. Measured at 1e4 Pa (the end moves
+// 1e-10 h): P 0.070-0.079 % at CFL 0.3 and 0.5 (the default 1.03-1.54 %), S 0.57-0.58 %, the
+// default's (0.75-0.98 % with the lumped trapezoidal mean there); at 100 MPa the P pulse moves
+// the end by 0.4 % of a cell off its grid line, and P returns 0.54 % (default 1.12 %). Bounds:
+// P 0.1 % at small amplitude and 0.6 % at 100 MPa, S 0.65 %.
 TEST(SilentLayer, DelayedClosureOnePpc) {
   for (const Scheme sc : {Scheme::MUSL, Scheme::USF})
     for (const double cfl : {0.3, 0.5})
@@ -1113,7 +1114,7 @@ TEST(SilentLayer, DelayedClosureOnePpc) {
           const double amp = std::sqrt(reflected_energy_ratio(c, 16, 0.01));
           std::printf("  [%s CFL %.1f %.0e Pa %s] reflected amplitude %.5f\n", scheme_name(sc), cfl,
                       amplitude, shear ? "S" : "P", amp);
-          const double bound = shear ? 1.1e-2 : amplitude > 1e4 ? 6e-3 : 1e-3;
+          const double bound = shear ? 6.5e-3 : amplitude > 1e4 ? 6e-3 : 1e-3;
           EXPECT_LE(amp, bound) << scheme_name(sc) << " CFL " << cfl << " " << amplitude << " Pa "
                                 << (shear ? "S" : "P");
         }
@@ -1121,7 +1122,7 @@ TEST(SilentLayer, DelayedClosureOnePpc) {
 
 // The delayed closure over 10^5 steps after an 8-cell pulse has left a 60-cell column (MUSL and
 // USF, P and S, CFL 0.3 and 0.9): the energy left (the column's drift and what the end still
-// rings with) sampled every 500 steps from 10^4 steps on. Measured: it decays (to 0.03-0.3 of
+// rings with) sampled every 500 steps from 10^4 steps on. Measured: it decays (to 0.03-0.35 of
 // its value at 10^4 steps), except MUSL P at CFL 0.9, which swaps up to 2.4 times its value at
 // 10^4 steps once before it decays to 0.03 of it. With the tangential strain velocity closed
 // as the normal one the run grew within 2 000 steps, and with neither within 4-9 * 10^4.

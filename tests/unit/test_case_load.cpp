@@ -342,8 +342,11 @@ TEST(CaseLoad, ReferenceExampleBuilds) {
 
 }  // namespace
 
-// The note on the delayed closure in long runs (docs/physics.md section 4): said above CFL 0.3,
-// for more than 10^4 steps; not for the default edge velocity.
+// The note on nodal edges with the lumped trapezoidal mean in long runs (docs/physics.md
+// section 4): said for multi-field contact above CFL 0.2 at 1 ppc, for more than 10^4 steps; not
+// for the default edge velocity (the particles' mean at the dashpot nodes), nor for the delayed
+// closure, whose tangential component takes that mean too (before, it grew above CFL 0.3 and
+// was noted).
 TEST(CaseLoad, NoteOnLongRunsOfNodalEdges) {
   const fs::path file = write_file("valid_note.json", kValid);
   const auto noted = [&](const std::vector<std::string>& more) {
@@ -356,12 +359,8 @@ TEST(CaseLoad, NoteOnLongRunsOfNodalEdges) {
       if (n.find("where such edges meet free surfaces") != std::string::npos) found = n;
     return found;
   };
-  const std::string delayed = noted({"time.end=2e-3", "boundaries.2.edge_velocity=delayed"});
-  EXPECT_NE(delayed.find("above CFL 0.3"), std::string::npos) << delayed;
-  EXPECT_NE(delayed.find("(edge_velocity \"delayed\") under MUSL at CFL 0.5"), std::string::npos)
-      << delayed;
-  EXPECT_EQ(noted({"time.end=2e-3", "boundaries.2.edge_velocity=delayed", "time.cfl=0.3"}), "");
-  EXPECT_EQ(noted({"boundaries.2.edge_velocity=delayed"}), "");  // 1e-6 s: a few steps
+  EXPECT_EQ(noted({"time.end=2e-3", "boundaries.2.edge_velocity=delayed"}), "");
+  EXPECT_EQ(noted({"time.end=2e-3", "boundaries.2.edge_velocity=delayed", "time.cfl=0.9"}), "");
   // The default edge velocity (the particles' mean at the dashpot nodes) is not concerned, at
   // 1 and 4 ppc, nor is the paper's particle form (kValid's own); with multi-field contact,
   // which keeps the lumped trapezoidal mean, it is, above CFL 0.2 at 1 ppc and 0.4 at 4 ppc.
@@ -372,6 +371,7 @@ TEST(CaseLoad, NoteOnLongRunsOfNodalEdges) {
             std::string::npos) << multi;
   EXPECT_NE(multi.find("above CFL 0.2 at 1 particle per cell"), std::string::npos) << multi;
   EXPECT_EQ(noted({"time.end=2e-3", R"(contact={"type": "multi"})", "time.cfl=0.2"}), "");
+  EXPECT_EQ(noted({R"(contact={"type": "multi"})"}), "");  // 1e-6 s: a few steps
   const smpm::Case particle = smpm::load_case(file.string(), {"time.end=2e-3"});
   for (const auto& n : particle.notes)
     EXPECT_EQ(n.find("where such edges meet free surfaces"), std::string::npos) << n;

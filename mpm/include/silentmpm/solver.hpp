@@ -302,7 +302,7 @@ class Solver {
   double vmax2_ = 0;                    // the step's fastest updated nodal velocity, squared
   // grid_update's record of each dashpot node for consistent_dashpots (kDn values per node, in
   // the order of dashpot_nodes_): m, f x y, v x y, v+ x y, the block xx xy yy, the consistent
-  // weight, and the flags (the fix bits; 4: strained with v+ or the delayed closure's).
+  // weight, and the flags (the fix bits and dashpot_solve_flags).
   static constexpr int kDn = 12;
   std::vector<double> dn_rec_;
   long order_version_ = 0;              // bumped whenever the particles' order or count changes
@@ -419,6 +419,7 @@ class Solver {
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
   void update_dashpot_node(long i, bool delayed, double gx, double gy);
+  int dashpot_solve_flags(long i);
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
