@@ -196,7 +196,9 @@ void Solver::finalize() {
             body_of_group_.empty();
   updated_weight_.assign(updated ? grid.nodes() : 0, 0.0);
   edge_velocity_.clear();
-  bool consistent = false;  // a nodal layer with the default edge velocity (MUSL or USF, one field)
+  // A nodal layer with the default edge velocity or the delayed closure (whose tangential
+  // component takes the particles' mean), MUSL or USF, one field.
+  bool consistent = false;
   for (const auto& s : silents)
     consistent = consistent || (s.form == SilentForm::Nodal && !s.updated_velocity);
   consistent = consistent && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
@@ -1268,7 +1270,7 @@ void Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
     rec[kDelayAt] = -1;
     const bool blocks = cxx > 0 && cyy > 0;
     // The closure takes the normal component (delayed_axis); the tangential one keeps the
-    // trapezoidal update.
+    // trapezoidal update here, which consistent_dashpots replaces with the particles' mean.
     const bool on_x = delayed_axis(cxx, cyy), on_y = delayed_axis(cyy, cxx);
     const double dx = blocks ? grid.h / (cxx / rec[kDelayRho] * DT) - 0.5 : 0.0;
     const double dy = blocks ? grid.h / (cyy / rec[kDelayRho] * DT) - 0.5 : 0.0;
@@ -1326,7 +1328,8 @@ void Solver::consistent_dashpots() {
   const double DT = dt, floor = mass_floor_;
   const long nnx = grid.nnx;
   // The nodes: a block from such a layer, heavy enough (the same choice on every copy of a
-  // shared node: it reads only values summed over the halo). A node whose mass is not its
+  // shared node: it reads only values summed over the halo, and whether a delayed closure acted,
+  // which every rank that holds the node decides from its ring of those values). A node whose mass is not its
   // particles' is dropped and the choice made again (the same on every rank), once the zone
   // was found this step: a node that a particle missing from an older zone left short asks for
   // a new one first.
@@ -1587,8 +1590,10 @@ void Solver::consistent_dashpots() {
       pxx = 1 / A;  // y held
     }
     const double rx = r[3] + 0.5 * c[0] / mi, ry = r[4] + 0.5 * c[1] / mi;
-    n[0] = pxx * rx + pxy * ry;
-    n[1] = pxy * rx + pyy * ry;
+    // A component the delayed closure holds keeps the mean of its start and its closure's
+    // velocity (its Q row is zero: pxx = pxy = 0 there).
+    n[0] = (fi & 8) ? 0.5 * (r[3] + r[5]) : pxx * rx + pxy * ry;
+    n[1] = (fi & 16) ? 0.5 * (r[4] + r[6]) : pxy * rx + pyy * ry;
     const double q = 0.5 / mi;
     n[2] = q * pxx;
     n[3] = q * pxy;
@@ -1768,7 +1773,8 @@ void Solver::boundary_work(bool remapped) {
         // The delayed closure: what it takes out against the conservative update, the force
         // and its work with the strain velocity (delay_strain_velocities):
         // (f + C v_d)/2 . wbar + f . (g - g0), f the force less gravity.
-        // The tangential component took the trapezoidal update: C vbar . wbar.
+        // The tangential component: C vbar . wbar, vbar the particles' mean where
+        // consistent_dashpots solved it.
         const double fx = rec[kDelayFx], fy = rec[kDelayFy];
         const double cx = rec[kDelayCxx] * rec[kDelayVx], cy = rec[kDelayCyy] * rec[kDelayVy];
         vbar(i, ax, ay);

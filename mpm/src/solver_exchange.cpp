@@ -151,6 +151,13 @@ void Solver::cm_sum(int first, int count) {
       cm_[kCm * k + first + c] = f[c][cm_nodes_[k]];
       f[c][cm_nodes_[k]] = 0;
     }
+  // A shared node listed on another rank only would leave its sum here, for every later sum
+  // to carry: the ranks' choices must agree.
+  for_shared_nodes(grid, own_, halo_, [&](long i, long j) {
+    for (int c = 0; c < count; ++c)
+      if (f[c][j * grid.nnx + i] != 0)
+        throw std::logic_error("cm_sum: a shared node is a slot on another rank only");
+  });
 }
 
 void Solver::keep_particles(const std::vector<std::uint8_t>& keep) {

@@ -267,8 +267,9 @@ class Solver {
   // layer is.
   std::vector<double> updated_weight_;
   // MUSL and USF, one velocity field: the dashpot blocks of the silent layers with the default
-  // edge velocity act on the mean of the velocities the particles map to the node at the start
-  // and at the end of the step (consistent_dashpots; docs/physics.md section 4). Per grid node,
+  // edge velocity (and the tangential component of the delayed closure's) act on the mean of the
+  // velocities the particles map to the node at the start and at the end of the step
+  // (consistent_dashpots; docs/physics.md section 4). Per grid node,
   // the weight (w N rho c_d) those layers put on it this step, summed over the halo with the
   // blocks (empty when the scheme or the layers do not take it); the nodes solved so this step,
   // the particles whose shape functions reach them, and per node its slot (-1: none).
