@@ -1002,16 +1002,23 @@ void Solver::apply_loads() {
   // Nodal dashpot blocks: clear the nodes assembled last step, then assemble
   // C_i += (V_p / h) N_i [a rho c_d n n^T + b rho c_s (I - n n^T)].
   if (dashpot_mark_.size() != grid.nodes()) dashpot_mark_.assign(grid.nodes(), 0);
-  for (long i : dashpot_nodes_) {
-    grid.cxx[i] = grid.cxy[i] = grid.cyy[i] = 0;
-    dashpot_mark_[i] = 0;
+  {
+    // One pass (in parallel): along an edge every node lies on its own cache lines.
+    const long nd = static_cast<long>(dashpot_nodes_.size());
+    const long* dn = dashpot_nodes_.data();
+    double* uw = updated_weight_.empty() ? nullptr : updated_weight_.data();
+    double* dr = delay_rho_.empty() ? nullptr : delay_rho_.data();
+    double* cw = consistent_weight_.empty() ? nullptr : consistent_weight_.data();
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
+    for (long k = 0; k < nd; ++k) {
+      const long i = dn[k];
+      grid.cxx[i] = grid.cxy[i] = grid.cyy[i] = 0;
+      dashpot_mark_[i] = 0;
+      if (uw) uw[i] = 0;
+      if (dr) dr[i] = 0;
+      if (cw) cw[i] = 0;
+    }
   }
-  if (!updated_weight_.empty())
-    for (long i : dashpot_nodes_) updated_weight_[i] = 0;
-  if (!delay_rho_.empty())
-    for (long i : dashpot_nodes_) delay_rho_[i] = 0;
-  if (!consistent_weight_.empty())
-    for (long i : dashpot_nodes_) consistent_weight_[i] = 0;
   dashpot_nodes_.clear();
   has_nodal_dashpot_ = false;
   for (auto& sl : silents) {
