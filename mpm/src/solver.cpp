@@ -1210,34 +1210,35 @@ void Solver::grid_update() {
     update_dashpot_node(i, delayed, gx, gy);
     if (!track) continue;
     double* r = rec_all + kDn * k;
-    r[0] = m[i];
-    r[1] = fx[i];
-    r[2] = fy[i];
-    r[3] = vx[i];
-    r[4] = vy[i];
-    r[5] = ux[i];
-    r[6] = uy[i];
-    r[7] = grid.cxx[i];
-    r[8] = grid.cxy[i];
-    r[9] = grid.cyy[i];
-    r[10] = consistent_weight_[i];
-    r[11] = static_cast<double>((fix[i] & 3) | dashpot_solve_flags(i));
+    r[kDnM] = m[i];
+    r[kDnFx] = fx[i];
+    r[kDnFy] = fy[i];
+    r[kDnVx] = vx[i];
+    r[kDnVy] = vy[i];
+    r[kDnUx] = ux[i];
+    r[kDnUy] = uy[i];
+    r[kDnCxx] = grid.cxx[i];
+    r[kDnCxy] = grid.cxy[i];
+    r[kDnCyy] = grid.cyy[i];
+    r[kDnWeight] = consistent_weight_[i];
+    r[kDnFlags] = static_cast<double>((fix[i] & 3) | dashpot_solve_flags(i));
     vd2 = std::max(vd2, ux[i] * ux[i] + uy[i] * uy[i]);  // the dashpots' updates
   }
   if (track) vmax2_ = std::max(vmax2_, vd2);
 }
 
-// How the dashpot solve takes dashpot node i (grid_update's record): 4 not at all (strained with
-// v+, or a delayed closure's node that kept the trapezoidal update or whose two components the
-// closure took, at a corner); 8 (16): its x (y) component is the closure's, held in the solve.
+// How the dashpot solve takes dashpot node i (grid_update's record): kDnSkip, not at all
+// (strained with v+, or a delayed closure's node that kept the trapezoidal update or whose two
+// components the closure took, at a corner); kDnHeldX (Y): its x (y) component is the closure's,
+// held in the solve.
 int Solver::dashpot_solve_flags(long i) {
-  if (!updated_weight_.empty() && updated_weight_[i] > 0) return 4;
+  if (!updated_weight_.empty() && updated_weight_[i] > 0) return kDnSkip;
   if (delay_rho_.empty() || !(delay_rho_[i] > 0)) return 0;
   const double* rec = delay_record(i);
-  if (!rec || rec[kDelayAt] != static_cast<double>(steps)) return 4;
+  if (!rec || rec[kDelayAt] != static_cast<double>(steps)) return kDnSkip;
   const bool on_x = delayed_axis(rec[kDelayCxx], rec[kDelayCyy]);
   const bool on_y = delayed_axis(rec[kDelayCyy], rec[kDelayCxx]);
-  return on_x && on_y ? 4 : on_x ? 8 : 16;
+  return on_x && on_y ? kDnSkip : on_x ? kDnHeldX : kDnHeldY;
 }
 
 // One dashpot node's updated velocity in grid_update: the delayed closure's, or the
@@ -1361,15 +1362,15 @@ void Solver::consistent_dashpots() {
     for (std::size_t k = 0; k < dashpot_nodes_.size(); ++k) {
       const long i = dashpot_nodes_[k];
       const double* r = dn_rec_.data() + kDn * k;
-      if (r[10] <= 0 || r[0] <= floor) continue;
+      if (r[kDnWeight] <= 0 || r[kDnM] <= floor) continue;
       // strained with v+, or the delayed closure's own
-      if (static_cast<int>(r[11]) & 4) continue;
-      const double cxx = r[7], cxy = r[8], cyy = r[9];
+      if (static_cast<int>(r[kDnFlags]) & kDnSkip) continue;
+      const double cxx = r[kDnCxx], cxy = r[kDnCxy], cyy = r[kDnCyy];
       const double lmax =
           0.5 * (cxx + cyy) + std::sqrt(0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy);
       // No block (a = b = 0: a rank that shares the node lists it only with a block), or one
       // too strong for the node's mass.
-      if (!(lmax > 0) || 0.5 * DT * lmax > r[0]) continue;
+      if (!(lmax > 0) || 0.5 * DT * lmax > r[kDnM]) continue;
       if (std::binary_search(dropped.begin(), dropped.end(), i)) continue;
       cm_slot_[i] = static_cast<int>(cm_nodes_.size());
       cm_nodes_.push_back(i);
@@ -1434,9 +1435,13 @@ void Solver::consistent_dashpots() {
     cm_dv_.resize(2 * cm_nodes_.size());
     for (std::size_t k = 0; k < cm_nodes_.size(); ++k) {
       const double* r = dn_rec_.data() + kDn * cm_dk_[k];
-      const int fj = static_cast<int>(r[11]);
-      cm_dv_[2 * k] = (fj & 8) ? r[5] - r[3] : (fj & 1) ? 0.0 : DT * r[1] / r[0];
-      cm_dv_[2 * k + 1] = (fj & 16) ? r[6] - r[4] : (fj & 2) ? 0.0 : DT * r[2] / r[0];
+      const int fj = static_cast<int>(r[kDnFlags]);
+      cm_dv_[2 * k] = (fj & kDnHeldX) ? r[kDnUx] - r[kDnVx]
+                      : (fj & 1)      ? 0.0
+                                      : DT * r[kDnFx] / r[kDnM];
+      cm_dv_[2 * k + 1] = (fj & kDnHeldY) ? r[kDnUy] - r[kDnVy]
+                          : (fj & 2)      ? 0.0
+                                          : DT * r[kDnFy] / r[kDnM];
     }
     auto dv0 = [&](long j, double& ax, double& ay) {
       if (const int sl = cm_slot_[j]; sl >= 0) {
@@ -1524,7 +1529,7 @@ void Solver::consistent_dashpots() {
     cm_sum(0, 4);
     short_nodes.clear();
     for (std::size_t k = 0; k < ns; ++k) {
-      const double mi = dn_rec_[kDn * cm_dk_[k]];
+      const double mi = dn_rec_[kDn * cm_dk_[k] + kDnM];
       if (std::abs(cm_[kCm * k + 3] - mi) > 1e-9 * mi) short_nodes.push_back(cm_nodes_[k]);
     }
     more[0] = short_nodes.empty() ? 0.0 : 1.0;
@@ -1580,9 +1585,10 @@ void Solver::consistent_dashpots() {
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
     double* n = cm_node_.data() + kCmNode * k;
     const double* c = cm_.data() + kCm * k;
-    const int fi = static_cast<int>(r[11]);  // a held component: fixed, or the closure's
-    const double mi = r[0], fx = (fi & 9) ? 0.0 : 1.0, fy = (fi & 18) ? 0.0 : 1.0;
-    const double cxx = r[7], cxy = r[8], cyy = r[9];
+    const int fi = static_cast<int>(r[kDnFlags]);  // a held component: fixed, or the closure's
+    const double mi = r[kDnM], fx = (fi & (1 | kDnHeldX)) ? 0.0 : 1.0,
+                 fy = (fi & (2 | kDnHeldY)) ? 0.0 : 1.0;
+    const double cxx = r[kDnCxx], cxy = r[kDnCxy], cyy = r[kDnCyy];
     const double kap = 0.5 * DT * c[2] / (mi * mi);
     const double A = 1 + kap * cxx, B = kap * cxy, D = 1 + kap * cyy;
     double pxx = 0, pxy = 0, pyy = 0;
@@ -1596,11 +1602,11 @@ void Solver::consistent_dashpots() {
     } else if (fx != 0) {
       pxx = 1 / A;  // y held
     }
-    const double rx = r[3] + 0.5 * c[0] / mi, ry = r[4] + 0.5 * c[1] / mi;
+    const double rx = r[kDnVx] + 0.5 * c[0] / mi, ry = r[kDnVy] + 0.5 * c[1] / mi;
     // A component the delayed closure holds keeps the mean of its start and its closure's
     // velocity (its Q row is zero: pxx = pxy = 0 there).
-    n[0] = (fi & 8) ? 0.5 * (r[3] + r[5]) : pxx * rx + pxy * ry;
-    n[1] = (fi & 16) ? 0.5 * (r[4] + r[6]) : pxy * rx + pyy * ry;
+    n[0] = (fi & kDnHeldX) ? 0.5 * (r[kDnVx] + r[kDnUx]) : pxx * rx + pxy * ry;
+    n[1] = (fi & kDnHeldY) ? 0.5 * (r[kDnVy] + r[kDnUy]) : pxy * rx + pyy * ry;
     const double q = 0.5 / mi;
     n[2] = q * pxx;
     n[3] = q * pxy;
@@ -1611,8 +1617,8 @@ void Solver::consistent_dashpots() {
     n[7] = cxx;
     n[8] = cxy;
     n[9] = cyy;
-    vb[2 * k] = 0.5 * (r[3] + r[5]);
-    vb[2 * k + 1] = 0.5 * (r[4] + r[6]);
+    vb[2 * k] = 0.5 * (r[kDnVx] + r[kDnUx]);
+    vb[2 * k + 1] = 0.5 * (r[kDnVy] + r[kDnUy]);
     g[2 * k] = n[5] * (cxx * vb[2 * k] + cxy * vb[2 * k + 1]);
     g[2 * k + 1] = n[6] * (cxy * vb[2 * k] + cyy * vb[2 * k + 1]);
   }
@@ -1669,9 +1675,11 @@ void Solver::consistent_dashpots() {
     const long i = cm_nodes_[k];
     const double* c = cm_.data() + kCm * k;
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
-    const int fi = static_cast<int>(r[11]);
-    const double ux = (fi & 8) ? r[5] : (fi & 1) ? 0.0 : r[3] + DT * (r[1] - r[7] * c[4] - r[8] * c[5]) / r[0];
-    const double uy = (fi & 16) ? r[6] : (fi & 2) ? 0.0 : r[4] + DT * (r[2] - r[8] * c[4] - r[9] * c[5]) / r[0];
+    const int fi = static_cast<int>(r[kDnFlags]);
+    const double fx = r[kDnFx] - r[kDnCxx] * c[4] - r[kDnCxy] * c[5];
+    const double fy = r[kDnFy] - r[kDnCxy] * c[4] - r[kDnCyy] * c[5];
+    const double ux = (fi & kDnHeldX) ? r[kDnUx] : (fi & 1) ? 0.0 : r[kDnVx] + DT * fx / r[kDnM];
+    const double uy = (fi & kDnHeldY) ? r[kDnUy] : (fi & 2) ? 0.0 : r[kDnVy] + DT * fy / r[kDnM];
     grid.vnx[i] = ux;
     grid.vny[i] = uy;
     v2 = std::max(v2, ux * ux + uy * uy);

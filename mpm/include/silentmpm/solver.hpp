@@ -302,9 +302,11 @@ class Solver {
   double cm_drift_ = 0;                 // how far a particle may have moved since (m)
   double vmax2_ = 0;                    // the step's fastest updated nodal velocity, squared
   // grid_update's record of each dashpot node for consistent_dashpots (kDn values per node, in
-  // the order of dashpot_nodes_): m, f x y, v x y, v+ x y, the block xx xy yy, the consistent
-  // weight, and the flags (the fix bits and dashpot_solve_flags).
-  static constexpr int kDn = 12;
+  // the order of dashpot_nodes_): m, f, v, v+, the block, the consistent weight, and the flags
+  // (the fix bits and dashpot_solve_flags: skipped, or the x or y component held).
+  enum : int { kDnM, kDnFx, kDnFy, kDnVx, kDnVy, kDnUx, kDnUy, kDnCxx, kDnCxy, kDnCyy, kDnWeight,
+               kDnFlags, kDn };
+  static constexpr int kDnSkip = 4, kDnHeldX = 8, kDnHeldY = 16;
   std::vector<double> dn_rec_;
   long order_version_ = 0;              // bumped whenever the particles' order or count changes
   template <class S> void consistent_dashpots();
