@@ -3,7 +3,7 @@
 // traces OUT/trace_<P|SV>_<angle>.csv.
 //
 //   oblique OUTDIR [--method fem|mpm] [--angles "0 15 30 45 60"] [--fwhm 24] [--flat 200] [--taper 60] [--degree 1] [--threads N] [--shape bilinear|gimp|bspline]
-//           [--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P]
+//           [--boundary lk|kv|damping|pml|delayed] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P]
 //           [--beta F] (damping: the band's stiffness part, F h / c_d seconds)
 //           (the right side of run A)
 #include <cstdlib>
@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
                          "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
-                         "[--boundary lk|kv|damping|pml] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P] [--beta F]\n");
+                         "[--boundary lk|kv|damping|pml|delayed] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P] [--beta F]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -53,8 +53,8 @@ int main(int argc, char** argv) {
     } else if (a == "--boundary") {
       base.boundary = argv[i + 1];
       if (base.boundary != "lk" && base.boundary != "kv" && base.boundary != "damping" &&
-          base.boundary != "pml") {
-        std::fprintf(stderr, "oblique: --boundary must be lk, kv, damping or pml\n");
+          base.boundary != "pml" && base.boundary != "delayed") {
+        std::fprintf(stderr, "oblique: --boundary must be lk, kv, damping, pml or delayed\n");
         return 1;
       }
     } else if (a == "--delta") {
@@ -84,6 +84,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "oblique: unknown option %s\n", a.c_str());
       return 1;
     }
+  }
+  if (method == "fem" && base.boundary == "delayed") {
+    std::fprintf(stderr, "oblique: --boundary delayed is the particles' closure: --method mpm only\n");
+    return 1;
   }
   try {
     std::filesystem::create_directories(out);

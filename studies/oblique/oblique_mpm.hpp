@@ -46,6 +46,7 @@ inline Result measure_mpm(const Setup& su) {
       SilentBoundary sb;
       sb.layer = s->select_layer("right", 0, cells_x * h, 0, cells_x * h, w.ly * h, 1, 0, h);
       if (su.boundary == "kv") sb.delta = su.delta * h;
+      sb.delayed = su.boundary == "delayed";  // the edge lies on a grid line, 1 ppc, MUSL
       s->silents.push_back(sb);
       if (su.boundary == "damping") {
         DampingLayer dl;
