@@ -20,6 +20,8 @@
 //     measured on each); --sizes: about how many particles (default 1e5, 1e6, 4e6; from 1e3 to
 //     1e8); --rounds: how many times each free and silent pair runs, alternating (default 1).
 //     Steps per rate: 200, 30 or 10 by size, times half the thread count from 4 threads on.
+//     After each size and thread count a line gives the silent edge's cost over the free one:
+//     from the best rates of the rounds, and the range of the rounds' own pairs.
 #include <omp.h>
 
 #include <algorithm>
@@ -185,16 +187,36 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < thread_counts.size(); ++k) {
       const int th = thread_counts[k];
       const int steps = base * std::max(1, th / 2);
+      // Each round's rates, free and silent, per shape: the silent edge's cost over the free one.
+      const std::size_t ns = shapes.size();
+      std::vector<double> free_rate(ns * rounds), silent_rate(ns * rounds);
       for (int round = 0; round < rounds; ++round)
         for (bool silent : {false, true})
-          for (ShapeKind shape : shapes) {
+          for (std::size_t si = 0; si < ns; ++si) {
+            const ShapeKind shape = shapes[si];
             const double r = rate(h, silent, th, steps, shape);
+            (silent ? silent_rate : free_rate)[round * ns + si] = r;
             const double gbs = r * per_update / 1e9;
             std::printf("%10zu %9s %8d %8d %14.3e %9s %8.0f %8.1f %8.0f%%\n", n,
                         silent ? "silent" : "free", th, steps, r, shape_name(shape), per_update,
                         gbs, 100 * gbs / triad[k]);
             std::fflush(stdout);
           }
+      for (std::size_t si = 0; si < ns; ++si) {
+        double best_free = 0, best_silent = 0, lo = 1e300, hi = -1e300;
+        for (int round = 0; round < rounds; ++round) {
+          const double f = free_rate[round * ns + si], sr = silent_rate[round * ns + si];
+          best_free = std::max(best_free, f);
+          best_silent = std::max(best_silent, sr);
+          lo = std::min(lo, f / sr - 1);
+          hi = std::max(hi, f / sr - 1);
+        }
+        std::printf("# %zu particles, %d thread%s, %s: the silent edge costs %.1f %% over the free "
+                    "one (best rates of %d round%s; %.1f to %.1f %% round by round)\n",
+                    n, th, th == 1 ? "" : "s", shape_name(shapes[si]),
+                    100 * (best_free / best_silent - 1), rounds, rounds == 1 ? "" : "s", 100 * lo,
+                    100 * hi);
+      }
     }
   }
   return 0;
