@@ -1207,7 +1207,7 @@ void Solver::grid_update() {
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024) reduction(max : vd2)
   for (long k = 0; k < nd; ++k) {  // each node its own: in parallel, the same values
     const long i = dnodes[k];
-    update_dashpot_node(i, delayed, gx, gy);
+    const int closure = update_dashpot_node(i, delayed, gx, gy);
     if (!track) continue;
     double* r = rec_all + kDn * k;
     r[kDnM] = m[i];
@@ -1221,29 +1221,19 @@ void Solver::grid_update() {
     r[kDnCxy] = grid.cxy[i];
     r[kDnCyy] = grid.cyy[i];
     r[kDnWeight] = consistent_weight_[i];
-    r[kDnFlags] = static_cast<double>((fix[i] & 3) | dashpot_solve_flags(i));
+    // Strained with v+: not in the solve.
+    const int skip = !updated_weight_.empty() && updated_weight_[i] > 0 ? kDnSkip : 0;
+    r[kDnFlags] = static_cast<double>((fix[i] & 3) | skip | closure);
     vd2 = std::max(vd2, ux[i] * ux[i] + uy[i] * uy[i]);  // the dashpots' updates
   }
   if (track) vmax2_ = std::max(vmax2_, vd2);
 }
 
-// How the dashpot solve takes dashpot node i (grid_update's record): kDnSkip, not at all
-// (strained with v+, or a delayed closure's node that kept the trapezoidal update or whose two
-// components the closure took, at a corner); kDnHeldX (Y): its x (y) component is the closure's,
-// held in the solve.
-int Solver::dashpot_solve_flags(long i) {
-  if (!updated_weight_.empty() && updated_weight_[i] > 0) return kDnSkip;
-  if (delay_rho_.empty() || !(delay_rho_[i] > 0)) return 0;
-  const double* rec = delay_record(i);
-  if (!rec || rec[kDelayAt] != static_cast<double>(steps)) return kDnSkip;
-  const bool on_x = delayed_axis(rec[kDelayCxx], rec[kDelayCyy]);
-  const bool on_y = delayed_axis(rec[kDelayCyy], rec[kDelayCxx]);
-  return on_x && on_y ? kDnSkip : on_x ? kDnHeldX : kDnHeldY;
-}
-
 // One dashpot node's updated velocity in grid_update: the delayed closure's, or the
-// trapezoidal update of its block.
-void Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
+// trapezoidal update of its block. Returns how the dashpot solve takes a delayed closure's node
+// (0 for any other): kDnSkip, not at all (the closure did not act, or took both components, at
+// a corner); kDnHeldX (Y): its x (y) component is the closure's, held in the solve.
+int Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
   const double floor = mass_floor_, DT = dt;
   const double* m = grid.m.data();
   const uint8_t* fix = grid.fix.data();
@@ -1300,12 +1290,14 @@ void Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
       rec[kDelayFy] = fry;
       rec[kDelayVx] = vdx;
       rec[kDelayVy] = vdy;
-      return;
+      return on_x && on_y ? kDnSkip : on_x ? kDnHeldX : kDnHeldY;
     }
   }
-  if (m[i] <= floor) return;
+  const int closure = delayed && delay_rho_[i] > 0 ? kDnSkip : 0;
+  if (m[i] <= floor) return closure;
   dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
                    fix[i], ux[i], uy[i]);
+  return closure;
 }
 
 // MUSL and USF, in particle terms (positions held, one field, FLIP): the nodal velocity is
@@ -1337,8 +1329,8 @@ void Solver::consistent_dashpots() {
   const long nnx = grid.nnx;
   // The nodes: a block from such a layer, heavy enough (the same choice on every copy of a
   // shared node: it reads only values summed over the halo, and whether a delayed closure acted,
-  // which every rank that holds the node decides from its ring of those values). A node whose mass is not its
-  // particles' is dropped and the choice made again (the same on every rank), once the zone
+  // which every rank that holds the node decides from its ring of those values). A node whose
+  // mass is not its particles' is dropped and the choice made again (the same on every rank), once the zone
   // was found this step: a node that a particle missing from an older zone left short asks for
   // a new one first.
   if (dn_rec_.size() != kDn * dashpot_nodes_.size())
@@ -1363,8 +1355,7 @@ void Solver::consistent_dashpots() {
       const long i = dashpot_nodes_[k];
       const double* r = dn_rec_.data() + kDn * k;
       if (r[kDnWeight] <= 0 || r[kDnM] <= floor) continue;
-      // strained with v+, or the delayed closure's own
-      if (static_cast<int>(r[kDnFlags]) & kDnSkip) continue;
+      if (static_cast<int>(r[kDnFlags]) & kDnSkip) continue;  // see grid_update
       const double cxx = r[kDnCxx], cxy = r[kDnCxy], cyy = r[kDnCyy];
       const double lmax =
           0.5 * (cxx + cyy) + std::sqrt(0.25 * (cxx - cyy) * (cxx - cyy) + cxy * cxy);
@@ -1586,20 +1577,20 @@ void Solver::consistent_dashpots() {
     double* n = cm_node_.data() + kCmNode * k;
     const double* c = cm_.data() + kCm * k;
     const int fi = static_cast<int>(r[kDnFlags]);  // a held component: fixed, or the closure's
-    const double mi = r[kDnM], fx = (fi & (1 | kDnHeldX)) ? 0.0 : 1.0,
-                 fy = (fi & (2 | kDnHeldY)) ? 0.0 : 1.0;
+    const double mi = r[kDnM], free_x = (fi & (1 | kDnHeldX)) ? 0.0 : 1.0,
+                 free_y = (fi & (2 | kDnHeldY)) ? 0.0 : 1.0;
     const double cxx = r[kDnCxx], cxy = r[kDnCxy], cyy = r[kDnCyy];
     const double kap = 0.5 * DT * c[2] / (mi * mi);
     const double A = 1 + kap * cxx, B = kap * cxy, D = 1 + kap * cyy;
     double pxx = 0, pxy = 0, pyy = 0;
-    if (fx != 0 && fy != 0) {
+    if (free_x != 0 && free_y != 0) {
       const double det = A * D - B * B;
       pxx = D / det;
       pxy = -B / det;
       pyy = A / det;
-    } else if (fy != 0) {
+    } else if (free_y != 0) {
       pyy = 1 / D;  // x held
-    } else if (fx != 0) {
+    } else if (free_x != 0) {
       pxx = 1 / A;  // y held
     }
     const double rx = r[kDnVx] + 0.5 * c[0] / mi, ry = r[kDnVy] + 0.5 * c[1] / mi;
@@ -1612,8 +1603,8 @@ void Solver::consistent_dashpots() {
     n[3] = q * pxy;
     n[4] = q * pyy;
     const double gs = DT / mi;
-    n[5] = fx * gs;
-    n[6] = fy * gs;
+    n[5] = free_x * gs;
+    n[6] = free_y * gs;
     n[7] = cxx;
     n[8] = cxy;
     n[9] = cyy;

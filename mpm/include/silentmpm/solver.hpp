@@ -303,7 +303,8 @@ class Solver {
   double vmax2_ = 0;                    // the step's fastest updated nodal velocity, squared
   // grid_update's record of each dashpot node for consistent_dashpots (kDn values per node, in
   // the order of dashpot_nodes_): m, f, v, v+, the block, the consistent weight, and the flags
-  // (the fix bits and dashpot_solve_flags: skipped, or the x or y component held).
+  // (the fix bits; kDnSkip: not in the solve; kDnHeldX, Y: that component held, see
+  // update_dashpot_node).
   enum : int { kDnM, kDnFx, kDnFy, kDnVx, kDnVy, kDnUx, kDnUy, kDnCxx, kDnCxy, kDnCyy, kDnWeight,
                kDnFlags, kDn };
   static constexpr int kDnSkip = 4, kDnHeldX = 8, kDnHeldY = 16;
@@ -421,8 +422,7 @@ class Solver {
   template <class S> void pml_pic();
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
-  void update_dashpot_node(long i, bool delayed, double gx, double gy);
-  int dashpot_solve_flags(long i);
+  int update_dashpot_node(long i, bool delayed, double gx, double gy);
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
