@@ -208,6 +208,7 @@ void Solver::finalize() {
   cm_slot_.assign(consistent ? grid.nodes() : 0, -1);
   cm_cover_.assign(consistent ? grid.nodes() : 0, 0);
   cm_covered_.clear();
+  cm_moving_.clear();
   cm_cell_.assign(consistent ? static_cast<std::size_t>(grid.nx) * grid.ny : 0, 0);
   cm_cells_.clear();
   cm_reach_.clear();
@@ -1174,9 +1175,8 @@ void Solver::grid_update() {
   // or Inf anywhere in the particles' mass, momentum or stress reaches the nodes' updated
   // velocities this step (x - x is 0 only for finite x).
   int bad = 0;
-  double v2 = 0;  // the fastest updated velocity (consistent_dashpots' drift)
   const bool track = !consistent_weight_.empty();
-#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad) reduction(max : v2)
+#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
   for (long i = 0; i < n; ++i) {
     const double mi = m[i];
     const bool heavy = mi > floor;
@@ -1188,10 +1188,8 @@ void Solver::grid_update() {
     ux[i] = (fix[i] & 1) ? 0.0 : vxi + DT * fx[i] / mi;
     uy[i] = (fix[i] & 2) ? 0.0 : vyi + DT * fy[i] / mi;
     bad |= !(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0);
-    if (track) v2 = std::max(v2, ux[i] * ux[i] + uy[i] * uy[i]);
   }
   if (bad) fail_nonfinite();
-  vmax2_ = v2;
   // For consistent_dashpots, each dashpot node's values in one record (kDn per node, in the
   // order of dashpot_nodes_): along an edge every node lies on its own cache lines of a dozen
   // grid-sized arrays, which the whole-grid pass above has evicted by now.
@@ -1203,8 +1201,7 @@ void Solver::grid_update() {
   const long* dnodes = dashpot_nodes_.data();
   const double gx = opt.gravity_x, gy = opt.gravity_y;
   double* rec_all = dn_rec_.data();
-  double vd2 = 0;
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024) reduction(max : vd2)
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
   for (long k = 0; k < nd; ++k) {  // each node its own: in parallel, the same values
     const long i = dnodes[k];
     const int closure = update_dashpot_node(i, delayed, gx, gy);
@@ -1224,9 +1221,7 @@ void Solver::grid_update() {
     // Strained with v+: not in the solve.
     const int skip = !updated_weight_.empty() && updated_weight_[i] > 0 ? kDnSkip : 0;
     r[kDnFlags] = static_cast<double>((fix[i] & 3) | skip | closure);
-    vd2 = std::max(vd2, ux[i] * ux[i] + uy[i] * uy[i]);  // the dashpots' updates
   }
-  if (track) vmax2_ = std::max(vmax2_, vd2);
 }
 
 // One dashpot node's updated velocity in grid_update: the delayed closure's, or the
@@ -1373,21 +1368,25 @@ void Solver::consistent_dashpots() {
     // pass over every particle when a listed node is not covered (a node along the edge enters
     // and leaves the list as the edge's points cross a grid line: its neighbours are covered),
     // the particles were re-ordered, or they may have drifted half a cell since (cm_drift_, the
-    // sum over the steps of dt times the fastest nodal velocity they moved with; a particle
-    // outside the zone was a cell away from a covered node's cells, less round-off), and every
+    // sum over the steps of dt times the fastest velocity of the nodes that move the zone's
+    // particles; a particle outside the zone was a cell away from a covered node's cells, less
+    // round-off, and crosses zone cells to reach them), and every
     // step when hooks may change that velocity (once).
     bool scan = rescan || (!hooks_.empty() && !scanned) || cm_scan_version_ != order_version_ ||
                 cm_scan_size_ != p.size() || !(cm_drift_ < 0.5 * grid.h);
-    for (std::size_t k = 0; k < cm_nodes_.size() && !scan; ++k) scan = !cm_cover_[cm_nodes_[k]];
+    for (std::size_t k = 0; k < cm_nodes_.size() && !scan; ++k)
+      scan = !(cm_cover_[cm_nodes_[k]] & 1);
     if (scan) {
       for (const long c : cm_cells_) cm_cell_[c] &= 2;
       cm_cells_.clear();
       for (const long i : cm_covered_) cm_cover_[i] = 0;
+      for (const long i : cm_moving_) cm_cover_[i] = 0;
       cm_covered_.clear();
+      cm_moving_.clear();
       for (const long i : cm_nodes_) {
         around(i, 1, 1, nnx, grid.nny, [&](long c) {
-          if (!cm_cover_[c]) {
-            cm_cover_[c] = 1;
+          if (!(cm_cover_[c] & 1)) {
+            cm_cover_[c] |= 1;
             cm_covered_.push_back(c);
           }
         });
@@ -1398,6 +1397,14 @@ void Solver::consistent_dashpots() {
           }
         });
       }
+      // The nodes that move the zone's particles (marked 2): those of its cells' supports.
+      for (const long c : cm_cells_)
+        around((c / ncx) * nnx + c % ncx, S::kRowsBelow, S::kRowsAbove, nnx, grid.nny, [&](long n) {
+          if (!(cm_cover_[n] & 2)) {
+            cm_cover_[n] |= 2;
+            cm_moving_.push_back(n);
+          }
+        });
       cm_zone_.clear();
       if (!cm_nodes_.empty()) {
         const std::size_t n = p.size();
@@ -1661,7 +1668,6 @@ void Solver::consistent_dashpots() {
     cm_[kCm * k + 4] = vb[2 * k];
     cm_[kCm * k + 5] = vb[2 * k + 1];
   }
-  double v2 = vmax2_;
   for (std::size_t k = 0; k < ns; ++k) {
     const long i = cm_nodes_[k];
     const double* c = cm_.data() + kCm * k;
@@ -1673,9 +1679,14 @@ void Solver::consistent_dashpots() {
     const double uy = (fi & kDnHeldY) ? r[kDnUy] : (fi & 2) ? 0.0 : r[kDnVy] + DT * fy / r[kDnM];
     grid.vnx[i] = ux;
     grid.vny[i] = uy;
-    v2 = std::max(v2, ux * ux + uy * uy);
   }
-  cm_drift_ += DT * std::sqrt(v2);  // this step's move, with the velocities as they now are
+  // This step's move of a zone particle, with the velocities as they now are: at most the
+  // fastest of the nodes that move them (a particle from outside crosses a cell of the zone
+  // before it reaches a listed node).
+  double v2 = 0;
+  for (const long i : cm_moving_)
+    v2 = std::max(v2, grid.vnx[i] * grid.vnx[i] + grid.vny[i] * grid.vny[i]);
+  cm_drift_ += DT * std::sqrt(v2);
 }
 
 // Work of tractions and energy absorbed by dashpots over the step. The forces act with the

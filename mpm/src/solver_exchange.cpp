@@ -54,6 +54,7 @@ void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool das
     cm_slot_.assign(grid.nodes(), -1);
     cm_cover_.assign(grid.nodes(), 0);
     cm_covered_.clear();
+    cm_moving_.clear();
     cm_cell_.assign(static_cast<std::size_t>(grid.nx) * grid.ny, 0);
     cm_nodes_.clear();
     cm_cells_.clear();

@@ -295,12 +295,13 @@ class Solver {
   std::vector<double> cm_;              // per slot: kCm values (see consistent_dashpots)
   std::vector<double> cm_halo_;         // several ranks: grid-sized arrays for the halo sums
   std::vector<std::uint32_t> cm_zone_;  // the particles of the zone around the nodes
-  std::vector<std::uint8_t> cm_cover_;  // per node: covered by the zone (see consistent_dashpots)
-  std::vector<long> cm_covered_;        // the nodes marked
+  std::vector<std::uint8_t> cm_cover_;  // per node: covered by the zone (1), moves its particles
+                                        // (2) (see consistent_dashpots)
+  std::vector<long> cm_covered_;        // the nodes marked 1
+  std::vector<long> cm_moving_;         // the nodes marked 2
   long cm_scan_version_ = -1;           // the particles' order and count when the zone was found
   std::size_t cm_scan_size_ = 0;
   double cm_drift_ = 0;                 // how far a particle may have moved since (m)
-  double vmax2_ = 0;                    // the step's fastest updated nodal velocity, squared
   // grid_update's record of each dashpot node for consistent_dashpots (kDn values per node, in
   // the order of dashpot_nodes_): m, f, v, v+, the block, the consistent weight, and the flags
   // (the fix bits; kDnSkip: not in the solve; kDnHeldX, Y: that component held, see
