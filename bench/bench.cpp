@@ -176,7 +176,9 @@ int main(int argc, char** argv) {
     const double h = 1e-4 * std::sqrt(1e6 / size);  // 1e6 particles at 0.1 mm
     auto probe = pulse_plate(h, false, 1);
     const std::size_t n = probe->p.size();
-    const std::size_t grid_bytes = probe->grid.nodes() * (14 * sizeof(double) + 1);
+    // Per node: 11 fields, the dashpot record (Grid::kDash), the flags and the dashpot index.
+    const std::size_t grid_bytes =
+        probe->grid.nodes() * ((11 + smpm::Grid::kDash) * sizeof(double) + 1 + sizeof(int));
     const double per_update = step_bytes(double(probe->grid.nodes()) / n);
     std::printf("# %zu particles, %zu grid nodes: %.0f bytes per particle including the grid, "
                 "%.0f MB in all\n", n, probe->grid.nodes(),

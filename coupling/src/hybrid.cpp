@@ -522,7 +522,7 @@ void Hybrid::after_grid_update(Solver& S) {
     const double cxx = fe_c_[3 * k], cxy = fe_c_[3 * k + 1], cyy = fe_c_[3 * k + 2];
     const double vx = g.vx[n], vy = g.vy[n];
     double a, b;
-    dashpot_velocity(g.m[n], cxx + g.cxx[n], cxy + g.cxy[n], cyy + g.cyy[n], vx, vy, g.fx[n],
+    dashpot_velocity(g.m[n], cxx + g.cxx(n), cxy + g.cxy(n), cyy + g.cyy(n), vx, vy, g.fx[n],
                      g.fy[n], dt, g.fix[n], a, b);
     g.vnx[n] = a;
     g.vny[n] = b;

@@ -203,7 +203,8 @@ void Solver::finalize() {
     consistent = consistent || (s.form == SilentForm::Nodal && !s.updated_velocity);
   consistent = consistent && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
                body_of_group_.empty();
-  consistent_weight_.assign(consistent ? grid.nodes() : 0, 0.0);
+  consistent_ = consistent;
+  for (std::size_t n = 0; n < grid.dash.size() / Grid::kDash; ++n) grid.dash_weight(n) = 0;
   cm_nodes_.clear();
   cm_slot_.assign(consistent ? grid.nodes() : 0, -1);
   cm_cover_.assign(consistent ? grid.nodes() : 0, 0);
@@ -727,7 +728,7 @@ void Solver::remapped_velocities(bool updated_edges) {
   if (dist_) {  // every field's re-mapped momenta
     std::vector<double*> q;
     for (const VelocityField& F : fields_) q.insert(q.end(), {F.f.qx, F.f.qy});
-    dist_->sum_halo(q.data(), static_cast<int>(q.size()));
+    dist_->sum_halo(q.data(), static_cast<int>(q.size()), nullptr);
   }
   call([&](StepHooks& h) { h.after_remap(*this); });
   for (const VelocityField& F : fields_)
@@ -877,8 +878,8 @@ void Solver::pml_loads() {
     for (int a = 0; a < K; ++a) {
       grid.fx[nodes[a]] += f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
       grid.fy[nodes[a]] += f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
-      grid.cxx[nodes[a]] += cm * N[a];
-      grid.cyy[nodes[a]] += cm * N[a];
+      grid.cxx(nodes[a]) += cm * N[a];
+      grid.cyy(nodes[a]) += cm * N[a];
       add_dashpot_node(nodes[a]);
     }
   }
@@ -1002,22 +1003,21 @@ void Solver::apply_loads() {
   }
   // Nodal dashpot blocks: clear the nodes assembled last step, then assemble
   // C_i += (V_p / h) N_i [a rho c_d n n^T + b rho c_s (I - n n^T)].
-  if (dashpot_mark_.size() != grid.nodes()) dashpot_mark_.assign(grid.nodes(), 0);
+  if (dashpot_index_.size() != grid.nodes()) dashpot_index_.assign(grid.nodes(), -1);
   {
     // One pass (in parallel): along an edge every node lies on its own cache lines.
     const long nd = static_cast<long>(dashpot_nodes_.size());
     const long* dn = dashpot_nodes_.data();
     double* uw = updated_weight_.empty() ? nullptr : updated_weight_.data();
     double* dr = delay_rho_.empty() ? nullptr : delay_rho_.data();
-    double* cw = consistent_weight_.empty() ? nullptr : consistent_weight_.data();
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
     for (long k = 0; k < nd; ++k) {
       const long i = dn[k];
-      grid.cxx[i] = grid.cxy[i] = grid.cyy[i] = 0;
-      dashpot_mark_[i] = 0;
+      double* c = grid.dash.data() + Grid::kDash * i;  // the block and the weight
+      c[0] = c[1] = c[2] = c[3] = 0;
+      grid.fix[i] &= static_cast<uint8_t>(~Grid::kDashpotNode);
       if (uw) uw[i] = 0;
       if (dr) dr[i] = 0;
-      if (cw) cw[i] = 0;
     }
   }
   dashpot_nodes_.clear();
@@ -1050,7 +1050,7 @@ void Solver::apply_loads() {
     }
     const bool updated = !updated_weight_.empty() && sl.updated_velocity;
     const bool delayed = !delay_rho_.empty() && sl.delayed;
-    const bool consistent = !consistent_weight_.empty() && !sl.updated_velocity;
+    const bool consistent = consistent_ && !sl.updated_velocity;
     for (long q = 0; q < n; ++q) {
       const long* nodes = sl.nodes.data() + K * q;
       const double* N = sl.N.data() + K * q;
@@ -1072,9 +1072,9 @@ void Solver::apply_loads() {
       lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], bxx, bxy, byy);
       for (int a = 0; a < K; ++a) {
         const double wn = L.w[q] * N[a];
-        grid.cxx[nodes[a]] += wn * bxx;
-        grid.cxy[nodes[a]] += wn * bxy;
-        grid.cyy[nodes[a]] += wn * byy;
+        grid.cxx(nodes[a]) += wn * bxx;
+        grid.cxy(nodes[a]) += wn * bxy;
+        grid.cyy(nodes[a]) += wn * byy;
         add_dashpot_node(nodes[a]);
       }
       if (updated) {  // (w N rho) c_d
@@ -1087,7 +1087,7 @@ void Solver::apply_loads() {
       }
       if (consistent) {
         const Material& mq = materials[p.group[L.idx[q]]];
-        for (int a = 0; a < K; ++a) consistent_weight_[nodes[a]] += L.w[q] * N[a] * mq.rho * mq.cd;
+        for (int a = 0; a < K; ++a) grid.dash_weight(nodes[a]) += L.w[q] * N[a] * mq.rho * mq.cd;
       }
     }
   }
@@ -1103,8 +1103,8 @@ void Solver::apply_loads() {
       has_nodal_dashpot_ = true;
       const double c = dl.alpha[q] * p.mass[L.idx[q]];
       for (int a = 0; a < K; ++a) {
-        grid.cxx[dn[a]] += c * N[a];
-        grid.cyy[dn[a]] += c * N[a];
+        grid.cxx(dn[a]) += c * N[a];
+        grid.cyy(dn[a]) += c * N[a];
         add_dashpot_node(dn[a]);
       }
     }
@@ -1160,7 +1160,7 @@ void Solver::apply_loads() {
 
 // v+ = v + dt f / m on every node; then, on the few nodes that carry a dashpot block C,
 // (m + dt/2 C) v+ = (m - dt/2 C) v + dt f  (trapezoidal, unconditionally stable for C).
-// The second loop touches only the boundary nodes, so the silent layer costs O(boundary).
+// The dashpot nodes are updated again in the same pass, so the silent layer costs O(boundary).
 void Solver::grid_update() {
   const long n = static_cast<long>(grid.nodes());
   const double floor = mass_floor_, DT = dt;
@@ -1170,43 +1170,47 @@ void Solver::grid_update() {
   double* vx = grid.vx.data(); double* vy = grid.vy.data();
   const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
   double* ux = grid.vnx.data(); double* uy = grid.vny.data();
-  // One pass: the start velocity p / m (as kernels::nodal_velocity computes it) and the updated
-  // one, without reading the nodes' mass and flags twice. Health check at no extra pass: a NaN
-  // or Inf anywhere in the particles' mass, momentum or stress reaches the nodes' updated
-  // velocities this step (x - x is 0 only for finite x).
-  int bad = 0;
-  const bool track = !consistent_weight_.empty();
-#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
-  for (long i = 0; i < n; ++i) {
+  // The start velocity p / m (as kernels::nodal_velocity computes it) and the updated one,
+  // without reading the nodes' mass and flags twice. Health check at no extra pass: a NaN or
+  // Inf anywhere in the particles' mass, momentum or stress reaches the nodes' updated
+  // velocities this step (x - x is 0 only for finite x); 1 if not finite.
+  auto update = [&](long i) {
     const double mi = m[i];
     const bool heavy = mi > floor;
     const double vxi = heavy && !(fix[i] & 1) ? px[i] / mi : 0.0;
     const double vyi = heavy && !(fix[i] & 2) ? py[i] / mi : 0.0;
     vx[i] = vxi;
     vy[i] = vyi;
-    if (mi <= floor) { ux[i] = 0; uy[i] = 0; continue; }
+    if (mi <= floor) {  // not !heavy: a NaN mass goes on to the check
+      ux[i] = 0;
+      uy[i] = 0;
+      return 0;
+    }
     ux[i] = (fix[i] & 1) ? 0.0 : vxi + DT * fx[i] / mi;
     uy[i] = (fix[i] & 2) ? 0.0 : vyi + DT * fy[i] / mi;
-    bad |= !(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0);
+    return static_cast<int>(!(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0));
+  };
+  int bad = 0;
+  if (!has_nodal_dashpot_) {
+#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
+    for (long i = 0; i < n; ++i) bad |= update(i);
+    if (bad) fail_nonfinite();
+    return;
   }
-  if (bad) fail_nonfinite();
-  // For consistent_dashpots, each dashpot node's values in one record (kDn per node, in the
-  // order of dashpot_nodes_): along an edge every node lies on its own cache lines of a dozen
-  // grid-sized arrays, which the whole-grid pass above has evicted by now.
+  // A dashpot node (grid.fix's kDashpotNode) is updated again right after, while its values
+  // are in cache (each node its own: in parallel, the same values). For consistent_dashpots,
+  // each one's values go into one record (kDn per node, in the order of dashpot_nodes_): along
+  // an edge every node lies on its own cache lines of a dozen grid-sized arrays.
+  const bool track = consistent_;
   if (track) dn_rec_.resize(kDn * dashpot_nodes_.size());
-  if (!has_nodal_dashpot_) return;
   const bool delayed = !delay_rho_.empty();
   if (delayed) delay_prepare();
-  const long nd = static_cast<long>(dashpot_nodes_.size());
-  const long* dnodes = dashpot_nodes_.data();
   const double gx = opt.gravity_x, gy = opt.gravity_y;
   double* rec_all = dn_rec_.data();
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
-  for (long k = 0; k < nd; ++k) {  // each node its own: in parallel, the same values
-    const long i = dnodes[k];
+  auto dashpot = [&](long i) {
     const int closure = update_dashpot_node(i, delayed, gx, gy);
-    if (!track) continue;
-    double* r = rec_all + kDn * k;
+    if (!track) return;
+    double* r = rec_all + kDn * dashpot_index_[i];
     r[kDnM] = m[i];
     r[kDnFx] = fx[i];
     r[kDnFy] = fy[i];
@@ -1214,14 +1218,21 @@ void Solver::grid_update() {
     r[kDnVy] = vy[i];
     r[kDnUx] = ux[i];
     r[kDnUy] = uy[i];
-    r[kDnCxx] = grid.cxx[i];
-    r[kDnCxy] = grid.cxy[i];
-    r[kDnCyy] = grid.cyy[i];
-    r[kDnWeight] = consistent_weight_[i];
+    const double* c = grid.dash.data() + Grid::kDash * i;
+    r[kDnCxx] = c[0];
+    r[kDnCxy] = c[1];
+    r[kDnCyy] = c[2];
+    r[kDnWeight] = c[3];
     // Strained with v+: not in the solve.
     const int skip = !updated_weight_.empty() && updated_weight_[i] > 0 ? kDnSkip : 0;
     r[kDnFlags] = static_cast<double>((fix[i] & 3) | skip | closure);
+  };
+#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
+  for (long i = 0; i < n; ++i) {
+    bad |= update(i);
+    if (fix[i] & Grid::kDashpotNode) dashpot(i);
   }
+  if (bad) fail_nonfinite();
 }
 
 // One dashpot node's updated velocity in grid_update: the delayed closure's, or the
@@ -1256,7 +1267,7 @@ int Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
     ring[1] = vy[i];
     ring[2] = frx;
     ring[3] = fry;
-    const double cxx = grid.cxx[i], cyy = grid.cyy[i];
+    const double cxx = grid.cxx(i), cyy = grid.cyy(i);
     rec[kDelayCxx] = cxx;
     rec[kDelayCyy] = cyy;
     rec[kDelayRho] = delay_rho_[i];
@@ -1270,7 +1281,7 @@ int Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
     const double reach = std::max(on_x ? dx : 0.0, on_y ? dy : 0.0);
     const double history = static_cast<double>(steps) - rec[kDelayRunFrom];  // entries before
     const double half = 0.5 * rec[kDelayRho] * grid.h;  // an edge node's mass on its line
-    if (m[i] > floor && grid.cxy[i] == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
+    if (m[i] > floor && grid.cxy(i) == 0 && 0.5 * DT * std::max(cxx, cyy) <= m[i] && blocks &&
         std::abs(m[i] - half) <= kDelayMassTolerance * half && std::floor(reach) + 1 <= history) {
       const double vdx = on_x ? delay_value(rec, 0, dx, 0) : 0.0;
       const double vdy = on_y ? delay_value(rec, 1, dy, 0) : 0.0;
@@ -1290,7 +1301,7 @@ int Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
   }
   const int closure = delayed && delay_rho_[i] > 0 ? kDnSkip : 0;
   if (m[i] <= floor) return closure;
-  dashpot_velocity(m[i], grid.cxx[i], grid.cxy[i], grid.cyy[i], vx[i], vy[i], fx[i], fy[i], DT,
+  dashpot_velocity(m[i], grid.cxx(i), grid.cxy(i), grid.cyy(i), vx[i], vy[i], fx[i], fy[i], DT,
                    fix[i], ux[i], uy[i]);
   return closure;
 }
@@ -1797,14 +1808,14 @@ void Solver::boundary_work(bool remapped) {
         vbar(i, ax, ay);
         w += delayed_axis(rec[kDelayCxx], rec[kDelayCyy])
                  ? 0.5 * (fx + cx) * bx + fx * rec[kDelayDgx]
-                 : grid.cxx[i] * ax * bx;
+                 : grid.cxx(i) * ax * bx;
         w += delayed_axis(rec[kDelayCyy], rec[kDelayCxx])
                  ? 0.5 * (fy + cy) * by + fy * rec[kDelayDgy]
-                 : grid.cyy[i] * ay * by;
+                 : grid.cyy(i) * ay * by;
         continue;
       }
       vbar(i, ax, ay);
-      w += (grid.cxx[i] * ax + grid.cxy[i] * ay) * bx + (grid.cxy[i] * ax + grid.cyy[i] * ay) * by;
+      w += (grid.cxx(i) * ax + grid.cxy(i) * ay) * bx + (grid.cxy(i) * ax + grid.cyy(i) * ay) * by;
     }
     energy.absorbed += dt * w;
   }
@@ -2059,7 +2070,7 @@ void Solver::project(NodalProjection& o) const {
   if (dist_) {  // the shared nodes' sums over the ranks, before the division
     double* f[7] = {o.mass.data(), o.vx.data(), o.vy.data(), o.sxx.data(),
                     o.syy.data(),  o.szz.data(), o.sxy.data()};
-    dist_->sum_halo(f, 7);
+    dist_->sum_halo(f, 7, nullptr);
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (!(o.mass[i] > 0)) {
@@ -2107,7 +2118,7 @@ void Solver::step_with() {
   apply_loads<S>();
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
-  if (!consistent_weight_.empty()) consistent_dashpots<S>();
+  if (consistent_) consistent_dashpots<S>();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
   bool remapped_power = sc == Scheme::MUSL || (sc == Scheme::USF && usf_remapped_power());
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });

@@ -48,9 +48,9 @@ void Solver::set_decomposition(Decomposition* d, NodeBox own, int halo, bool das
   halo_ = halo;
   halo_dashpots_ = dashpots;
   dashpot_nodes_.clear();
-  dashpot_mark_.assign(grid.nodes(), 0);
-  if (!consistent_weight_.empty()) {  // the window's nodes and cells
-    consistent_weight_.assign(grid.nodes(), 0.0);
+  dashpot_index_.assign(grid.nodes(), -1);
+  for (auto& f : grid.fix) f &= static_cast<uint8_t>(~Grid::kDashpotNode);
+  if (consistent_) {  // the window's nodes and cells
     cm_slot_.assign(grid.nodes(), -1);
     cm_cover_.assign(grid.nodes(), 0);
     cm_covered_.clear();
@@ -95,16 +95,20 @@ static void for_shared_nodes(const Grid& g, const NodeBox& own, long w, Fn&& fn)
 // others.
 void Solver::sum_halo(bool momentum, bool force) {
   std::vector<double*> f;
+  std::vector<int> stride;  // 1 but for the dashpot blocks and weights
   const bool usf = opt.scheme == Scheme::USF;
   if (momentum)
     for (auto* v : {&grid.m, &grid.px, &grid.py}) f.push_back(v->data());
   if (force) {
     for (auto* v : {&grid.fx, &grid.fy}) f.push_back(v->data());
     if (halo_dashpots_) {
-      for (auto* v : {&grid.cxx, &grid.cxy, &grid.cyy}) f.push_back(v->data());
       if (!updated_weight_.empty()) f.push_back(updated_weight_.data());
-      if (!consistent_weight_.empty()) f.push_back(consistent_weight_.data());
       if (!delay_rho_.empty()) f.push_back(delay_rho_.data());
+      stride.assign(f.size(), 1);
+      for (int c = 0; c < (consistent_ ? 4 : 3); ++c) {  // the block, the solve's weight
+        f.push_back(grid.dash.data() + c);
+        stride.push_back(Grid::kDash);
+      }
     }
   }
   const bool bodies = !body_of_group_.empty();
@@ -114,7 +118,8 @@ void Solver::sum_halo(bool momentum, bool force) {
       if (momentum) f.insert(f.end(), {b.m, b.px, b.py, b.gx, b.gy, b.xm, b.ym, b.sm});
       if ((momentum && !usf) || (force && usf)) f.insert(f.end(), {b.fx, b.fy});
     }
-  dist_->sum_halo(f.data(), static_cast<int>(f.size()));
+  stride.resize(f.size(), 1);
+  dist_->sum_halo(f.data(), static_cast<int>(f.size()), stride.data());
   if (bodies && momentum)
     for (VelocityField& F : fields_)
       for_shared_nodes(grid, own_, halo_, [&](long i, long j) {
@@ -124,10 +129,10 @@ void Solver::sum_halo(bool momentum, bool force) {
              std::max<int>(x[3], j)};
       });
   if (!force || !halo_dashpots_) return;
-  if (dashpot_mark_.size() != grid.nodes()) dashpot_mark_.assign(grid.nodes(), 0);
+  if (dashpot_index_.size() != grid.nodes()) dashpot_index_.assign(grid.nodes(), -1);
   for_shared_nodes(grid, own_, halo_, [&](long i, long j) {
     const long n = j * grid.nnx + i;
-    if (grid.cxx[n] != 0 || grid.cxy[n] != 0 || grid.cyy[n] != 0) {
+    if (grid.cxx(n) != 0 || grid.cxy(n) != 0 || grid.cyy(n) != 0) {
       add_dashpot_node(n);
       has_nodal_dashpot_ = true;
     }
@@ -146,7 +151,7 @@ void Solver::cm_sum(int first, int count) {
   for (int c = 0; c < count; ++c) f[c] = cm_halo_.data() + nn * c;
   for (std::size_t k = 0; k < cm_nodes_.size(); ++k)
     for (int c = 0; c < count; ++c) f[c][cm_nodes_[k]] = cm_[kCm * k + first + c];
-  dist_->sum_halo(f.data(), count);
+  dist_->sum_halo(f.data(), count, nullptr);
   for (std::size_t k = 0; k < cm_nodes_.size(); ++k)
     for (int c = 0; c < count; ++c) {
       cm_[kCm * k + first + c] = f[c][cm_nodes_[k]];

@@ -162,7 +162,7 @@ std::vector<std::string> Solver::particle_blocks(const std::string& pre) {
 // The counts of the dashpots' solve (dashpot_solve), the same on every rank: a restarted run's
 // summary counts the whole run.
 void Solver::put_dashpot_solve(StateWriter& w, const std::string& pre) const {
-  if (consistent_weight_.empty()) return;
+  if (!consistent_) return;
   const auto& d = dashpot_solve;
   w.put(pre + "dashpot_solve",
         std::vector<std::int64_t>{d.steps, d.iterations, d.max_iterations, d.unconverged, d.rescans});
@@ -178,7 +178,7 @@ void Solver::load_clock(const StateReader& r, const std::string& pre) {
   energy = r.get<Energies>(pre + "energy");
   contact.dissipated = r.get<double>(pre + "contact_dissipated");
   dashpot_solve = {};
-  if (!consistent_weight_.empty() && r.has(pre + "dashpot_solve")) {
+  if (consistent_ && r.has(pre + "dashpot_solve")) {
     std::vector<std::int64_t> d;
     r.get(pre + "dashpot_solve", d, 5);
     dashpot_solve = {d[0], d[1], d[2], d[3], d[4]};

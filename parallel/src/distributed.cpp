@@ -360,7 +360,7 @@ long Distributed::received() const { return d_->received; }
 
 // Ghost nodes' partial sums go to their owners and are added there (the owner's value first);
 // the sums come back to every copy.
-void Distributed::sum_halo(double* const* fields, int nf) {
+void Distributed::sum_halo(double* const* fields, int nf, const int* strides) {
   Impl& d = *d_;
   if (d.size == 1 || nf == 0) return;
   const double t0 = MPI_Wtime();
@@ -370,10 +370,11 @@ void Distributed::sum_halo(double* const* fields, int nf) {
   d.root.resize(nr * nf);
   for (int f = 0; f < nf; ++f) {
     const double* v = fields[f];
+    const std::size_t st = strides ? static_cast<std::size_t>(strides[f]) : 1;
     double* lb = d.leaf.data() + f * nl;
     double* rb = d.root.data() + f * nr;
-    for (std::size_t q = 0; q < nl; ++q) lb[q] = v[d.leaves[q]];
-    for (std::size_t q = 0; q < nr; ++q) rb[q] = v[d.roots[q]];
+    for (std::size_t q = 0; q < nl; ++q) lb[q] = v[st * d.leaves[q]];
+    for (std::size_t q = 0; q < nr; ++q) rb[q] = v[st * d.roots[q]];
   }
   check(PetscSFReduceBegin(sf, MPI_DOUBLE, d.leaf.data(), d.root.data(), MPI_SUM), "PetscSFReduce");
   check(PetscSFReduceEnd(sf, MPI_DOUBLE, d.leaf.data(), d.root.data(), MPI_SUM), "PetscSFReduce");
@@ -381,10 +382,11 @@ void Distributed::sum_halo(double* const* fields, int nf) {
   check(PetscSFBcastEnd(sf, MPI_DOUBLE, d.root.data(), d.leaf.data(), MPI_REPLACE), "PetscSFBcast");
   for (int f = 0; f < nf; ++f) {
     double* v = fields[f];
+    const std::size_t st = strides ? static_cast<std::size_t>(strides[f]) : 1;
     const double* lb = d.leaf.data() + f * nl;
     const double* rb = d.root.data() + f * nr;
-    for (std::size_t q = 0; q < nr; ++q) v[d.roots[q]] = rb[q];
-    for (std::size_t q = 0; q < nl; ++q) v[d.leaves[q]] = lb[q];
+    for (std::size_t q = 0; q < nr; ++q) v[st * d.roots[q]] = rb[q];
+    for (std::size_t q = 0; q < nl; ++q) v[st * d.leaves[q]] = lb[q];
   }
   d.t.halo_seconds += MPI_Wtime() - t0;
   d.t.halo_bytes += static_cast<double>((nl + nr) * nf * sizeof(double));  // leaves out, roots back

@@ -22,8 +22,9 @@ class Decomposition {
   virtual int rank() const = 0;
   virtual int size() const = 0;
   virtual int across() const = 0;  // ranks across x (the blocks' layout)
-  // Sums the halo of the n grid arrays (each grid.nodes() long) over the ranks sharing nodes.
-  virtual void sum_halo(double* const* fields, int n) = 0;
+  // Sums the halo of the n grid arrays over the ranks sharing nodes: node i's value of field f
+  // at fields[f][i * strides[f]] (strides null: every stride 1).
+  virtual void sum_halo(double* const* fields, int n, const int* strides) = 0;
   // Moves the particles outside this rank's cells (with their boundary-layer entries) to
   // their owners; returns whether any particle left or arrived here.
   virtual bool migrate(Solver& s) = 0;

@@ -1,10 +1,31 @@
 #pragma once
 // Dense uniform background grid of square cells. Nodal fields are plain arrays indexed
 // n = j * nnx + i. The grid is reset every step (paper §3: the mesh may be discarded).
+#include <cstddef>
 #include <cstdint>
+#include <new>
 #include <vector>
 
 namespace smpm {
+
+// Storage on A-byte boundaries (a record of A bytes then lies on one cache line).
+template <class T, std::size_t A>
+struct AlignedAllocator {
+  using value_type = T;
+  template <class U>
+  struct rebind { using other = AlignedAllocator<U, A>; };
+  AlignedAllocator() = default;
+  template <class U>
+  AlignedAllocator(const AlignedAllocator<U, A>&) {}
+  T* allocate(std::size_t n) {
+    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(A)));
+  }
+  void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(A)); }
+  template <class U>
+  bool operator==(const AlignedAllocator<U, A>&) const { return true; }
+  template <class U>
+  bool operator!=(const AlignedAllocator<U, A>&) const { return false; }
+};
 
 struct Grid {
   double x0 = 0, y0 = 0;  // origin (lower-left node)
@@ -19,10 +40,24 @@ struct Grid {
   std::vector<double> vx, vy;   // velocity at the start of the step (p / m)
   std::vector<double> vnx, vny; // updated velocity
   std::vector<double> qx, qy;   // MUSL: momentum re-mapped from the updated particle velocities
-  // Semi-implicit nodal dashpot block C (symmetric 2x2), assembled from the silent layer.
-  std::vector<double> cxx, cxy, cyy;
-  // Essential conditions: bit 0 fixes the x velocity, bit 1 fixes y.
+  // Semi-implicit nodal dashpot block C (symmetric 2x2), assembled from the boundary layers,
+  // and the silent layers' weight w N rho c_d at the node (the dashpot solve's): kDash values
+  // per node together, on one cache line (along an edge each node lies on its own lines of the
+  // other fields).
+  static constexpr int kDash = 4;
+  std::vector<double, AlignedAllocator<double, 32>> dash;
+  double& cxx(std::size_t n) { return dash[kDash * n]; }
+  double& cxy(std::size_t n) { return dash[kDash * n + 1]; }
+  double& cyy(std::size_t n) { return dash[kDash * n + 2]; }
+  double& dash_weight(std::size_t n) { return dash[kDash * n + 3]; }
+  double cxx(std::size_t n) const { return dash[kDash * n]; }
+  double cxy(std::size_t n) const { return dash[kDash * n + 1]; }
+  double cyy(std::size_t n) const { return dash[kDash * n + 2]; }
+  double dash_weight(std::size_t n) const { return dash[kDash * n + 3]; }
+  // Essential conditions: bit 0 fixes the x velocity, bit 1 fixes y. Bit 2 (kDashpotNode) is
+  // the solver's: the node carries a dashpot block this step.
   std::vector<uint8_t> fix;
+  static constexpr uint8_t kDashpotNode = 4;
 
   // The geometry and the constraint flags; the nodal fields too unless `fields` is false (a grid
   // that only describes the whole one to a split over ranks, whose windows hold the fields).

@@ -252,13 +252,14 @@ class Solver {
   int stencil_rows_ = 1;  // a particle in cell row r writes node rows [r - b, r + stencil_rows_ - b]
   bool has_nodal_dashpot_ = false;
   // The nodes holding a dashpot block this step, each once (in the order they were first
-  // assembled; the blocks' update is per node, so the order does not matter), and a flag per
-  // grid node saying it is listed.
+  // assembled; the blocks' update is per node, so the order does not matter), each marked in
+  // grid.fix (Grid::kDashpotNode) with its index in the list.
   std::vector<long> dashpot_nodes_;
-  std::vector<std::uint8_t> dashpot_mark_;
+  std::vector<int> dashpot_index_;
   void add_dashpot_node(long i) {
-    if (dashpot_mark_[i]) return;
-    dashpot_mark_[i] = 1;
+    if (grid.fix[i] & Grid::kDashpotNode) return;
+    grid.fix[i] |= Grid::kDashpotNode;
+    dashpot_index_[i] = static_cast<int>(dashpot_nodes_.size());
     dashpot_nodes_.push_back(i);
   }
   // MUSL or USF, one velocity field: per grid node, the full LK impedance (rho c_d times the
@@ -269,11 +270,11 @@ class Solver {
   // MUSL and USF, one velocity field: the dashpot blocks of the silent layers with the default
   // edge velocity (and the tangential component of the delayed closure's) act on the mean of the
   // velocities the particles map to the node at the start and at the end of the step
-  // (consistent_dashpots; docs/physics.md section 4). Per grid node,
-  // the weight (w N rho c_d) those layers put on it this step, summed over the halo with the
-  // blocks (empty when the scheme or the layers do not take it); the nodes solved so this step,
-  // the particles whose shape functions reach them, and per node its slot (-1: none).
-  std::vector<double> consistent_weight_;
+  // (consistent_dashpots; docs/physics.md section 4): whether the scheme and the layers take it
+  // (the weight w N rho c_d those layers put on a node is in grid.dash, summed over the halo
+  // with the blocks); the nodes solved so this step, the particles whose shape functions reach
+  // them, and per node its slot (-1: none).
+  bool consistent_ = false;
   std::vector<long> cm_nodes_;
   std::vector<long> cm_dk_;             // per slot: its node's place in dashpot_nodes_
   std::vector<int> cm_slot_;

@@ -37,7 +37,7 @@ class Distributed final : public Decomposition {
 
   int rank() const override;
   int size() const override;
-  void sum_halo(double* const* fields, int n) override;
+  void sum_halo(double* const* fields, int n, const int* strides) override;
   bool migrate(Solver& s) override;
   void sum(double* v, int n) override;
   void max(double* v, int n) override;
