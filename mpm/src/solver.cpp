@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -1161,39 +1162,66 @@ void Solver::apply_loads() {
 // v+ = v + dt f / m on every node; then, on the few nodes that carry a dashpot block C,
 // (m + dt/2 C) v+ = (m - dt/2 C) v + dt f  (trapezoidal, unconditionally stable for C).
 // The dashpot nodes are updated again in the same pass, so the silent layer costs O(boundary).
+namespace {
+// This thread's share [i0, i1) of [0, n), as schedule(static) splits it.
+void omp_range(long n, long& i0, long& i1) {
+  const long t = omp_get_thread_num(), nt = omp_get_num_threads();
+  const long q = n / nt, r = n % nt;
+  i0 = t * q + std::min(t, r);
+  i1 = i0 + q + (t < r ? 1 : 0);
+}
+
+// grid_update's pass over nodes [i0, i1): the start velocity p / m (as kernels::nodal_velocity
+// computes it) and the updated one, without reading the nodes' mass and flags twice. Health
+// check at no extra pass: a NaN or Inf anywhere in the particles' mass, momentum or stress
+// reaches the nodes' updated velocities this step (x - x is 0 only for finite x). Returns 1 if
+// one is not finite. Called with its own copy per thread, so its pointers stay in registers.
+struct NodeUpdate {
+  const double *m, *px, *py, *fx, *fy;
+  const uint8_t* fix;
+  double *vx, *vy, *ux, *uy;
+  double floor, dt;
+  int run(long i0, long i1) const {
+    int bad = 0;
+    for (long i = i0; i < i1; ++i) {
+      const double mi = m[i];
+      const bool heavy = mi > floor;
+      const double vxi = heavy && !(fix[i] & 1) ? px[i] / mi : 0.0;
+      const double vyi = heavy && !(fix[i] & 2) ? py[i] / mi : 0.0;
+      vx[i] = vxi;
+      vy[i] = vyi;
+      if (mi <= floor) {  // not !heavy: a NaN mass goes on to the check
+        ux[i] = 0;
+        uy[i] = 0;
+        continue;
+      }
+      ux[i] = (fix[i] & 1) ? 0.0 : vxi + dt * fx[i] / mi;
+      uy[i] = (fix[i] & 2) ? 0.0 : vyi + dt * fy[i] / mi;
+      bad |= !(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0);
+    }
+    return bad;
+  }
+};
+}  // namespace
+
 void Solver::grid_update() {
   const long n = static_cast<long>(grid.nodes());
-  const double floor = mass_floor_, DT = dt;
   const double* m = grid.m.data();
   const uint8_t* fix = grid.fix.data();
-  const double* px = grid.px.data(); const double* py = grid.py.data();
-  double* vx = grid.vx.data(); double* vy = grid.vy.data();
+  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
   const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
-  double* ux = grid.vnx.data(); double* uy = grid.vny.data();
-  // The start velocity p / m (as kernels::nodal_velocity computes it) and the updated one,
-  // without reading the nodes' mass and flags twice. Health check at no extra pass: a NaN or
-  // Inf anywhere in the particles' mass, momentum or stress reaches the nodes' updated
-  // velocities this step (x - x is 0 only for finite x); 1 if not finite.
-  auto update = [&](long i) {
-    const double mi = m[i];
-    const bool heavy = mi > floor;
-    const double vxi = heavy && !(fix[i] & 1) ? px[i] / mi : 0.0;
-    const double vyi = heavy && !(fix[i] & 2) ? py[i] / mi : 0.0;
-    vx[i] = vxi;
-    vy[i] = vyi;
-    if (mi <= floor) {  // not !heavy: a NaN mass goes on to the check
-      ux[i] = 0;
-      uy[i] = 0;
-      return 0;
-    }
-    ux[i] = (fix[i] & 1) ? 0.0 : vxi + DT * fx[i] / mi;
-    uy[i] = (fix[i] & 2) ? 0.0 : vyi + DT * fy[i] / mi;
-    return static_cast<int>(!(ux[i] - ux[i] == 0 && uy[i] - uy[i] == 0));
-  };
+  const double* ux = grid.vnx.data(); const double* uy = grid.vny.data();
+  const NodeUpdate nodes{m, grid.px.data(), grid.py.data(), fx, fy, fix, grid.vx.data(),
+                         grid.vy.data(), grid.vnx.data(), grid.vny.data(), mass_floor_, dt};
   int bad = 0;
   if (!has_nodal_dashpot_) {
-#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
-    for (long i = 0; i < n; ++i) bad |= update(i);
+#pragma omp parallel num_threads(nthreads_) reduction(| : bad)
+    {
+      const NodeUpdate u = nodes;
+      long i0, i1;
+      omp_range(n, i0, i1);
+      bad |= u.run(i0, i1);
+    }
     if (bad) fail_nonfinite();
     return;
   }
@@ -1227,10 +1255,29 @@ void Solver::grid_update() {
     const int skip = !updated_weight_.empty() && updated_weight_[i] > 0 ? kDnSkip : 0;
     r[kDnFlags] = static_cast<double>((fix[i] & 3) | skip | closure);
   };
-#pragma omp parallel for schedule(static) num_threads(nthreads_) reduction(| : bad)
-  for (long i = 0; i < n; ++i) {
-    bad |= update(i);
-    if (fix[i] & Grid::kDashpotNode) dashpot(i);
+  // In blocks of nodes that stay in the L1 cache: the plain update of a block, then its
+  // dashpot nodes.
+  constexpr long kBlock = 256;
+#pragma omp parallel num_threads(nthreads_) reduction(| : bad)
+  {
+    const NodeUpdate u = nodes;
+    long i0, i1;
+    omp_range(n, i0, i1);
+    for (long b0 = i0; b0 < i1; b0 += kBlock) {
+      const long b1 = std::min(i1, b0 + kBlock);
+      bad |= u.run(b0, b1);
+      // The flags eight at a time: a block holds one or two dashpot nodes.
+      long i = b0;
+      for (; i + 8 <= b1; i += 8) {
+        std::uint64_t w;
+        std::memcpy(&w, u.fix + i, 8);
+        if (!(w & (0x0101010101010101ull * Grid::kDashpotNode))) continue;
+        for (long j = i; j < i + 8; ++j)
+          if (u.fix[j] & Grid::kDashpotNode) dashpot(j);
+      }
+      for (; i < b1; ++i)
+        if (u.fix[i] & Grid::kDashpotNode) dashpot(i);
+    }
   }
   if (bad) fail_nonfinite();
 }
