@@ -1722,13 +1722,14 @@ void Solver::consistent_dashpots() {
     dashpot_solve.iterations += it + 1;
     dashpot_solve.max_iterations = std::max(dashpot_solve.max_iterations, static_cast<long>(it + 1));
   }
-  for (std::size_t k = 0; k < ns; ++k) {
-    cm_[kCm * k + 4] = vb[2 * k];
-    cm_[kCm * k + 5] = vb[2 * k + 1];
-  }
-  for (std::size_t k = 0; k < ns; ++k) {
+  // Each slot its own: in parallel, the same values.
+  const long nsl = static_cast<long>(ns);
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nsl >= 1024)
+  for (long k = 0; k < nsl; ++k) {
     const long i = cm_nodes_[k];
-    const double* c = cm_.data() + kCm * k;
+    double* c = cm_.data() + kCm * k;
+    c[4] = vb[2 * k];
+    c[5] = vb[2 * k + 1];
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
     const int fi = static_cast<int>(r[kDnFlags]);
     const double fx = r[kDnFx] - r[kDnCxx] * c[4] - r[kDnCxy] * c[5];
@@ -1742,8 +1743,11 @@ void Solver::consistent_dashpots() {
   // fastest of the nodes that move them (a particle from outside crosses a cell of the zone
   // before it reaches a listed node).
   double v2 = 0;
-  for (const long i : cm_moving_)
-    v2 = std::max(v2, grid.vnx[i] * grid.vnx[i] + grid.vny[i] * grid.vny[i]);
+  const long nm = static_cast<long>(cm_moving_.size());
+  const long* mv = cm_moving_.data();
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nm >= 4096) reduction(max : v2)
+  for (long e = 0; e < nm; ++e)
+    v2 = std::max(v2, grid.vnx[mv[e]] * grid.vnx[mv[e]] + grid.vny[mv[e]] * grid.vny[mv[e]]);
   cm_drift_ += DT * std::sqrt(v2);
 }
 
@@ -1837,9 +1841,17 @@ void Solver::boundary_work(bool remapped) {
   // nodes (a shared node's block is summed over the halo). The per-entry sum of the same terms,
   // sum_q w_q N_i C_q, gives the same work up to round-off.
   if (has_nodal_dashpot_) {
-    double w = 0;
+    // Each node's one or two terms (in parallel, each its own), then their sum in order.
+    const long nd = static_cast<long>(dashpot_nodes_.size());
+    dn_work_.resize(2 * nd);
+    dn_terms_.resize(nd);
+    double* T = dn_work_.data();
+    std::uint8_t* terms = dn_terms_.data();
     const double now = static_cast<double>(steps);
-    for (const long i : dashpot_nodes_) {
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
+    for (long k = 0; k < nd; ++k) {
+      const long i = dashpot_nodes_[k];
+      terms[k] = 0;
       if (!owns_node(i)) continue;
       double ax, ay, bx, by;
       wbar(i, bx, by);
@@ -1853,16 +1865,24 @@ void Solver::boundary_work(bool remapped) {
         const double fx = rec[kDelayFx], fy = rec[kDelayFy];
         const double cx = rec[kDelayCxx] * rec[kDelayVx], cy = rec[kDelayCyy] * rec[kDelayVy];
         vbar(i, ax, ay);
-        w += delayed_axis(rec[kDelayCxx], rec[kDelayCyy])
-                 ? 0.5 * (fx + cx) * bx + fx * rec[kDelayDgx]
-                 : grid.cxx(i) * ax * bx;
-        w += delayed_axis(rec[kDelayCyy], rec[kDelayCxx])
-                 ? 0.5 * (fy + cy) * by + fy * rec[kDelayDgy]
-                 : grid.cyy(i) * ay * by;
+        T[2 * k] = delayed_axis(rec[kDelayCxx], rec[kDelayCyy])
+                       ? 0.5 * (fx + cx) * bx + fx * rec[kDelayDgx]
+                       : grid.cxx(i) * ax * bx;
+        T[2 * k + 1] = delayed_axis(rec[kDelayCyy], rec[kDelayCxx])
+                           ? 0.5 * (fy + cy) * by + fy * rec[kDelayDgy]
+                           : grid.cyy(i) * ay * by;
+        terms[k] = 2;
         continue;
       }
       vbar(i, ax, ay);
-      w += (grid.cxx(i) * ax + grid.cxy(i) * ay) * bx + (grid.cxy(i) * ax + grid.cyy(i) * ay) * by;
+      T[2 * k] =
+          (grid.cxx(i) * ax + grid.cxy(i) * ay) * bx + (grid.cxy(i) * ax + grid.cyy(i) * ay) * by;
+      terms[k] = 1;
+    }
+    double w = 0;
+    for (long k = 0; k < nd; ++k) {
+      if (terms[k] > 0) w += T[2 * k];
+      if (terms[k] > 1) w += T[2 * k + 1];
     }
     energy.absorbed += dt * w;
   }

@@ -256,6 +256,8 @@ class Solver {
   // grid.fix (Grid::kDashpotNode) with its index in the list.
   std::vector<long> dashpot_nodes_;
   std::vector<int> dashpot_index_;
+  std::vector<double> dn_work_;        // boundary_work: each node's terms (scratch)
+  std::vector<std::uint8_t> dn_terms_; // and how many
   void add_dashpot_node(long i) {
     if (grid.fix[i] & Grid::kDashpotNode) return;
     grid.fix[i] |= Grid::kDashpotNode;
