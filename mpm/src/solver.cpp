@@ -205,6 +205,7 @@ void Solver::finalize() {
   consistent = consistent && (opt.scheme == Scheme::MUSL || opt.scheme == Scheme::USF) &&
                body_of_group_.empty();
   consistent_ = consistent;
+  // The solve's weights start from zero (apply_loads clears only the nodes it listed).
   for (std::size_t n = 0; n < grid.dash.size() / Grid::kDash; ++n) grid.dash_weight(n) = 0;
   cm_nodes_.clear();
   cm_slot_.assign(consistent ? grid.nodes() : 0, -1);
