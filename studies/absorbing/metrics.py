@@ -3,7 +3,7 @@ boundary and method, with the LK closed form (docs/physics.md section 4.1) besid
 
     /usr/bin/python3 studies/absorbing/metrics.py OUTDIR
 
-Reads OUTDIR/<fem|mpm>_<lk|kv|damping|rayleigh|pml>/metrics[_mpm].json (written by `oblique`), writes
+Reads OUTDIR/<fem|mpm>_<lk|kv|damping|rayleigh|pml|pml_r5>/metrics[_mpm].json (written by `oblique`), writes
 OUTDIR/metrics.json and OUTDIR/reflection_vs_angle.png and prints the tables: the same-type
 amplitude (|R_PP| for an incident P wave, |R_SS| for SV), the converted one (|R_PS|, |R_SP|), and
 per boundary the largest amplitude of either type up to 80 degrees and beyond.
@@ -18,6 +18,8 @@ import style  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
 BOUNDARIES = ["lk", "kv", "damping", "rayleigh", "pml"]
+# Variants in metrics.json and the summary only: the PML with r0 5e-3.
+EXTRA = ["pml_r5"]
 NAMES = {"lk": "LK dashpots", "kv": "Kelvin–Voigt", "damping": "damping band",
          "rayleigh": "Rayleigh band", "pml": "PML"}
 METHODS = {"fem": "FEM far field", "mpm": "MPM"}
@@ -32,7 +34,7 @@ def read(out):
     or "lk_exact"."""
     table = {"same": {}, "converted": {}}
     for m in METHODS:
-        for b in BOUNDARIES:
+        for b in BOUNDARIES + EXTRA:
             f = os.path.join(out, f"{m}_{b}", "metrics.json" if m == "fem" else "metrics_mpm.json")
             if not os.path.exists(f):
                 continue
@@ -92,7 +94,7 @@ def main(out):
                 ax.set_xlabel("angle from the normal (°)")
             ax.set_ylabel(f"$|R_{{{key[2:]}}}|$, reflected / incident amplitude")
     print(f"largest amplitude of either type, 0-{GOAL_ANGLE:.0f} degrees and beyond:")
-    for c in cols[1:]:
+    for c in cols[1:] + [f"{m}_{b}" for m in METHODS for b in EXTRA]:
         v, wave, a = largest(table, c, 0, GOAL_ANGLE)
         w, wave2, a2 = largest(table, c, GOAL_ANGLE + 1e-9, 90)
         if wave is None:
