@@ -1012,7 +1012,7 @@ void Solver::apply_loads() {
     const long* dn = dashpot_nodes_.data();
     double* uw = updated_weight_.empty() ? nullptr : updated_weight_.data();
     double* dr = delay_rho_.empty() ? nullptr : delay_rho_.data();
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 256)
     for (long k = 0; k < nd; ++k) {
       const long i = dn[k];
       double* c = grid.dash.data() + Grid::kDash * i;  // the block and the weight
@@ -1402,8 +1402,10 @@ void Solver::consistent_dashpots() {
         fn(j * w + ii);
   };
   for (;;) {
-    for (const long i : cm_nodes_) cm_slot_[i] = -1;
-    cm_nodes_.clear();
+    // The list is made apart and compared with the last one: along a quiet edge it is the same
+    // (its nodes' slots, the zone's cover of them and the cells that reach them are then as
+    // they were: no pass over their scattered grid entries).
+    cm_next_.clear();
     cm_dk_.clear();
     for (std::size_t k = 0; k < dashpot_nodes_.size(); ++k) {
       const long i = dashpot_nodes_[k];
@@ -1417,9 +1419,14 @@ void Solver::consistent_dashpots() {
       // too strong for the node's mass.
       if (!(lmax > 0) || 0.5 * DT * lmax > r[kDnM]) continue;
       if (std::binary_search(dropped.begin(), dropped.end(), i)) continue;
-      cm_slot_[i] = static_cast<int>(cm_nodes_.size());
-      cm_nodes_.push_back(i);
+      cm_next_.push_back(i);
       cm_dk_.push_back(static_cast<long>(k));
+    }
+    const bool same_list = cm_next_ == cm_nodes_;
+    if (!same_list) {
+      for (const long i : cm_nodes_) cm_slot_[i] = -1;
+      cm_nodes_.swap(cm_next_);
+      for (std::size_t k = 0; k < cm_nodes_.size(); ++k) cm_slot_[cm_nodes_[k]] = static_cast<int>(k);
     }
     // The particles whose shape functions reach those nodes, from a zone of particles kept
     // between steps: those in the cells whose particles can reach a listed node or one next to
@@ -1433,7 +1440,9 @@ void Solver::consistent_dashpots() {
     // step when hooks may change that velocity (once).
     bool scan = rescan || (!hooks_.empty() && !scanned) || cm_scan_version_ != order_version_ ||
                 cm_scan_size_ != p.size() || !(cm_drift_ < 0.5 * grid.h);
-    for (std::size_t k = 0; k < cm_nodes_.size() && !scan; ++k)
+    // (The nodes of an unchanged list are covered: a scan covers every listed node, and only a
+    // scan clears the cover.)
+    for (std::size_t k = 0; k < cm_nodes_.size() && !scan && !same_list; ++k)
       scan = !(cm_cover_[cm_nodes_[k]] & 1);
     if (scan) {
       for (const long c : cm_cells_) cm_cell_[c] &= 2;
@@ -1509,16 +1518,19 @@ void Solver::consistent_dashpots() {
         ay = grid.vny[j] - grid.vy[j];
       }
     };
-    // The cells whose particles can reach a listed node: a zone particle elsewhere reaches none.
-    for (const long c : cm_reach_) cm_cell_[c] &= 1;
-    cm_reach_.clear();
-    for (const long i : cm_nodes_)
-      around(i, S::kRowsAbove, S::kRowsBelow, ncx, ncy, [&](long c) {
-        if (!(cm_cell_[c] & 2)) {
-          cm_cell_[c] |= 2;
-          cm_reach_.push_back(c);
-        }
-      });
+    // The cells whose particles can reach a listed node: a zone particle elsewhere reaches none
+    // (a scan keeps these marks).
+    if (!same_list) {
+      for (const long c : cm_reach_) cm_cell_[c] &= 1;
+      cm_reach_.clear();
+      for (const long i : cm_nodes_)
+        around(i, S::kRowsAbove, S::kRowsBelow, ncx, ncy, [&](long c) {
+          if (!(cm_cell_[c] & 2)) {
+            cm_cell_[c] |= 2;
+            cm_reach_.push_back(c);
+          }
+        });
+    }
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nz >= 512)
     for (long e = 0; e < nz; ++e) {
       const std::uint32_t k = cm_zone_[e];
@@ -1725,7 +1737,7 @@ void Solver::consistent_dashpots() {
   }
   // Each slot its own: in parallel, the same values.
   const long nsl = static_cast<long>(ns);
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nsl >= 1024)
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nsl >= 256)
   for (long k = 0; k < nsl; ++k) {
     const long i = cm_nodes_[k];
     double* c = cm_.data() + kCm * k;
@@ -1746,7 +1758,7 @@ void Solver::consistent_dashpots() {
   double v2 = 0;
   const long nm = static_cast<long>(cm_moving_.size());
   const long* mv = cm_moving_.data();
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nm >= 4096) reduction(max : v2)
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nm >= 1024) reduction(max : v2)
   for (long e = 0; e < nm; ++e)
     v2 = std::max(v2, grid.vnx[mv[e]] * grid.vnx[mv[e]] + grid.vny[mv[e]] * grid.vny[mv[e]]);
   cm_drift_ += DT * std::sqrt(v2);
@@ -1849,7 +1861,7 @@ void Solver::boundary_work(bool remapped) {
     double* T = dn_work_.data();
     std::uint8_t* terms = dn_terms_.data();
     const double now = static_cast<double>(steps);
-#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 1024)
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nd >= 256)
     for (long k = 0; k < nd; ++k) {
       const long i = dashpot_nodes_[k];
       terms[k] = 0;

@@ -278,6 +278,7 @@ class Solver {
   // them, and per node its slot (-1: none).
   bool consistent_ = false;
   std::vector<long> cm_nodes_;
+  std::vector<long> cm_next_;           // the list being made (scratch)
   std::vector<long> cm_dk_;             // per slot: its node's place in dashpot_nodes_
   std::vector<int> cm_slot_;
   std::vector<std::uint8_t> cm_cell_;   // per cell: 1 in the zone, 2 reaches a listed node
