@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
                          "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
-                         "[--boundary lk|kv|damping|pml|delayed] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P] [--beta F]\n");
+                         "[--boundary lk|kv|damping|pml|delayed] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P] [--beta F] [--receiver CELLS]\n");
     return argc < 2 ? 1 : 0;
   }
   const std::string out = argv[1];
@@ -61,6 +61,8 @@ int main(int argc, char** argv) {
       base.delta = std::atof(argv[i + 1]);
     } else if (a == "--band") {
       base.band = std::atof(argv[i + 1]);
+    } else if (a == "--receiver") {
+      base.receiver = std::atof(argv[i + 1]);
     } else if (a == "--r0") {
       base.r0 = std::atof(argv[i + 1]);
     } else if (a == "--alpha") {
@@ -84,6 +86,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "oblique: unknown option %s\n", a.c_str());
       return 1;
     }
+  }
+  if (!(base.receiver > 0 && base.receiver < 150)) {  // run A is 160 cells wide
+    std::fprintf(stderr, "oblique: --receiver must be between 0 and 150 cells from the boundary\n");
+    return 1;
   }
   if (method == "fem" && base.boundary == "delayed") {
     std::fprintf(stderr, "oblique: --boundary delayed is the particles' closure: --method mpm only\n");

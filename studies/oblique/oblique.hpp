@@ -13,7 +13,7 @@
 //     G a Gaussian whose full width at half maximum is `fwhm` cells, E a flat-topped beam
 //     envelope (flat over 2 x 200 cells, 60-cell cos^2 tapers; Ly = 2 (flat + taper + 20) + 60),
 //     so the rays that reach the receiver after reflection are in the flat part;
-//   * receiver R: 20.5 cells inside the boundary, at y = flat + taper + 20.5 cells, on the beam's
+//   * receiver R: 20.5 cells inside the boundary (Setup::receiver), at y = flat + taper + 20.5 cells, on the beam's
 //     centre line; the pulse starts 4 sigma + 8 cells before R;
 //   * with a layer (damping, pml) the initial data is cut off (a cos^2 ramp over 8 cells) 2 cells
 //     before the layer, in A and in B alike: an inclined beam is hundreds of cells wide along its
@@ -62,6 +62,10 @@ struct Setup {
   std::string boundary = "lk";
   double delta = 40, band = 10, r0 = 1e-3, alpha = 0, power = 2, beta = 0;
   double parallel = 0;  // pml: the multi-axial layer's share of d along the edge
+  // Cells from the boundary to the receiver R. A layer's initial-data cut (clear()) and its ramp
+  // of 8 cells reach the incident pulse's tail at normal incidence once they pass about 28 cells
+  // (the pulse ends 4 sigma + 8 cells before R): layers of more than 15 cells need R further in.
+  double receiver = 20.5;
   // Cells before the boundary where the initial data ends (a layer's thickness plus 2), or -1:
   // not cut (LK, Kelvin-Voigt).
   double clear() const { return boundary == "damping" || boundary == "pml" ? band + 2 : -1.0; }
@@ -124,7 +128,7 @@ struct Plane {
     dx = su.sv ? tx : nx, dy = su.sv ? ty : ny;
     F = su.flat * h, T = su.taper * h;
     sig = su.fwhm * h / 2.3548;  // Gaussian sigma of the pulse
-    rx = (lx - 20.5) * h, ry = (yr + 0.5) * h;
+    rx = (lx - su.receiver) * h, ry = (yr + 0.5) * h;
     D = 4 * sig + 8 * h;
     x0 = rx - D * nx, y0 = ry - D * ny;
     k = mat.cs / mat.cd;
