@@ -12,7 +12,7 @@ reflected amplitude of any type (same-type and converted) for:
   * r0 for the MPM PML at 10 cells.
 Thicker layers need the receiver further in: 10, 15 and 20 cells are run again with it
 30.5 cells from the boundary (`oblique --receiver`). Writes OUTDIR/scan/scan.json and
-OUTDIR/scan/scan.png and prints the tables. About 13 minutes on two cores.
+OUTDIR/scan/scan.png and prints the tables. About 16 minutes on two cores.
 """
 import json
 import os

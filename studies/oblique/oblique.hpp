@@ -13,8 +13,8 @@
 //     G a Gaussian whose full width at half maximum is `fwhm` cells, E a flat-topped beam
 //     envelope (flat over 2 x 200 cells, 60-cell cos^2 tapers; Ly = 2 (flat + taper + 20) + 60),
 //     so the rays that reach the receiver after reflection are in the flat part;
-//   * receiver R: 20.5 cells inside the boundary (Setup::receiver), at y = flat + taper + 20.5 cells, on the beam's
-//     centre line; the pulse starts 4 sigma + 8 cells before R;
+//   * receiver R: 20.5 cells inside the boundary (Setup::receiver), at y = flat + taper + 20.5
+//     cells, on the beam's centre line; the pulse starts 4 sigma + 8 cells before R;
 //   * with a layer (damping, pml) the initial data is cut off (a cos^2 ramp over 8 cells) 2 cells
 //     before the layer, in A and in B alike: an inclined beam is hundreds of cells wide along its
 //     front and would otherwise reach into the layer at t = 0, which would start filled with a
