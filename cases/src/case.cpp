@@ -742,6 +742,17 @@ class Builder {
                     ") is outside the grid " + grid_.describe());
     }
     set_time_step();
+    // USL strains the particles with v+ at every node; with the wider shapes a surface that moves
+    // outward at all puts a sliver of mass on the node row beyond it, a node whose v+ that
+    // update cannot take (docs/physics.md section 9.3).
+    if (s_->opt.scheme == Scheme::USL && s_->opt.shape != ShapeKind::Bilinear)
+      c.notes.push_back(std::string("note: scheme.update \"USL\" with scheme.shape \"") +
+                        shape_name(s_->opt.shape) +
+                        "\": a free surface that moves outward puts a sliver of mass on the "
+                        "node row beyond it, whose updated velocity USL strains the particles "
+                        "with (a column under a shear traction kept about a twentieth of the "
+                        "energy MUSL gives it; docs/physics.md section 9.3); with this shape "
+                        "prefer \"MUSL\"");
     // The updated edge velocity was measured stable up to CFL 0.85 under MUSL, 0.9 under USF
     // (docs/physics.md section 4).
     const double cfl = s_->dt / s_->critical_dt();

@@ -100,6 +100,26 @@ TEST(CaseLoad, DefaultsAndOverrides) {
   EXPECT_EQ(s.tractions[0].layer.ids.size(), 10u);
 }
 
+// USL with the wider shapes gets a note (docs/physics.md section 9.3: a surface that moves
+// outward leaves nodes of a sliver of mass beyond it, which USL's update cannot take); MUSL and
+// bilinear USL do not.
+TEST(CaseLoad, UslWithWiderShapesGetsANote) {
+  const fs::path file = write_file("valid_usl_shape.json", kValid);
+  auto has_note = [](const smpm::Case& c) {
+    for (const std::string& n : c.notes)
+      if (n.find("note: scheme.update \"USL\" with scheme.shape") != std::string::npos) return true;
+    return false;
+  };
+  for (const char* shape : {"gimp", "bspline"}) {
+    const smpm::Case c = smpm::load_case(
+        file.string(), {"scheme.update=USL", std::string("scheme.shape=") + shape});
+    EXPECT_TRUE(has_note(c)) << shape;
+    const smpm::Case m = smpm::load_case(file.string(), {std::string("scheme.shape=") + shape});
+    EXPECT_FALSE(has_note(m)) << shape;
+  }
+  EXPECT_FALSE(has_note(smpm::load_case(file.string(), {"scheme.update=USL"})));
+}
+
 // A kelvin_voigt boundary is the silent layer with springs k = alpha rho c^2 / delta per particle.
 TEST(CaseLoad, KelvinVoigtBoundary) {
   const fs::path file = write_file("valid_kv.json", kValid);
