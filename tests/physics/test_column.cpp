@@ -656,18 +656,24 @@ static LongRun long_run(ColumnSpec c) {
 // 0.163 m/s without the layer), so what is left is the static shear strain in the layer; the
 // layer's memories decay at the rate alpha + d, and at alpha = 0 those where d is small hardly
 // forget and integrate that strain: the rise is the layer's response at zero frequency (with
-// alpha > 0 there is none: the next test). Bounds on
-// the rise from 10^4 steps on: P 1e-6, S 3e-3 of the energy when the pulse has left.
+// alpha > 0 there is none: the next test). Bounds on the rise from 10^4 steps on: P 1e-6,
+// S 3e-3 of the energy when the pulse has left.
+// The long runs' column: 100 cells, a 10-cell layer at its end, USL at CFL 0.5.
+static ColumnSpec pml_long_column(bool shear, double alpha, End end = End::Free) {
+  ColumnSpec c;
+  c.cells = 100;
+  c.end = end;
+  c.scheme = Scheme::USL;
+  c.shear = shear;
+  c.cfl = 0.5;
+  c.pml_cells = 10;
+  c.pml_alpha = alpha;
+  return c;
+}
+
 TEST(Pml, NoGrowthOver100000StepsUsl) {
   for (const bool shear : {false, true}) {
-    ColumnSpec c;
-    c.cells = 100;
-    c.end = End::Free;
-    c.scheme = Scheme::USL;
-    c.shear = shear;
-    c.cfl = 0.5;
-    c.pml_cells = 10;
-    const LongRun r = long_run(c);
+    const LongRun r = long_run(pml_long_column(shear, 0));
     std::printf("  [%s] energy left %.3e of the input; after 1e4 steps %.6f of it, largest later "
                 "%.6f; the column's mean velocity %.2e m/s\n", shear ? "S" : "P", r.e0_of_input,
                 r.e1, r.emax, r.drift);
@@ -690,15 +696,7 @@ TEST(Pml, NoGrowthOver100000StepsUsl) {
 // same steps (the test above). With LK behind the layer, below, nothing is left.
 TEST(Pml, ShiftedLayerNoGrowthOver100000StepsUsl) {
   for (const bool shear : {false, true}) {
-    ColumnSpec c;
-    c.cells = 100;
-    c.end = End::Free;
-    c.scheme = Scheme::USL;
-    c.shear = shear;
-    c.cfl = 0.5;
-    c.pml_cells = 10;
-    c.pml_alpha = 2e4;
-    const LongRun r = long_run(c);
+    const LongRun r = long_run(pml_long_column(shear, 2e4));
     std::printf("  [%s] energy left %.3e of the input; after 1e4 steps %.6e of it, from 5e4 steps "
                 "on %.7e to %.7e; the column's mean velocity %.2e m/s\n", shear ? "S" : "P",
                 r.e0_of_input, r.e1, r.late_min, r.late_max, r.drift);
@@ -711,15 +709,7 @@ TEST(Pml, ShiftedLayerNoGrowthOver100000StepsUsl) {
   // With LK dashpots behind the layer (the recommended layout) they take that drift out: the
   // energy left falls to 8.5e-9 of what it held after the pulse and stays there (S; 8.549e-9 at
   // 5 * 10^4 steps, 8.540e-9 at the end).
-  ColumnSpec c;
-  c.cells = 100;
-  c.end = End::Silent;
-  c.scheme = Scheme::USL;
-  c.shear = true;
-  c.cfl = 0.5;
-  c.pml_cells = 10;
-  c.pml_alpha = 2e4;
-  const LongRun r = long_run(c);
+  const LongRun r = long_run(pml_long_column(true, 2e4, End::Silent));
   std::printf("  [S, LK behind] energy left after 1e4 steps %.3e, at 1.1e5 %.3e\n", r.e1, r.elast);
   EXPECT_LE(r.late_max, 1e-7);  // from 5 * 10^4 steps on
 }
