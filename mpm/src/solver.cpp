@@ -834,7 +834,8 @@ static inline void advance_spring(SilentBoundary& sl, std::size_t q, const doubl
 // through the same shape functions (pml_advance). At the start of a step it loads the grid with
 // the stretched parts of its stress, V_p grad N . [(d_y - d_x) C_x psi_x + (d_x - d_y) C_y psi_y]
 // with psi_x, psi_y the convolutions of H's x and y rows with exp(-(alpha + d) t), and the mass
-// term m_p N (pml_mass_term), and puts m_p (d_x + d_y) N into the nodal dashpot blocks.
+// term m_p N (pml_mass_term), and (USL) puts m_p (d_x + d_y) N into the nodal dashpot blocks; MUSL
+// damps the particles themselves (pml_pic, pml_damping).
 template <class S>
 void Solver::pml_loads() {
   PmlLayer& P = pml;
@@ -847,7 +848,8 @@ void Solver::pml_loads() {
   // USF strains the particles with the start-of-step velocity, before the forces.
   if (opt.scheme == Scheme::USF) pml_advance<S>(grid.vx, grid.vy);
   constexpr int K = S::kNodes;
-  has_nodal_dashpot_ = true;
+  const bool nodal = opt.scheme != Scheme::MUSL;
+  if (nodal) has_nodal_dashpot_ = true;
   for (std::size_t q = 0; q < n; ++q) {
     const uint32_t k = P.layer.idx[q];
     const long* nodes = P.nodes.data() + K * q;
@@ -880,6 +882,7 @@ void Solver::pml_loads() {
     for (int a = 0; a < K; ++a) {
       grid.fx[nodes[a]] += f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
       grid.fy[nodes[a]] += f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
+      if (!nodal) continue;
       grid.cxx(nodes[a]) += cm * N[a];
       grid.cyy(nodes[a]) += cm * N[a];
       add_dashpot_node(nodes[a]);
@@ -894,11 +897,14 @@ void Solver::pml_loads() {
 // thousand steps. w grows from 0 at the layer's inner edge as (depth / width)^5: an earlier
 // switch to PIC reflects and converts waves (PIC smooths the velocity over the stencil each
 // step), a later one (power 6 and more, under USL) leaves enough FLIP for the growth to return
-// (docs/physics.md section 9.3).
+// (docs/physics.md section 9.3). Under MUSL the particle velocity then takes the first part of the
+// layer's damping (pml_damping).
 template <class S>
 void Solver::pml_pic() {
   constexpr int K = S::kNodes;
   const long n = static_cast<long>(pml.layer.idx.size());
+  const bool damp = opt.scheme == Scheme::MUSL;
+  if (damp) pml.vd.resize(4 * static_cast<std::size_t>(n));
   // Each particle its own: in parallel, the same values as in order.
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 1024)
   for (long q = 0; q < n; ++q) {
@@ -917,7 +923,53 @@ void Solver::pml_pic() {
     const double w = pml.pic[q];
     p.vx[k] = w * wx + (1 - w) * p.vx[k];
     p.vy[k] = w * wy + (1 - w) * p.vy[k];
+    if (damp) {  // the first half of the trapezoidal damping (pml_damping)
+      double* vd = pml.vd.data() + 4 * q;
+      const double a = 0.5 * (pml.dx[q] + pml.dy[q]) * dt;
+      vd[0] = p.vx[k];
+      vd[1] = p.vy[k];
+      p.vx[k] *= (1 - a) / (1 + a);
+      p.vy[k] *= (1 - a) / (1 + a);
+      vd[2] = p.vx[k];
+      vd[3] = p.vy[k];
+    }
   }
+}
+
+// Under MUSL the layer's damping m_p (d_x + d_y) v acts on its particles, not on the nodes:
+// trapezoidal, v' = [(1 - a) v + N dv] / (1 + a) with a = (d_x + d_y) dt / 2 and N dv g2p's
+// increment. pml_pic took the particle velocity to (1 - a) v / (1 + a) before g2p; here the
+// increment is divided by 1 + a, the re-mapped momenta lose what the particles lost (so the
+// stress update strains them with their damped velocities) and the damping's work,
+// dt m_p (d_x + d_y) |(v + v')/2|^2, is booked as absorbed. On the nodes, whose trapezoidal mean
+// is not the particles' (docs/physics.md section 4), MUSL's layer grew within 2 000 steps; on
+// the particles it is stable at 4 and 9 particles per cell (docs/physics.md section 9.3).
+// Serial in layer order: the sums into the nodes and the work in one order.
+template <class S>
+void Solver::pml_damping() {
+  constexpr int K = S::kNodes;
+  if (!body_of_group_.empty())
+    throw std::logic_error("pml_damping: a layer under MUSL with one velocity field per body");
+  double work = 0;
+  for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
+    const uint32_t k = pml.layer.idx[q];
+    const double* vd = pml.vd.data() + 4 * q;
+    const double a = 0.5 * (pml.dx[q] + pml.dy[q]) * dt;
+    const double ux = vd[2] + (p.vx[k] - vd[2]) / (1 + a);
+    const double uy = vd[3] + (p.vy[k] - vd[3]) / (1 + a);
+    const double lx = p.vx[k] - ux, ly = p.vy[k] - uy;
+    p.vx[k] = ux;
+    p.vy[k] = uy;
+    const double m = p.mass[k];
+    for (int b = 0; b < K; ++b) {
+      const long n = pml.nodes[K * q + b];
+      grid.qx[n] -= m * pml.N[K * q + b] * lx;
+      grid.qy[n] -= m * pml.N[K * q + b] * ly;
+    }
+    const double bx = 0.5 * (vd[0] + ux), by = 0.5 * (vd[1] + uy);
+    work += m * 2 * a * (bx * bx + by * by);
+  }
+  energy.absorbed += work;
 }
 
 template <class S>
@@ -2208,6 +2260,7 @@ void Solver::step_with() {
   switch (sc) {
     case Scheme::MUSL:
       g2p<S>(true, false);
+      if (pml.active()) pml_damping<S>();
       remapped_velocities(true);
       if (remapped_power) boundary_work<S>(true);
       update_stress<S>(true, false, true);

@@ -579,6 +579,18 @@ TEST(MpiCli, DelayedEdgeOnRanksAndRestartsOnAnyCount) {
                              "ckdelayed", 300, {0, 4}, 1e-10);
 }
 
+// The particle PML under MUSL (4 ppc; its particles take the layer's damping and their re-mapped
+// momenta lose what they lost before the halo's sum, docs/physics.md section 9.3): plain on 2
+// ranks and restarts on 1 process and on 3 ranks against the plain run.
+TEST(MpiCli, MuslPmlOnRanksAndRestartsOnAnyCount) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
+  expect_checkpoint_restarts(
+      kCase + " --set time.end=1.6e-5 -q --set bodies.0.particles_per_cell=4 --set "
+              "'boundaries.2={\"type\": \"pml\", \"body\": \"plate\", \"curve\": \"right\", "
+              "\"width\": 0.005, \"r0\": 0.01}'",
+      "ckmuslpml", 150, {0, 3}, 1e-10);
+}
+
 // A restart on several ranks: rank 0 reads the whole checkpoint and the others what is not the
 // particles', so rank 0's verdict is every rank's. A checkpoint with a corrupt byte, and one
 // whose particle lies off the grid behind a recomputed checksum (which rank 0 alone sees), are

@@ -425,6 +425,7 @@ class Solver {
   template <class S> void pml_shapes();
   template <class S> void pml_loads();
   template <class S> void pml_pic();
+  template <class S> void pml_damping();
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
   int update_dashpot_node(long i, bool delayed, double gx, double gy);
