@@ -583,19 +583,24 @@ TEST(DampingLayer, StiffnessPartStableAtLightNodes) {
 // 1 ppc (with the power 2.5 used before: 8.0e-6, 2.8e-5, 9.0e-6, 4.1e-5, 2.4e-6, 2.2e-6; the
 // larger power trades a little normal-incidence reflection for much smaller converted waves at
 // oblique incidence; the FE column: 6.7e-5 and 2.7e-4, 9.6e-7).
+// The reflection tests' column: 100 cells, a layer of `cells` at its free end.
+static ColumnSpec pml_column(Scheme scheme, int ppc_side, int cells, bool shear) {
+  ColumnSpec c;
+  c.cells = 100;
+  c.ppc_side = ppc_side;
+  c.end = End::Free;
+  c.scheme = scheme;
+  c.shear = shear;
+  c.pml_cells = cells;
+  return c;
+}
+
 TEST(Pml, ColumnReflectionUsl) {
   for (const int ppc : {1, 2})
     for (const int cells : {10, 20})
       for (const bool shear : {false, true}) {
         if (ppc == 2 && cells == 20) continue;
-        ColumnSpec c;
-        c.cells = 100;
-        c.ppc_side = ppc;
-        c.end = End::Free;
-        c.scheme = Scheme::USL;
-        c.shear = shear;
-        c.pml_cells = cells;
-        const double ratio = reflected_energy_ratio(c, 8);
+        const double ratio = reflected_energy_ratio(pml_column(Scheme::USL, ppc, cells, shear), 8);
         std::printf("  [USL, %d ppc, %d cells, %s] reflected energy %.3e\n", ppc * ppc, cells,
                     shear ? "S" : "P", ratio);
         EXPECT_LE(ratio, cells == 10 ? 1e-4 : 1e-5) << cells << " cells, " << (shear ? "S" : "P");
@@ -653,14 +658,7 @@ static LongRun long_run(ColumnSpec c) {
 TEST(Pml, ColumnReflectionMusl) {
   for (const int ppc : {2, 3})
     for (const bool shear : {false, true}) {
-      ColumnSpec c;
-      c.cells = 100;
-      c.ppc_side = ppc;
-      c.end = End::Free;
-      c.scheme = Scheme::MUSL;
-      c.shear = shear;
-      c.pml_cells = 10;
-      const double ratio = reflected_energy_ratio(c, 8);
+      const double ratio = reflected_energy_ratio(pml_column(Scheme::MUSL, ppc, 10, shear), 8);
       std::printf("  [MUSL, %d ppc, %s] reflected energy %.3e\n", ppc * ppc, shear ? "S" : "P",
                   ratio);
       EXPECT_LE(ratio, 3e-5) << ppc * ppc << " ppc, " << (shear ? "S" : "P");
