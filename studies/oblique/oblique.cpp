@@ -20,7 +20,7 @@ using namespace smpm;
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
-                         "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] "
+                         "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] [--ppc 1|4|9] [--scheme usl|musl] "
                          "[--boundary lk|kv|damping|pml|delayed] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P] [--beta F] [--receiver CELLS]\n");
     return argc < 2 ? 1 : 0;
   }
@@ -73,6 +73,18 @@ int main(int argc, char** argv) {
       base.parallel = std::atof(argv[i + 1]);
     } else if (a == "--beta") {
       base.beta = std::atof(argv[i + 1]);
+    } else if (a == "--ppc") {
+      base.ppc = std::atoi(argv[i + 1]);
+      if (base.ppc != 1 && base.ppc != 4 && base.ppc != 9) {
+        std::fprintf(stderr, "oblique: --ppc must be 1, 4 or 9\n");
+        return 1;
+      }
+    } else if (a == "--scheme") {
+      base.scheme = argv[i + 1];
+      if (base.scheme != "usl" && base.scheme != "musl") {
+        std::fprintf(stderr, "oblique: --scheme must be usl or musl\n");
+        return 1;
+      }
     } else if (a == "--shape") {
       const std::string v = argv[i + 1];
       if (v == "bilinear") base.shape = ShapeKind::Bilinear;
@@ -91,6 +103,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "oblique: --receiver must be between 0 and 150 cells from the boundary\n");
     return 1;
   }
+  if (method == "mpm" && base.boundary == "pml" && base.scheme == "musl" && base.ppc == 1) {
+    std::fprintf(stderr, "oblique: --boundary pml under --scheme musl needs --ppc 4 or 9 (at 1 a "
+                         "slow mode of MUSL's grows in the layer)\n");
+    return 1;
+  }
+  if (method == "fem" && (base.ppc != 1 || !base.scheme.empty())) {
+    std::fprintf(stderr, "oblique: --ppc and --scheme are the particles': --method mpm only\n");
+    return 1;
+  }
   if (method == "fem" && base.boundary == "delayed") {
     std::fprintf(stderr, "oblique: --boundary delayed is the particles' closure: --method mpm only\n");
     return 1;
@@ -102,8 +123,14 @@ int main(int argc, char** argv) {
                       ? "FEM (deal.II) Q" + std::to_string(base.degree) +
                             ", lumped mass, semi-implicit LK dashpots a = b = 1; extended-domain "
                             "differencing"
-                      : std::string("MPM, 1 particle per cell, MUSL, nodal semi-implicit silent layer "
-                                    "a = b = 1, CFL 0.3; extended-domain differencing (div u, curl u: the sampled velocity's div and curl integrated over the steps)");
+                      : "MPM, " + std::to_string(base.ppc) + " particle" +
+                            (base.ppc == 1 ? "" : "s") + " per cell, " +
+                            (base.scheme == "usl" || (base.scheme.empty() && base.boundary == "pml")
+                                 ? "USL"
+                                 : "MUSL") +
+                            ", nodal semi-implicit silent layer a = b = 1, CFL 0.3; extended-domain "
+                            "differencing (div u, curl u: the sampled velocity's div and curl "
+                            "integrated over the steps)";
     if (method == "mpm") j["shape"] = shape_name(base.shape);
     j["boundary"] = base.boundary;
     if (base.boundary == "kv") j["kv_delta_cells"] = base.delta;

@@ -1,6 +1,6 @@
 #pragma once
 // The MPM counterpart of oblique.hpp: the same geometry, pulse, beam, receiver and windows, on
-// MPM bodies (1 particle per cell, MUSL (USL with a pml), the default semi-implicit nodal silent layer on the
+// MPM bodies (1 particle per cell unless Setup::ppc, MUSL (USL with a pml) unless Setup::scheme, the default semi-implicit nodal silent layer on the
 // right side of run A), with the particles of A and B on the same lattice and the identical dt
 // (CFL 0.3 of h / c_d). The initial condition sets the particles' velocity and stress from the
 // plane pulse. P and S are separated with div u and curl u at R (docs/physics.md §4.1: R are
@@ -29,7 +29,8 @@ inline Result measure_mpm(const Setup& su) {
     auto s = std::make_unique<Solver>();
     s->materials.push_back(mat);
     s->grid.init(-2 * h, -2 * h, h, cells_x + 4, w.ly + 4);
-    s->seed_rectangle(0, 0, cells_x * h, w.ly * h, 1, 0, 0, 0, 0);
+    s->seed_rectangle(0, 0, cells_x * h, w.ly * h, su.ppc == 9 ? 3 : su.ppc == 4 ? 2 : 1, 0, 0,
+                      0, 0);
     if (silent && su.boundary == "pml") {  // in front of the dashpots, as in the FE far field
       PmlBand band;
       band.name = "pml";
@@ -59,7 +60,10 @@ inline Result measure_mpm(const Setup& su) {
       }
     }
     s->opt.threads = su.threads;
-    if (su.boundary == "pml") s->opt.scheme = Scheme::USL;  // the particle layer's scheme (both runs)
+    // The particle layer's scheme by default (both runs): USL; MUSL takes it at 4 and 9 ppc.
+    if (su.boundary == "pml") s->opt.scheme = Scheme::USL;
+    if (su.scheme == "usl") s->opt.scheme = Scheme::USL;
+    if (su.scheme == "musl") s->opt.scheme = Scheme::MUSL;
     s->opt.shape = su.shape;
     s->dt = dt;
     s->finalize();
