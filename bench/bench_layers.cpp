@@ -19,11 +19,12 @@
 // (L cells for the band and the PML, one cell for the dashpots and springs, which act on the
 // edge only). 1 means the layer is free; the goal the project keeps is at most 1.5.
 //
-// The MPM PML needs USL: its variant is timed against a free square under USL too (the other
-// MPM variants use MUSL, the default scheme).
+// The MPM PML runs under USL, timed against a free square under USL too (the other MPM variants
+// use MUSL, the default scheme); with --ppc 4 or 9 also under MUSL, whose layer damps its
+// particles (docs/physics.md section 9.3).
 //
 //   build/bench_layers [--cells W] [--layer L] [--steps S] [--rounds R] [--threads T]
-//                      [--only mpm|fem] [--kind lk|kv|damping|pml]
+//                      [--only mpm|fem] [--kind lk|kv|damping|pml] [--ppc 1|4|9]
 #include <time.h>
 
 #include <algorithm>
@@ -47,6 +48,7 @@ namespace {
 
 struct Options {
   int cells = 200, layer = 10, steps = 200, rounds = 5, threads = 1;
+  int ppc = 1;       // MPM particles per cell: 1, 4 or 9
   std::string only;  // "mpm" or "fem": that method only
   std::string kind;  // one boundary (with the free square it is compared with)
 };
@@ -96,7 +98,7 @@ std::string mpm_case(const Options& o, const std::string& kind, const std::strin
   b += R"("scheme": {"update": ")" + scheme + R"(", "threads": )" + std::to_string(o.threads) + "},";
   b += std::string(kMaterial) + ",";
   b += R"("bodies": [{"name": "b", "material": "steel", "box": [0, 0, )" + num(W) + ", " + num(W) +
-       R"(], "particles_per_cell": 1}],)";
+       R"(], "particles_per_cell": )" + std::to_string(o.ppc) + "}],";
   b += R"("boundaries": [{"type": "traction", "body": "b", "side": "top", "interval": [)" +
        num(0.4 * W) + ", " + num(0.6 * W) +
        R"(], "normal": -1e8, "time": {"shape": "sin2", "start": 0, "duration": 2e-6, "ramp": 1e-6}})";
@@ -161,19 +163,22 @@ int main(int argc, char** argv) {
     else if (a == "--threads") o.threads = std::atoi(next("--threads"));
     else if (a == "--only") o.only = next("--only");
     else if (a == "--kind") o.kind = next("--kind");
+    else if (a == "--ppc") o.ppc = std::atoi(next("--ppc"));
     else {
       std::fprintf(stderr,
                    "usage: bench_layers [--cells W] [--layer L] [--steps S] [--rounds R] "
-                   "[--threads T] [--only mpm|fem] [--kind lk|kv|damping|pml]\n");
+                   "[--threads T] [--only mpm|fem] [--kind lk|kv|damping|pml] [--ppc 1|4|9]\n");
       return 2;
     }
   }
   if (o.cells < 4 * o.layer || o.layer < 1 || o.steps < 1 || o.rounds < 1 || o.threads < 1 ||
       (!o.only.empty() && o.only != "mpm" && o.only != "fem") ||
       (!o.kind.empty() && o.kind != "lk" && o.kind != "kv" && o.kind != "damping" &&
-       o.kind != "pml")) {
+       o.kind != "pml") ||
+      (o.ppc != 1 && o.ppc != 4 && o.ppc != 9)) {
     std::fprintf(stderr, "bench_layers: need --layer >= 1, --cells >= 4 layers, --steps, --rounds, "
-                         "--threads >= 1, --only mpm or fem, --kind lk, kv, damping or pml\n");
+                         "--threads >= 1, --only mpm or fem, --kind lk, kv, damping or pml, "
+                         "--ppc 1, 4 or 9\n");
     return 2;
   }
   const fs::path dir = fs::temp_directory_path() / "smpm_bench_layers";
@@ -184,7 +189,8 @@ int main(int argc, char** argv) {
   std::vector<Variant> vs;
   try {
     if (o.only != "fem") {
-      for (const char* k : {"free", "lk", "kv", "damping"}) {
+      for (const char* k : {"free", "lk", "kv", "damping", "pml"}) {
+        if (std::string(k) == "pml" && o.ppc < 4) continue;  // MUSL's layer needs 4 or 9 ppc
         Variant v{"MPM", k, "MUSL", {}, 0, 1e300, {}};
         v.c = load_case_text(mpm_case(o, k, "MUSL"), (dir / "mpm.json").string());
         vs.push_back(std::move(v));
