@@ -848,7 +848,7 @@ void Solver::pml_loads() {
   // USF strains the particles with the start-of-step velocity, before the forces.
   if (opt.scheme == Scheme::USF) pml_advance<S>(grid.vx, grid.vy);
   constexpr int K = S::kNodes;
-  const bool nodal = opt.scheme != Scheme::MUSL;
+  const bool nodal = !pml_damps_particles();
   if (nodal) has_nodal_dashpot_ = true;
   for (std::size_t q = 0; q < n; ++q) {
     const uint32_t k = P.layer.idx[q];
@@ -903,7 +903,7 @@ template <class S>
 void Solver::pml_pic() {
   constexpr int K = S::kNodes;
   const long n = static_cast<long>(pml.layer.idx.size());
-  const bool damp = opt.scheme == Scheme::MUSL;
+  const bool damp = pml_damps_particles();
   if (damp) pml.vd.resize(4 * static_cast<std::size_t>(n));
   // Each particle its own: in parallel, the same values as in order.
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (n >= 1024)
@@ -2260,7 +2260,7 @@ void Solver::step_with() {
   switch (sc) {
     case Scheme::MUSL:
       g2p<S>(true, false);
-      if (pml.active()) pml_damping<S>();
+      if (pml.active() && pml_damps_particles()) pml_damping<S>();
       remapped_velocities(true);
       if (remapped_power) boundary_work<S>(true);
       update_stress<S>(true, false, true);
