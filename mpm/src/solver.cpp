@@ -882,7 +882,7 @@ void Solver::pml_loads() {
     for (int a = 0; a < K; ++a) {
       grid.fx[nodes[a]] += f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
       grid.fy[nodes[a]] += f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
-      if (!nodal) continue;
+      if (!nodal || cm * N[a] == 0) continue;  // no block: the plain update
       grid.cxx(nodes[a]) += cm * N[a];
       grid.cyy(nodes[a]) += cm * N[a];
       add_dashpot_node(nodes[a]);
@@ -1126,6 +1126,7 @@ void Solver::apply_loads() {
       lk_block(sl.zn[q], sl.zt[q], L.nx[q], L.ny[q], bxx, bxy, byy);
       for (int a = 0; a < K; ++a) {
         const double wn = L.w[q] * N[a];
+        if (wn == 0) continue;  // a node the anchor's weights miss: no block, the plain update
         grid.cxx(nodes[a]) += wn * bxx;
         grid.cxy(nodes[a]) += wn * bxy;
         grid.cyy(nodes[a]) += wn * byy;
@@ -1157,6 +1158,7 @@ void Solver::apply_loads() {
       has_nodal_dashpot_ = true;
       const double c = dl.alpha[q] * p.mass[L.idx[q]];
       for (int a = 0; a < K; ++a) {
+        if (N[a] == 0) continue;  // no block: the plain update
         grid.cxx(dn[a]) += c * N[a];
         grid.cyy(dn[a]) += c * N[a];
         add_dashpot_node(dn[a]);
@@ -1540,14 +1542,6 @@ void Solver::consistent_dashpots() {
       scanned = true;
       rescan = false;
     }
-    // Each zone particle's shape functions, its nodes' slots and this step's dv0 . N (in
-    // parallel, each its own), then those that reach a listed node kept in zone order.
-    const long nz = static_cast<long>(cm_zone_.size());
-    cm_pN_.resize(K * nz);
-    cm_ps_.resize(K * nz);
-    cm_pm_.resize(nz);
-    cm_s_.resize(2 * nz);
-    std::vector<std::uint8_t> reaches(nz);
     // dv0 at a node: without the listed nodes' dashpots (a delayed closure's component: its
     // update, whose dashpot is explicit).
     cm_dv_.resize(2 * cm_nodes_.size());
@@ -1583,6 +1577,15 @@ void Solver::consistent_dashpots() {
           }
         });
     }
+    // Each zone particle's shape functions, its nodes' slots and this step's dv0 . N (in
+    // parallel, each its own), then the places of those that reach a listed node, in zone order.
+    const long nz = static_cast<long>(cm_zone_.size());
+    cm_pN_.resize(K * nz);
+    cm_ps_.resize(K * nz);
+    cm_pm_.resize(nz);
+    cm_s_.resize(2 * nz);
+    cm_reaches_.resize(nz);
+    std::uint8_t* reaches = cm_reaches_.data();
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nz >= 512)
     for (long e = 0; e < nz; ++e) {
       const std::uint32_t k = cm_zone_[e];
@@ -1614,26 +1617,13 @@ void Solver::consistent_dashpots() {
       cm_s_[2 * e] = sx;
       cm_s_[2 * e + 1] = sy;
     }
-    std::size_t nc = 0;
-    cm_particles_.resize(nz);
-    for (long e = 0; e < nz; ++e) {
-      if (!reaches[e]) continue;
-      if (static_cast<long>(nc) != e) {
-        for (int a = 0; a < K; ++a) {
-          cm_pN_[K * nc + a] = cm_pN_[K * e + a];
-          cm_ps_[K * nc + a] = cm_ps_[K * e + a];
-        }
-        cm_pm_[nc] = cm_pm_[e];
-        cm_s_[2 * nc] = cm_s_[2 * e];
-        cm_s_[2 * nc + 1] = cm_s_[2 * e + 1];
-      }
-      cm_particles_[nc++] = cm_zone_[e];
-    }
-    cm_particles_.resize(nc);
-    const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
+    cm_hits_.clear();
+    for (long e = 0; e < nz; ++e)
+      if (reaches[e]) cm_hits_.push_back(static_cast<std::uint32_t>(e));
+    const std::size_t ns = cm_nodes_.size();
     cm_.assign(kCm * ns, 0.0);
     // The sums at each slot, in particle order: Mc dv0, d and the particles' mass.
-    for (std::size_t q = 0; q < np; ++q) {
+    for (const std::uint32_t q : cm_hits_) {
       const double* N = cm_pN_.data() + K * q;
       const int* sls = cm_ps_.data() + K * q;
       const double mp = cm_pm_[q], sx = cm_s_[2 * q], sy = cm_s_[2 * q + 1];
@@ -1666,7 +1656,7 @@ void Solver::consistent_dashpots() {
     dropped.insert(dropped.end(), short_nodes.begin(), short_nodes.end());
     std::sort(dropped.begin(), dropped.end());
   }
-  const std::size_t ns = cm_nodes_.size(), np = cm_particles_.size();
+  const std::size_t ns = cm_nodes_.size();
   // The consistent mass between the slots, row by row (the diagonal left out; in each row the
   // entries in the order their first particle met them, each summed in particle order):
   // (Mc)_ij = sum_p m_p N_ip N_jp. A row holds at most the slots a particle's stencil shares
@@ -1674,7 +1664,7 @@ void Solver::consistent_dashpots() {
   cm_cnt_.assign(ns, 0);
   cm_col_.resize(kCmRow * ns);
   cm_w_.resize(kCmRow * ns);
-  for (std::size_t q = 0; q < np; ++q) {
+  for (const std::uint32_t q : cm_hits_) {
     const double* N = cm_pN_.data() + K * q;
     const int* sls = cm_ps_.data() + K * q;
     for (int a = 0; a < K; ++a) {

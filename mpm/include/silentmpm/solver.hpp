@@ -284,8 +284,9 @@ class Solver {
   std::vector<std::uint8_t> cm_cell_;   // per cell: 1 in the zone, 2 reaches a listed node
   std::vector<long> cm_cells_;          // the cells marked 1
   std::vector<long> cm_reach_;          // and 2
-  std::vector<std::uint32_t> cm_particles_;
-  std::vector<double> cm_pN_;           // their shape values (K per particle)
+  std::vector<std::uint8_t> cm_reaches_;  // per zone particle: whether it reaches a listed node
+  std::vector<std::uint32_t> cm_hits_;  // the places in the zone of those that do
+  std::vector<double> cm_pN_;           // per zone particle: its shape values (K)
   std::vector<int> cm_ps_;              // and their nodes' slots (-1: none)
   std::vector<double> cm_pm_;           // their masses
   std::vector<double> cm_s_;            // 2 per particle: its sum N . dv (scratch)
