@@ -882,7 +882,7 @@ void Solver::pml_loads() {
     for (int a = 0; a < K; ++a) {
       grid.fx[nodes[a]] += f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
       grid.fy[nodes[a]] += f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
-      if (!nodal || cm * N[a] == 0) continue;  // no block: the plain update
+      if (!nodal) continue;
       grid.cxx(nodes[a]) += cm * N[a];
       grid.cyy(nodes[a]) += cm * N[a];
       add_dashpot_node(nodes[a]);
@@ -1294,6 +1294,9 @@ void Solver::grid_update() {
     const int closure = update_dashpot_node(i, delayed, gx, gy);
     if (!track) return;
     double* r = rec_all + kDn * dashpot_index_[i];
+    const double* c = grid.dash.data() + Grid::kDash * i;
+    r[kDnWeight] = c[3];
+    if (c[3] <= 0) return;  // no silent layer's weight (a damping band's node): not in the solve
     r[kDnM] = m[i];
     r[kDnFx] = fx[i];
     r[kDnFy] = fy[i];
@@ -1301,11 +1304,9 @@ void Solver::grid_update() {
     r[kDnVy] = vy[i];
     r[kDnUx] = ux[i];
     r[kDnUy] = uy[i];
-    const double* c = grid.dash.data() + Grid::kDash * i;
     r[kDnCxx] = c[0];
     r[kDnCxy] = c[1];
     r[kDnCyy] = c[2];
-    r[kDnWeight] = c[3];
     // Strained with v+: not in the solve.
     const int skip = !updated_weight_.empty() && updated_weight_[i] > 0 ? kDnSkip : 0;
     r[kDnFlags] = static_cast<double>((fix[i] & 3) | skip | closure);
