@@ -1132,18 +1132,15 @@ void Solver::apply_loads() {
         grid.cyy(nodes[a]) += wn * byy;
         add_dashpot_node(nodes[a]);
       }
-      if (updated) {  // (w N rho) c_d
-        const Material& mq = materials[p.group[L.idx[q]]];
+      if (!updated && !delayed && !consistent) continue;
+      // The entry's material (one material: no read of the particle's group).
+      const Material& mq = materials.size() == 1 ? materials[0] : materials[p.group[L.idx[q]]];
+      if (updated)  // (w N rho) c_d
         for (int a = 0; a < K; ++a) updated_weight_[nodes[a]] += L.w[q] * N[a] * mq.rho * mq.cd;
-      }
-      if (delayed) {
-        const Material& mq = materials[p.group[L.idx[q]]];
+      if (delayed)
         for (int a = 0; a < K; ++a) delay_rho_[nodes[a]] += L.w[q] * N[a] * mq.rho;
-      }
-      if (consistent) {
-        const Material& mq = materials[p.group[L.idx[q]]];
+      if (consistent)
         for (int a = 0; a < K; ++a) grid.dash_weight(nodes[a]) += L.w[q] * N[a] * mq.rho * mq.cd;
-      }
     }
   }
   // Damping layers: C_i += alpha_q m_q N_i(x_q) I, at the particle (a volume term).
