@@ -1025,6 +1025,39 @@ double sawtooth_energy_fraction(const Solver& s, int cells) {
 //   * with the end 0.03 h off the grid line the silent end reflects 7.1 % under MUSL, 0.27 %
 //     under USL: the pattern's frequency grows with the offset and meets the pulse's there.
 // Bounds: the ratios and levels above with a margin each.
+// An end on a node line carries its dashpots on its own node column only. Its anchors' bilinear
+// weights put nothing on the column beyond (void; its shares go to the end's nodes) nor, while
+// the end is at rest or moves out, on the column inside: nodes with a zero block take the plain
+// update and are no dashpot nodes (they were half the edge's, each updated by the block's
+// formula, recorded and booked every step). Checked every step while a compressive pulse
+// reaches the end and moves it outward, under MUSL (the dashpot solve) and USL.
+TEST(SilentLayer, EndOnANodeLineCarriesDashpotsOnItsNodesOnly) {
+  for (const Scheme sc : {Scheme::MUSL, Scheme::USL}) {
+    ColumnSpec c;
+    c.cells = 30;
+    c.scheme = sc;
+    c.fn = sin2_pulse(1e-6, 0.5e-6);
+    auto s = make_column(c);
+    const long end = c.cells + 2, nnx = s->grid.nnx;  // the end's node column (x0 = -2 h)
+    long steps_moved = 0;
+    for (int n = 0; n < 400; ++n) {
+      s->step();
+      long on_end = 0, elsewhere = 0;
+      for (long i = 0; i < static_cast<long>(s->grid.nodes()); ++i) {
+        if (!(s->grid.fix[i] & Grid::kDashpotNode)) continue;
+        if (i % nnx == end && s->grid.cxx(i) > 0) ++on_end;
+        else ++elsewhere;
+      }
+      ASSERT_EQ(on_end, c.height + 1) << "step " << n;
+      ASSERT_EQ(elsewhere, 0) << "step " << n;
+      // The end's particles have moved out (by more than 1e-6 of a cell) at least once.
+      const auto& L = s->silents[0].layer;
+      if (s->p.x[L.idx[0]] - s->p.x0[L.idx[0]] > 1e-6 * c.h) ++steps_moved;
+    }
+    EXPECT_GT(steps_moved, 100);
+  }
+}
+
 TEST(SilentLayer, MuslOnePpcEndsExciteTheOddEvenMode) {
   auto refl = [](Scheme sc, int w, double amplitude, double offset) {
     ColumnSpec c;
