@@ -1293,7 +1293,7 @@ void Solver::grid_update() {
     double* r = rec_all + kDn * dashpot_index_[i];
     const double* c = grid.dash.data() + Grid::kDash * i;
     r[kDnWeight] = c[3];
-    if (c[3] <= 0) return;  // no silent layer's weight (a damping band's node): not in the solve
+    if (c[3] <= 0) return;  // no silent layer's weight (a band's or PML's node): not in the solve
     r[kDnM] = m[i];
     r[kDnFx] = fx[i];
     r[kDnFy] = fy[i];
