@@ -1295,25 +1295,24 @@ class Builder {
 
     if (type == "pml") {
       // A band inside a side of a box body: the stretching acts along the side's normal, which
-      // must be an axis (docs/physics.md section 9.3). USL, or MUSL at 4 and 9 particles per
-      // cell with one velocity field (the layer damps its particles; at 1 particle per cell a
-      // slow mode of MUSL's grows in it); USF grows.
-      if (s_->opt.scheme == Scheme::USF)
-        o.fail("type", "a pml on particles needs scheme.update \"USL\" or \"MUSL\" (under USF the "
-                       "layer grows within a few thousand steps; docs/physics.md section 9.3)");
-      if (s_->opt.scheme == Scheme::MUSL && s_->contact.multi())
-        o.fail("type", "a pml on particles under scheme.update \"MUSL\" is not available with "
-                       "multi-field contact (use \"USL\")");
+      // must be an axis (docs/physics.md section 9.3). USL, or MUSL and USF at 4 and 9 particles
+      // per cell with one velocity field (the layer damps its particles; at 1 particle per cell
+      // a slow mode of those schemes grows in it).
+      const bool damps = s_->opt.scheme != Scheme::USL;
+      const std::string scheme = s_->opt.scheme == Scheme::USF ? "USF" : "MUSL";
+      if (damps && s_->contact.multi())
+        o.fail("type", "a pml on particles under scheme.update \"" + scheme + "\" is not "
+                       "available with multi-field contact (use \"USL\")");
       PmlBand band;
       band.name = name;
       band.body = body_ref(o);
       const BodySpec& b = bodies_[band.body];
-      if (s_->opt.scheme == Scheme::MUSL && b.ppc < 4)
-        o.fail("type", "a pml on particles under scheme.update \"MUSL\" needs 4 or 9 particles per "
-                       "cell in body \"" + b.name + "\" (it has " + std::to_string(b.ppc) +
-                       "; at 1 a slow mode of MUSL's grows in the layer): give the body "
-                       "\"particles_per_cell\": 4, or use scheme.update \"USL\" (docs/physics.md "
-                       "section 9.3)");
+      if (damps && b.ppc < 4)
+        o.fail("type", "a pml on particles under scheme.update \"" + scheme + "\" needs 4 or 9 "
+                       "particles per cell in body \"" + b.name + "\" (it has " +
+                       std::to_string(b.ppc) + "; at 1 a slow mode of " + scheme + "'s grows in "
+                       "the layer): give the body \"particles_per_cell\": 4, or use "
+                       "scheme.update \"USL\" (docs/physics.md section 9.3)");
       std::string side;  // "left side" or the physical curve's label
       double extent = 0;
       if (o.has("curve") || b.surface >= 0) {

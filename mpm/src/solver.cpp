@@ -936,20 +936,21 @@ void Solver::pml_pic() {
   }
 }
 
-// Under MUSL the layer's damping m_p (d_x + d_y) v acts on its particles, not on the nodes:
-// trapezoidal, v' = [(1 - a) v + N dv] / (1 + a) with a = (d_x + d_y) dt / 2 and N dv g2p's
-// increment. pml_pic took the particle velocity to (1 - a) v / (1 + a) before g2p; here the
-// increment is divided by 1 + a, the re-mapped momenta lose what the particles lost (so the
-// stress update strains them with their damped velocities) and the damping's work,
-// dt m_p (d_x + d_y) |(v + v')/2|^2, is booked as absorbed. On the nodes, whose trapezoidal mean
-// is not the particles' (docs/physics.md section 4), MUSL's layer grew within 2 000 steps; on
-// the particles it is stable at 4 and 9 particles per cell (docs/physics.md section 9.3).
-// Serial in layer order: the sums into the nodes and the work in one order.
+// Under MUSL and USF the layer's damping m_p (d_x + d_y) v acts on its particles, not on the
+// nodes: trapezoidal, v' = [(1 - a) v + N dv] / (1 + a) with a = (d_x + d_y) dt / 2 and N dv
+// g2p's increment. pml_pic took the particle velocity to (1 - a) v / (1 + a) before g2p; here the
+// increment is divided by 1 + a, the re-mapped momenta (`remapped`: MUSL, and USF when it books
+// the loads' power with them) lose what the particles lost (so that MUSL's stress update strains
+// them with their damped velocities; USF strains them so at the next step's start) and the
+// damping's work, dt m_p (d_x + d_y) |(v + v')/2|^2, is booked as absorbed. On the nodes, whose
+// trapezoidal mean is not the particles' (docs/physics.md section 4), MUSL's layer grew within
+// 2 000 steps; on the particles it is stable at 4 and 9 particles per cell (docs/physics.md
+// section 9.3). Serial in layer order: the sums into the nodes and the work in one order.
 template <class S>
-void Solver::pml_damping() {
+void Solver::pml_damping(bool remapped) {
   constexpr int K = S::kNodes;
   if (!body_of_group_.empty())
-    throw std::logic_error("pml_damping: a layer under MUSL with one velocity field per body");
+    throw std::logic_error("pml_damping: a particle-damped layer with one velocity field per body");
   double work = 0;
   for (std::size_t q = 0; q < pml.layer.idx.size(); ++q) {
     const uint32_t k = pml.layer.idx[q];
@@ -961,11 +962,12 @@ void Solver::pml_damping() {
     p.vx[k] = ux;
     p.vy[k] = uy;
     const double m = p.mass[k];
-    for (int b = 0; b < K; ++b) {
-      const long n = pml.nodes[K * q + b];
-      grid.qx[n] -= m * pml.N[K * q + b] * lx;
-      grid.qy[n] -= m * pml.N[K * q + b] * ly;
-    }
+    if (remapped)
+      for (int b = 0; b < K; ++b) {
+        const long n = pml.nodes[K * q + b];
+        grid.qx[n] -= m * pml.N[K * q + b] * lx;
+        grid.qy[n] -= m * pml.N[K * q + b] * ly;
+      }
     const double bx = 0.5 * (vd[0] + ux), by = 0.5 * (vd[1] + uy);
     work += m * 2 * a * (bx * bx + by * by);
   }
@@ -2248,7 +2250,7 @@ void Solver::step_with() {
   switch (sc) {
     case Scheme::MUSL:
       g2p<S>(true, false);
-      if (pml.active() && pml_damps_particles()) pml_damping<S>();
+      if (pml.active()) pml_damping<S>(true);
       remapped_velocities(true);
       if (remapped_power) boundary_work<S>(true);
       update_stress<S>(true, false, true);
@@ -2261,6 +2263,7 @@ void Solver::step_with() {
       // The particles move here; the loads' power is taken with the velocity they carry back,
       // their momenta re-mapped as MUSL's (unless a hook keeps v+).
       g2p<S>(remapped_power, true);
+      if (pml.active()) pml_damping<S>(remapped_power);
       if (remapped_power) {
         remapped_velocities(false);
         boundary_work<S>(true);

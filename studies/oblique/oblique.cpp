@@ -20,7 +20,7 @@ using namespace smpm;
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr, "usage: oblique OUTDIR [--angles \"0 15 30 45 60\"] [--fwhm 16] "
-                         "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] [--ppc 1|4|9] [--scheme usl|musl] "
+                         "[--degree 1] [--threads N] [--shape bilinear|gimp|bspline] [--ppc 1|4|9] [--scheme usl|musl|usf] "
                          "[--boundary lk|kv|damping|pml|delayed] [--delta CELLS] [--band CELLS] [--r0 R] [--alpha 1/S] [--power N] [--parallel P] [--beta F] [--receiver CELLS]\n");
     return argc < 2 ? 1 : 0;
   }
@@ -81,8 +81,8 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--scheme") {
       base.scheme = argv[i + 1];
-      if (base.scheme != "usl" && base.scheme != "musl") {
-        std::fprintf(stderr, "oblique: --scheme must be usl or musl\n");
+      if (base.scheme != "usl" && base.scheme != "musl" && base.scheme != "usf") {
+        std::fprintf(stderr, "oblique: --scheme must be usl, musl or usf\n");
         return 1;
       }
     } else if (a == "--shape") {
@@ -103,9 +103,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "oblique: --receiver must be between 0 and 150 cells from the boundary\n");
     return 1;
   }
-  if (method == "mpm" && base.boundary == "pml" && base.scheme == "musl" && base.ppc == 1) {
-    std::fprintf(stderr, "oblique: --boundary pml under --scheme musl needs --ppc 4 or 9 (at 1 a "
-                         "slow mode of MUSL's grows in the layer)\n");
+  if (method == "mpm" && base.boundary == "pml" && (base.scheme == "musl" || base.scheme == "usf") &&
+      base.ppc == 1) {
+    std::fprintf(stderr, "oblique: --boundary pml under --scheme %s needs --ppc 4 or 9 (at 1 a "
+                         "slow mode of the scheme's grows in the layer)\n", base.scheme.c_str());
     return 1;
   }
   if (method == "fem" && (base.ppc != 1 || !base.scheme.empty())) {
@@ -127,7 +128,7 @@ int main(int argc, char** argv) {
                             (base.ppc == 1 ? "" : "s") + " per cell, " +
                             (base.scheme == "usl" || (base.scheme.empty() && base.boundary == "pml")
                                  ? "USL"
-                                 : "MUSL") +
+                                 : base.scheme == "usf" ? "USF" : "MUSL") +
                             ", nodal semi-implicit silent layer a = b = 1, CFL 0.3; extended-domain "
                             "differencing (div u, curl u: the sampled velocity's div and curl "
                             "integrated over the steps)";

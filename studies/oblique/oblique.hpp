@@ -55,7 +55,7 @@ struct Setup {
   int taper = 60;          // cos^2 taper beyond it (cells)
   smpm::ShapeKind shape = smpm::ShapeKind::Bilinear;  // MPM grid shape functions
   int ppc = 1;             // MPM: particles per cell, 1, 4 or 9
-  std::string scheme;      // MPM: "usl" or "musl"; empty: MUSL, USL with a pml
+  std::string scheme;      // MPM: "usl", "musl" or "usf"; empty: MUSL, USL with a pml
   // The right side of run A: "lk" (dashpots), "kv" (dashpots and springs with `delta` cells),
   // "damping" (a graded damping band of `band` cells with r0 and power (default 2), then the dashpots),
   // "pml" (FEM: a perfectly matched layer of `band` cells with r0, power (default 2) and alpha, then the

@@ -60,10 +60,12 @@ inline Result measure_mpm(const Setup& su) {
       }
     }
     s->opt.threads = su.threads;
-    // The particle layer's scheme by default (both runs): USL; MUSL takes it at 4 and 9 ppc.
+    // The particle layer's scheme by default (both runs): USL; MUSL and USF take it at 4 and 9
+    // ppc.
     if (su.boundary == "pml") s->opt.scheme = Scheme::USL;
     if (su.scheme == "usl") s->opt.scheme = Scheme::USL;
     if (su.scheme == "musl") s->opt.scheme = Scheme::MUSL;
+    if (su.scheme == "usf") s->opt.scheme = Scheme::USF;
     s->opt.shape = su.shape;
     s->dt = dt;
     s->finalize();

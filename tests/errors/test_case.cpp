@@ -266,12 +266,23 @@ std::vector<Bad> bad_cases() {
        },
        "boundaries[2].type: a pml on particles under scheme.update \"MUSL\" is not available "
        "with multi-field contact"},
-      {"pml_under_usf",
+      {"pml_under_usf_at_one_particle_per_cell",
        [](ojson& j) {
          j["scheme"]["update"] = "USF";
+         j["bodies"][0]["particles_per_cell"] = 1;
+         bnd(j, 1)["width"] = 0.001;
          bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002}};
        },
-       "boundaries[2].type: a pml on particles needs scheme.update \"USL\" or \"MUSL\""},
+       "boundaries[2].type: a pml on particles under scheme.update \"USF\" needs 4 or 9 "
+       "particles per cell in body \"plate\" (it has 1;"},
+      {"pml_under_usf_multi_contact",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USF";
+         j["contact"] = {{"type", "multi"}};
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002}};
+       },
+       "boundaries[2].type: a pml on particles under scheme.update \"USF\" is not available "
+       "with multi-field contact"},
       {"pml_parallel_not_below_one",
        [](ojson& j) {
          j["scheme"]["update"] = "USL";

@@ -129,6 +129,8 @@ TEST(MpmPml, LambHalfSpaceAgainstExtendedDomain) { lamb("USL", 1, "usl"); }
 // 4 ppc: 0.0025, 0.0026, 0.0039).
 TEST(MpmPml, LambHalfSpaceUnderMusl) { lamb("MUSL", 4, "musl"); }
 
+TEST(MpmPml, LambHalfSpaceUnderUsf) { lamb("USF", 4, "usf"); }
+
 namespace {
 
 

@@ -153,8 +153,8 @@ struct PmlLayer {
   // evaluated once when the loads are assembled; the positions do not change before g2p.
   std::vector<long> nodes;
   std::vector<double> N, dNx, dNy;
-  // Under MUSL, within a step (pml_pic to pml_damping): 4 per particle, the velocity before
-  // its damping and after the damping of that velocity.
+  // Under MUSL and USF, within a step (pml_pic to pml_damping): 4 per particle, the velocity
+  // before its damping and after the damping of that velocity.
   std::vector<double> vd;
   bool active() const { return !layer.ids.empty(); }
 };

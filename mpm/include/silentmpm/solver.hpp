@@ -426,10 +426,11 @@ class Solver {
   template <class S> void pml_shapes();
   template <class S> void pml_loads();
   template <class S> void pml_pic();
-  template <class S> void pml_damping();
-  // The perfectly matched layer's damping acts on its particles (MUSL) or through the nodal
-  // dashpot blocks (USL, USF).
-  bool pml_damps_particles() const { return opt.scheme == Scheme::MUSL; }
+  template <class S> void pml_damping(bool remapped);
+  // The perfectly matched layer's damping acts on its particles (MUSL and USF, which strain them
+  // with their mapped velocities) or through the nodal dashpot blocks (USL, which strains them
+  // with the updated grid velocity).
+  bool pml_damps_particles() const { return opt.scheme != Scheme::USL; }
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
   int update_dashpot_node(long i, bool delayed, double gx, double gy);
