@@ -1307,12 +1307,6 @@ class Builder {
       band.name = name;
       band.body = body_ref(o);
       const BodySpec& b = bodies_[band.body];
-      if (damps && b.ppc < 4)
-        o.fail("type", "a pml on particles under scheme.update \"" + scheme + "\" needs 4 or 9 "
-                       "particles per cell in body \"" + b.name + "\" (it has " +
-                       std::to_string(b.ppc) + "; at 1 a slow mode of " + scheme + "'s grows in "
-                       "the layer): give the body \"particles_per_cell\": 4, or use "
-                       "scheme.update \"USL\" (docs/physics.md section 9.3)");
       std::string side;  // "left side" or the physical curve's label
       double extent = 0;
       if (o.has("curve") || b.surface >= 0) {
@@ -1337,6 +1331,27 @@ class Builder {
       o.ge("power", band.power, 0);
       band.alpha = o.num("alpha", 0.0);
       o.ge("alpha", band.alpha, 0);
+      if (damps && b.ppc < 4) {
+        // At 1 particle per cell MUSL and USF carry slow backward waves (the odd-even branch
+        // near the grid's shortest wavelength), which a stretching amplifies; a layer of enough
+        // cells with a frequency shift above their frequencies leaves them alone
+        // (docs/physics.md section 9.3).
+        const std::string why = "a pml on particles under scheme.update \"" + scheme +
+                                "\" at 1 particle per cell (body \"" + b.name + "\") needs ";
+        const std::string or_else = " (slow backward waves of the scheme grow in a thinner or "
+                                    "unshifted layer; put LK behind it), or give the body "
+                                    "\"particles_per_cell\": 4, or use scheme.update \"USL\" "
+                                    "(docs/physics.md section 9.3)";
+        const double h = s_->grid.h;
+        if (!(band.width >= kPmlOnePpcCells * h * (1 - 1e-9)))
+          o.fail("width", why + "width >= " + std::to_string(kPmlOnePpcCells) + " cells (" +
+                              fmt(kPmlOnePpcCells * h) + " m), got " + fmt(band.width) + or_else);
+        const double cd = s_->materials[static_cast<std::size_t>(b.material)].cd;
+        const double need = pml_one_ppc_alpha(cd, band.r0, band.power, band.width, h);
+        if (!(band.alpha >= need))
+          o.fail("alpha", why + "alpha >= " + fmt(kPmlOnePpcShift) + " sqrt(d0 c_d / h) = " +
+                              fmt(need) + " 1/s for this layer, got " + fmt(band.alpha) + or_else);
+      }
       band.parallel = o.num("parallel", 0.0);
       o.ge("parallel", band.parallel, 0);
       o.lt("parallel", band.parallel, 1);

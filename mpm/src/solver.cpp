@@ -260,7 +260,7 @@ void Solver::finalize() {
       const double pos = b.axis == 0 ? p.x[k] : p.y[k];
       const double s = (pos - (b.c - b.side * b.width)) * b.side / b.width;  // 0 at the inner edge
       if (!(s > 0)) continue;
-      const double d0 = -(b.power + 1) * m.cd * std::log(b.r0) / (2 * b.width);
+      const double d0 = pml_d0(m.cd, b.r0, b.power, b.width);
       const double d = d0 * std::pow(std::min(s, 1.0), b.power);
       (b.axis == 0 ? dx : dy) += d;
       (b.axis == 0 ? dy : dx) += b.parallel * d;  // a multi-axial layer's share along the side

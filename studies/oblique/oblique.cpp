@@ -105,9 +105,14 @@ int main(int argc, char** argv) {
   }
   if (method == "mpm" && base.boundary == "pml" && (base.scheme == "musl" || base.scheme == "usf") &&
       base.ppc == 1) {
-    std::fprintf(stderr, "oblique: --boundary pml under --scheme %s needs --ppc 4 or 9 (at 1 a "
-                         "slow mode of the scheme's grows in the layer)\n", base.scheme.c_str());
-    return 1;
+    const double cd = oblique::Plane(base).mat.cd;
+    const double need = pml_one_ppc_alpha(cd, base.r0, base.power, base.band * base.h, base.h);
+    if (base.band < kPmlOnePpcCells || !(base.alpha >= need)) {
+      std::fprintf(stderr, "oblique: --boundary pml under --scheme %s at --ppc 1 needs --band >= %d "
+                           "and --alpha >= %.6g (slow backward waves of the scheme grow in the "
+                           "layer), or --ppc 4 or 9\n", base.scheme.c_str(), kPmlOnePpcCells, need);
+      return 1;
+    }
   }
   if (method == "fem" && (base.ppc != 1 || !base.scheme.empty())) {
     std::fprintf(stderr, "oblique: --ppc and --scheme are the particles': --method mpm only\n");

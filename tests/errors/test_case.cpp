@@ -254,10 +254,10 @@ std::vector<Bad> bad_cases() {
          j["scheme"]["update"] = "MUSL";
          j["bodies"][0]["particles_per_cell"] = 1;
          bnd(j, 1)["width"] = 0.001;
-         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002}};
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "left"}, {"width", 0.01}};
        },
-       "boundaries[2].type: a pml on particles under scheme.update \"MUSL\" needs 4 or 9 "
-       "particles per cell in body \"plate\" (it has 1;"},
+       "boundaries[2].alpha: a pml on particles under scheme.update \"MUSL\" at 1 particle per "
+       "cell (body \"plate\") needs alpha >= 0.04 sqrt(d0 c_d / h) = "},
       {"pml_under_musl_multi_contact",
        [](ojson& j) {
          j["scheme"]["update"] = "MUSL";
@@ -271,10 +271,20 @@ std::vector<Bad> bad_cases() {
          j["scheme"]["update"] = "USF";
          j["bodies"][0]["particles_per_cell"] = 1;
          bnd(j, 1)["width"] = 0.001;
-         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002}};
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "left"}, {"width", 0.01}};
        },
-       "boundaries[2].type: a pml on particles under scheme.update \"USF\" needs 4 or 9 "
-       "particles per cell in body \"plate\" (it has 1;"},
+       "boundaries[2].alpha: a pml on particles under scheme.update \"USF\" at 1 particle per "
+       "cell (body \"plate\") needs alpha >= 0.04 sqrt(d0 c_d / h) = "},
+      {"pml_under_usf_at_one_particle_per_cell_thin",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USF";
+         j["bodies"][0]["particles_per_cell"] = 1;
+         bnd(j, 1)["width"] = 0.001;
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002},
+                      {"alpha", 1e9}};
+       },
+       "boundaries[2].width: a pml on particles under scheme.update \"USF\" at 1 particle per "
+       "cell (body \"plate\") needs width >= 10 cells ("},
       {"pml_under_usf_multi_contact",
        [](ojson& j) {
          j["scheme"]["update"] = "USF";

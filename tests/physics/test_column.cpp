@@ -770,6 +770,52 @@ TEST(Pml, NoGrowthOver100000StepsMusl) { pml_long_runs_4ppc(Scheme::MUSL); }
 // 2.3e-5; the account 1.5e-3 to 2.9e-3 of the work.
 TEST(Pml, NoGrowthOver100000StepsUsf) { pml_long_runs_4ppc(Scheme::USF); }
 
+// MUSL and USF at 1 ppc: the schemes' odd-even branch (a particle strained by its two
+// neighbours' velocities) carries slow waves whose group velocity opposes their phase velocity,
+// and a stretching amplifies such waves (docs/physics.md section 9.3). A 10-cell layer with the
+// frequency shift pml_one_ppc_alpha (2.4e5 1/s here), LK behind: 10^5 steps after the pulse the
+// energy left decays (measured: P 4.8e-4 of what the pulse left at 10^4 steps, at most 4.0e-4
+// from 5 * 10^4 on, 3.2e-4 at the end; S 2.7e-4, 1.4e-4, 7.4e-5; both schemes alike), and the
+// column reflects (CFL 0.3, 8-cell pulses) 8.1e-5 (P) and 2.1e-4 (S) of the energy under both
+// (unshifted, before the growth: 4.9e-5 and 2.5e-5). Without the shift the S column stops on the
+// energy check after 3.2 * 10^4 steps.
+TEST(Pml, OnePpcMuslUsfNeedTheShift) {
+  const Material m = tungsten();
+  for (const Scheme sc : {Scheme::USF, Scheme::MUSL})
+    for (const bool shear : {false, true}) {
+      const char* what = shear ? "S" : "P";
+      ColumnSpec c = pml_long_column(shear, 0, End::Silent);
+      c.cells = 60;
+      c.scheme = sc;
+      c.pml_alpha = pml_one_ppc_alpha(m.cd, 1e-3, 2, 10 * c.h, c.h);
+      const LongRun r = long_run(c);
+      std::printf("  [%s, %s, alpha %.3g] energy left after 1e4 steps %.3e, from 5e4 on at most "
+                  "%.3e, at 1.1e5 %.3e; imbalance %.2e of the work\n", scheme_name(sc), what,
+                  c.pml_alpha, r.e1, r.late_max, r.elast, r.imbalance);
+      EXPECT_LE(r.late_max, 1e-3) << scheme_name(sc) << " " << what;
+      EXPECT_LE(r.elast, 0.9 * r.late_max) << scheme_name(sc) << " " << what;
+      EXPECT_LE(std::abs(r.imbalance), 0.01) << scheme_name(sc) << " " << what;
+      ColumnSpec f = pml_column(sc, 1, 10, shear);
+      f.end = End::Silent;
+      f.pml_alpha = c.pml_alpha;
+      const double ratio = reflected_energy_ratio(f, 8);
+      std::printf("  [%s, %s] reflected energy %.3e\n", scheme_name(sc), what, ratio);
+      EXPECT_LE(ratio, 3e-4) << scheme_name(sc) << " " << what;
+    }
+  // The same S column without the shift grows.
+  ColumnSpec c = pml_long_column(true, 0, End::Silent);
+  c.cells = 60;
+  c.scheme = Scheme::USF;
+  bool grew = false;
+  try {
+    const LongRun r = long_run(c);
+    grew = r.emax > 10;
+  } catch (const std::runtime_error& e) {
+    grew = std::string(e.what()).find("unstable") != std::string::npos;
+  }
+  EXPECT_TRUE(grew) << "USF, S, 1 ppc, alpha 0";
+}
+
 // Long runs of the Kelvin-Voigt end and of the damping band (LK end behind it): after the pulse,
 // 10^5 steps at CFL 0.5 under each scheme, P and S. The energy left in the column (kinetic plus
 // elastic, the springs' included), as a fraction of what it held when the pulse had left, is

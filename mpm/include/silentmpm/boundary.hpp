@@ -11,6 +11,7 @@
 //    With springs (the Kelvin-Voigt or viscous-spring boundary, docs/physics.md section 9.1) the
 //    layer also carries t_s = -[ k_n (u.n) n + k_t (u - (u.n) n) ], u the displacement of the
 //    layer particle's anchor since the start, k_n = alpha_n rho c_d^2 / delta, k_t = alpha_t rho c_s^2 / delta.
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -134,6 +135,20 @@ inline constexpr const char* kPmlGrowthHint =
 
 // The power of the layer particles' PIC share in their depth (Solver::pml_pic).
 inline constexpr double kPmlPicPower = 5;
+
+// Under MUSL and USF at 1 particle per cell the scheme carries slow backward waves (its odd-even
+// branch), which a stretching amplifies; a layer there needs at least kPmlOnePpcCells cells and a
+// frequency shift alpha of at least pml_one_ppc_alpha (docs/physics.md section 9.3).
+inline constexpr int kPmlOnePpcCells = 10;
+inline constexpr double kPmlOnePpcShift = 0.04;
+// The layer's largest d, (power + 1) c_d ln(1/r0) / (2 width), as Solver::finalize sets it.
+inline double pml_d0(double cd, double r0, double power, double width) {
+  return -(power + 1) * cd * std::log(r0) / (2 * width);
+}
+// The least alpha under MUSL and USF at 1 particle per cell: kPmlOnePpcShift sqrt(d0 c_d / h).
+inline double pml_one_ppc_alpha(double cd, double r0, double power, double width, double h) {
+  return kPmlOnePpcShift * std::sqrt(pml_d0(cd, r0, power, width) * cd / h);
+}
 
 // The particles of every band of a solver, with their stretchings and memories (built by
 // Solver::finalize; a particle in two bands, at a corner, has both d_x and d_y).
