@@ -131,7 +131,8 @@ struct PmlBand {
 
 // What the energy checks of both methods add when a run with a PML blows up.
 inline constexpr const char* kPmlGrowthHint =
-    "a pml between two free surfaces needs \"parallel\", docs/physics.md section 9.3";
+    "a pml between two free surfaces needs \"alpha\" >= 0.04 sqrt(d0 c_d / h) or \"parallel\", "
+    "docs/physics.md section 9.3";
 
 // The power of the layer particles' PIC share in their depth (Solver::pml_pic).
 inline constexpr double kPmlPicPower = 5;
