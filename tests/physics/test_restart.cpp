@@ -100,16 +100,20 @@ TEST(Restart, MpmDelayedEdgeBitIdentical) {
   }
 }
 
-// A perfectly matched layer on particles (USL): its displacements and memories are state.
+// A perfectly matched layer on particles (USL, and MUSL and USF at 4 ppc, whose layer damps its
+// particles within each step): its displacements and memories are state.
 TEST(Restart, MpmPmlBitIdentical) {
   using namespace hybrid_case_testing;
-  json c = small_plate(4, 240);
-  c["scheme"]["update"] = "USL";
-  c["boundaries"].push_back({{"type", "pml"}, {"body", "plate"}, {"side", "top"},
-                             {"width", 5 * h}, {"alpha", 1e5}});
-  c["output"]["snapshots"] = 4;
-  const long from = expect_restart_identical("mpm_pml", c, "checkpoint_every", 100);
-  EXPECT_EQ(from, 200);
+  for (const char* scheme : {"USL", "MUSL", "USF"}) {
+    json c = small_plate(4, 240);
+    c["scheme"]["update"] = scheme;
+    c["boundaries"].push_back({{"type", "pml"}, {"body", "plate"}, {"side", "top"},
+                               {"width", 5 * h}, {"alpha", 1e5}});
+    c["output"]["snapshots"] = 4;
+    const long from =
+        expect_restart_identical(std::string("mpm_pml_") + scheme, c, "checkpoint_every", 100);
+    EXPECT_EQ(from, 200) << scheme;
+  }
 }
 
 TEST(Restart, MpmMultiFieldContactWithFrictionBitIdentical) {
