@@ -1295,9 +1295,9 @@ class Builder {
 
     if (type == "pml") {
       // A band inside a side of a box body: the stretching acts along the side's normal, which
-      // must be an axis (docs/physics.md section 9.3). USL, or MUSL and USF at 4 and 9 particles
-      // per cell with one velocity field (the layer damps its particles; at 1 particle per cell
-      // a slow mode of those schemes grows in it).
+      // must be an axis (docs/physics.md section 9.3). USL, or MUSL and USF with one velocity
+      // field (the layer damps its particles), at 1 particle per cell only with enough cells and
+      // a frequency shift (below).
       const bool damps = s_->opt.scheme != Scheme::USL;
       const std::string scheme = s_->opt.scheme == Scheme::USF ? "USF" : "MUSL";
       if (damps && s_->contact.multi())

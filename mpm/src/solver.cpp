@@ -944,8 +944,9 @@ void Solver::pml_pic() {
 // them with their damped velocities; USF strains them so at the next step's start) and the
 // damping's work, dt m_p (d_x + d_y) |(v + v')/2|^2, is booked as absorbed. On the nodes, whose
 // trapezoidal mean is not the particles' (docs/physics.md section 4), MUSL's layer grew within
-// 2 000 steps; on the particles it is stable at 4 and 9 particles per cell (docs/physics.md
-// section 9.3). Serial in layer order: the sums into the nodes and the work in one order.
+// 2 000 steps; on the particles it is stable at 4 and 9 particles per cell, and at 1 with a
+// frequency shift (docs/physics.md section 9.3). Serial in layer order: the sums into the nodes
+// and the work in one order.
 template <class S>
 void Solver::pml_damping(bool remapped) {
   constexpr int K = S::kNodes;

@@ -61,7 +61,7 @@ inline Result measure_mpm(const Setup& su) {
     }
     s->opt.threads = su.threads;
     // The particle layer's scheme by default (both runs): USL; MUSL and USF take it at 4 and 9
-    // ppc.
+    // ppc, and at 1 with the frequency shift that oblique.cpp checks.
     if (su.boundary == "pml") s->opt.scheme = Scheme::USL;
     if (su.scheme == "usl") s->opt.scheme = Scheme::USL;
     if (su.scheme == "musl") s->opt.scheme = Scheme::MUSL;
