@@ -1299,7 +1299,7 @@ class Builder {
       // field (the layer damps its particles), at 1 particle per cell only with enough cells and
       // a frequency shift (below).
       const bool damps = s_->opt.scheme != Scheme::USL;
-      const std::string scheme = s_->opt.scheme == Scheme::USF ? "USF" : "MUSL";
+      const std::string scheme = scheme_name(s_->opt.scheme);
       if (damps && s_->contact.multi())
         o.fail("type", "a pml on particles under scheme.update \"" + scheme + "\" is not "
                        "available with multi-field contact (use \"USL\")");
