@@ -74,6 +74,12 @@ struct Solver::Impl {
     std::vector<double> kl, km, dx, dy;
     std::vector<std::uint32_t> kind;
     std::vector<double> xi;                  // 4 per cell and point
+    // Axis-aligned Q1 cells (a box mesh's): per shape, whether its table is that of such a cell
+    // (tensor_ok, found at the first step from grad: pml_tensor_weights) and then the 8 weights
+    // that blend the cell's edge differences into its points' derivatives.
+    bool tensor_found = false;
+    std::vector<std::uint8_t> tensor_ok;
+    std::vector<double> tensor_w;
     std::vector<std::uint32_t> node;         // nodes with d_x + d_y > 0
     std::vector<double> m_sum, m_prod;       // m_i (d_x + d_y), m_i d_x d_y
     std::vector<double> zeta;                // 4 per node: the memories I1, I2 of u_x, then of u_y

@@ -61,6 +61,18 @@ std::size_t Solver::nodes() const {
 std::size_t Solver::matrix_blocks() const { return impl_->col.size(); }
 std::size_t Solver::stored_blocks() const { return impl_->val.size() / 4; }
 bool Solver::rows_shared() const { return !impl_->row_val.empty(); }
+std::size_t Solver::pml_cells() const {
+  return impl_->part ? impl_->part->pml_cells.size() : impl_->pml.cell.size();
+}
+std::size_t Solver::pml_tensor_cells() const {
+  const Impl::Pml& P = impl_->pml;
+  if (!P.tensor_found) return 0;
+  const Impl::Part* part = impl_->part.get();
+  const std::size_t n = part ? part->pml_cells.size() : P.cell.size();
+  std::size_t k = 0;
+  for (std::size_t cc = 0; cc < n; ++cc) k += P.tensor_ok[P.shape[part ? part->pml_cells[cc] : cc]];
+  return k;
+}
 std::size_t Solver::cells() const { return impl_->n_cells; }
 int Solver::degree() const { return impl_->degree; }
 int Solver::thread_count() const { return impl_->threads; }
@@ -243,6 +255,78 @@ inline void pml_cell(Solver::Impl::Pml& P, std::int64_t c, const double* __restr
   }
 }
 
+// Whether a Q1 shape table (4 points x 4 nodes x (d/dx, d/dy); the nodes and the points in
+// lexicographic order, x first) is that of an axis-aligned rectangle. Then, at point (i, j),
+//   du/dx = bx_j (u_1 - u_0) + tx_j (u_3 - u_2),   du/dy = ly_i (u_2 - u_0) + ry_i (u_3 - u_1)
+// (bx_j = (1 - eta_j) / a, tx_j = eta_j / a, ly_i = (1 - xi_i) / b, ry_i = xi_i / b), and w gets
+// bx_0, tx_0, bx_1, tx_1, ly_0, ry_0, ly_1, ry_1. Every entry is checked against that form, to
+// 1e-12 of the table's largest.
+bool pml_tensor_weights(const double* g, double* w) {
+  auto G = [g](int q, int a, int d) { return g[2 * (4 * q + a) + d]; };
+  for (int j = 0; j < 2; ++j) {
+    w[2 * j] = -G(2 * j, 0, 0);
+    w[2 * j + 1] = G(2 * j, 3, 0);
+  }
+  for (int i = 0; i < 2; ++i) {
+    w[4 + 2 * i] = -G(i, 0, 1);
+    w[5 + 2 * i] = G(i, 3, 1);
+  }
+  double big = 0;
+  for (int k = 0; k < 32; ++k) big = std::max(big, std::abs(g[k]));
+  if (!(big > 0)) return false;
+  for (int q = 0; q < 4; ++q)
+    for (int a = 0; a < 4; ++a) {
+      const int i = q & 1, j = q >> 1, ia = a & 1, ja = a >> 1;
+      const double ex = (ia ? 1 : -1) * (ja ? w[2 * j + 1] : w[2 * j]);
+      const double ey = (ja ? 1 : -1) * (ia ? w[5 + 2 * i] : w[4 + 2 * i]);
+      if (!(std::abs(G(q, a, 0) - ex) <= 1e-12 * big && std::abs(G(q, a, 1) - ey) <= 1e-12 * big))
+        return false;
+    }
+  return true;
+}
+
+// pml_cell<4, 4> for an axis-aligned Q1 cell (pml_tensor_weights): the same terms, the points'
+// derivatives blended from the four edge differences, and the forces gathered the same way
+// (each point's x part, summed over the points of a row, goes to the row's edge difference;
+// each y part, summed over a column, to the column's).
+inline void pml_cell_tensor(Solver::Impl::Pml& P, std::int64_t c, const double* __restrict u,
+                            const std::int32_t* __restrict dn, double* __restrict f) {
+  const std::uint32_t* cn = P.cell_nodes.data() + c * 4;
+  const double* w = P.tensor_w.data() + 8 * static_cast<std::size_t>(P.shape[c]);
+  V2 U[4];
+  for (int a = 0; a < 4; ++a) std::memcpy(&U[a], u + 2 * cn[a], sizeof(V2));
+  const V2 Db = U[1] - U[0], Dt = U[3] - U[2], Dl = U[2] - U[0], Dr = U[3] - U[1];
+  const V2 Gx[2] = {w[0] * Db + w[1] * Dt, w[2] * Db + w[3] * Dt};  // per row j
+  const V2 Gy[2] = {w[4] * Dl + w[5] * Dr, w[6] * Dl + w[7] * Dr};  // per column i
+  V2 Tx[2] = {{0.0, 0.0}, {0.0, 0.0}}, Ty[2] = {{0.0, 0.0}, {0.0, 0.0}};
+  double* __restrict xis = P.xi.data() + 16 * c;
+  const std::uint32_t* __restrict kind = P.kind.data() + 4 * c;
+  const double* __restrict packed = P.packed.data();
+  for (int q = 0; q < 4; ++q) {
+    const int i = q & 1, j = q >> 1;
+    double* xi = xis + 4 * q;
+    const double* t = packed + 8 * kind[q];  // kl, km, cx, cy
+    const double kl = t[0], km = t[1], *cx = t + 2, *cy = t + 5;
+    V2 Xx, Xy;
+    std::memcpy(&Xx, xi, sizeof(V2));
+    std::memcpy(&Xy, xi + 2, sizeof(V2));
+    const V2 Px = Xx + cx[2] * Gx[j], Py = Xy + cy[2] * Gy[i];
+    Xx = cx[0] * Px + cx[1] * Gx[j];
+    Xy = cy[0] * Py + cy[1] * Gy[i];
+    std::memcpy(xi, &Xx, sizeof(V2));
+    std::memcpy(xi + 2, &Xy, sizeof(V2));
+    Tx[j] += V2{kl, km} * Px;
+    Ty[i] += V2{-km, -kl} * Py;
+  }
+  const V2 Eb = w[0] * Tx[0] + w[2] * Tx[1], Et = w[1] * Tx[0] + w[3] * Tx[1];
+  const V2 El = w[4] * Ty[0] + w[6] * Ty[1], Er = w[5] * Ty[0] + w[7] * Ty[1];
+  const V2 F[4] = {Eb + El, Er - Eb, Et - El, -(Et + Er)};
+  for (int a = 0; a < 4; ++a) {
+    f[2 * dn[cn[a]]] += F[a][0];
+    f[2 * dn[cn[a]] + 1] += F[a][1];
+  }
+}
+
 template <int NB, int NQ>
 void pml_cells(Solver::Impl& m) {
   Solver::Impl::Pml& P = m.pml;
@@ -255,8 +339,11 @@ void pml_cells(Solver::Impl& m) {
   for (std::size_t colour = 0; colour + 1 < starts.size(); ++colour) {
     const std::int64_t c0 = starts[colour], c1 = starts[colour + 1];
 #pragma omp parallel for schedule(static) num_threads(m.threads) if (c1 - c0 >= 256)
-    for (std::int64_t cc = c0; cc < c1; ++cc)
-      pml_cell<NB, NQ>(P, part ? part->pml_cells[cc] : cc, u, dn, f);
+    for (std::int64_t cc = c0; cc < c1; ++cc) {
+      const std::int64_t c = part ? part->pml_cells[cc] : cc;
+      if (NB == 4 && NQ == 4 && P.tensor_ok[P.shape[c]]) pml_cell_tensor(P, c, u, dn, f);
+      else pml_cell<NB, NQ>(P, c, u, dn, f);
+    }
   }
 }
 
@@ -276,6 +363,15 @@ void pml_forces(Solver::Impl& m, double dt) {
       }
     }
     P.dt_coef = dt;
+  }
+  if (!P.tensor_found) {  // which shapes take the tensor-product form
+    const std::size_t shapes = P.nb > 0 && P.nq > 0 ? P.grad.size() / (2 * P.nb * P.nq) : 0;
+    P.tensor_ok.assign(shapes, 0);
+    P.tensor_w.assign(8 * shapes, 0.0);
+    if (m.spec.pml_tensor && P.nb == 4 && P.nq == 4)
+      for (std::size_t k = 0; k < shapes; ++k)
+        P.tensor_ok[k] = pml_tensor_weights(P.grad.data() + 32 * k, P.tensor_w.data() + 8 * k);
+    P.tensor_found = true;
   }
   double* __restrict f = m.dash_force.data();
   const std::int32_t* __restrict dn = m.dash_of_node.data();

@@ -121,6 +121,10 @@ struct Spec {
   // Rows of K equal bit for bit share one copy of their values (Solver::rows_shared); false
   // keeps every row's own (the tests compare the two).
   bool share_rows = true;
+  // A perfectly matched layer's axis-aligned Q1 cells take the tensor-product form of their
+  // derivatives (Solver::pml_tensor_cells); false steps every cell through its shape table (the
+  // tests compare the two).
+  bool pml_tensor = true;
 };
 
 // What a probe reads at a point: stresses, velocity, div u and curl u = du_y/dx - du_x/dy.
@@ -156,6 +160,10 @@ class Solver {
   // offset to its kind's values, rows_shared() true).
   std::size_t stored_blocks() const;
   bool rows_shared() const;
+  // The perfectly matched layers' cells (this rank's), and those whose forces take the
+  // tensor-product form (Spec::pml_tensor; known once the solver has stepped, 0 before).
+  std::size_t pml_cells() const;
+  std::size_t pml_tensor_cells() const;
   std::size_t cells() const;
   int degree() const;
   int thread_count() const;
