@@ -381,9 +381,11 @@ void pml_forces(Solver::Impl& m, double dt) {
   else if (P.nb == 9 && P.nq == 9) pml_cells<9, 9>(m);
   else pml_cells<0, 0>(m);
   const Solver::Impl::Part* part = m.part.get();
-  const std::size_t nodes = part ? part->pml_nodes.size() : P.node.size();
-  for (std::size_t jj = 0; jj < nodes; ++jj) {
-    const std::size_t j = part ? part->pml_nodes[jj] : jj;
+  // Each node its own block: in parallel, the same values.
+  const auto nodes = static_cast<std::int64_t>(part ? part->pml_nodes.size() : P.node.size());
+#pragma omp parallel for schedule(static) num_threads(m.threads) if (nodes >= 256)
+  for (std::int64_t jj = 0; jj < nodes; ++jj) {
+    const std::size_t j = part ? part->pml_nodes[jj] : static_cast<std::size_t>(jj);
     const std::uint32_t i = P.node[j];
     for (int c = 0; c < 2; ++c)  // zeta: 2 memories per component
       f[2 * dn[i] + c] += pml_mass_term(P.m_sum[j], P.m_prod[j], P.alpha, u[2 * i + c],
