@@ -381,15 +381,22 @@ void pml_forces(Solver::Impl& m, double dt) {
   else if (P.nb == 9 && P.nq == 9) pml_cells<9, 9>(m);
   else pml_cells<0, 0>(m);
   const Solver::Impl::Part* part = m.part.get();
-  // Each node its own block: in parallel, the same values.
+  // Each node its own block: in parallel, the same values (the layer's constants and arrays
+  // taken out of P first, which the stores could otherwise alias).
   const auto nodes = static_cast<std::int64_t>(part ? part->pml_nodes.size() : P.node.size());
+  const std::uint32_t* __restrict list = part ? part->pml_nodes.data() : nullptr;
+  const std::uint32_t* __restrict node = P.node.data();
+  const double* __restrict m_sum = P.m_sum.data();
+  const double* __restrict m_prod = P.m_prod.data();
+  double* __restrict zeta = P.zeta.data();
+  const double alpha = P.alpha, e_a = P.e_a, ca_a = P.ca_a, cb_a = P.cb_a;
 #pragma omp parallel for schedule(static) num_threads(m.threads) if (nodes >= 256)
   for (std::int64_t jj = 0; jj < nodes; ++jj) {
-    const std::size_t j = part ? part->pml_nodes[jj] : static_cast<std::size_t>(jj);
-    const std::uint32_t i = P.node[j];
+    const std::size_t j = list ? list[jj] : static_cast<std::size_t>(jj);
+    const std::uint32_t i = node[j];
     for (int c = 0; c < 2; ++c)  // zeta: 2 memories per component
-      f[2 * dn[i] + c] += pml_mass_term(P.m_sum[j], P.m_prod[j], P.alpha, u[2 * i + c],
-                                        P.zeta.data() + 4 * j + 2 * c, P.e_a, P.ca_a, P.cb_a);
+      f[2 * dn[i] + c] += pml_mass_term(m_sum[j], m_prod[j], alpha, u[2 * i + c],
+                                        zeta + 4 * j + 2 * c, e_a, ca_a, cb_a);
   }
 }
 
