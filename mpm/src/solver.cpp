@@ -1734,38 +1734,56 @@ void Solver::consistent_dashpots() {
     g[2 * k] = n[5] * (cxx * vb[2 * k] + cxy * vb[2 * k + 1]);
     g[2 * k + 1] = n[6] * (cxy * vb[2 * k] + cyy * vb[2 * k + 1]);
   }
+  // An iteration: each slot's o from g, then its vbar and its new g. Several ranks sum o over
+  // the halo between the two; on one process they are one pass, the new g written apart from
+  // the old (the same values in the same order). o's x and y go as a pair (one SIMD register,
+  // each lane the scalar multiply-adds).
+  using V2 = double __attribute__((vector_size(16)));
+  auto row_sum = [&](std::size_t k, const double* gg) {
+    const int* col = cm_col_.data() + kCmRow * k;
+    const double* w = cm_w_.data() + kCmRow * k;
+    V2 o = {0.0, 0.0};
+    for (int e = 0; e < cm_cnt_[k]; ++e) {
+      V2 gj;
+      std::memcpy(&gj, gg + 2 * col[e], sizeof(V2));
+      o += w[e] * gj;
+    }
+    return o;
+  };
+  auto update = [&](std::size_t k, double ox, double oy, double* gn, double& change, double& scale) {
+    const double* n = cm_node_.data() + kCmNode * k;
+    const double bx = n[0] - (n[2] * ox + n[3] * oy);
+    const double by = n[1] - (n[3] * ox + n[4] * oy);
+    change = std::max(change, std::max(std::abs(bx - vb[2 * k]), std::abs(by - vb[2 * k + 1])));
+    scale = std::max(scale, std::max(std::abs(bx), std::abs(by)));
+    vb[2 * k] = bx;
+    vb[2 * k + 1] = by;
+    gn[2 * k] = n[5] * (n[7] * bx + n[8] * by);
+    gn[2 * k + 1] = n[6] * (n[8] * bx + n[9] * by);
+  };
+  if (!dist_) cm_g_.resize(2 * ns);
   int it = 0;
   for (;; ++it) {
-    for (std::size_t k = 0; k < ns; ++k) {  // o_k = sum over the other slots of (Mc)_kj g_j
-      const int* col = cm_col_.data() + kCmRow * k;
-      const double* w = cm_w_.data() + kCmRow * k;
-      double ox = 0, oy = 0;
-      for (int e = 0; e < cm_cnt_[k]; ++e) {
-        ox += w[e] * g[2 * col[e]];
-        oy += w[e] * g[2 * col[e] + 1];
-      }
-      cm_[kCm * k + 6] = ox;
-      cm_[kCm * k + 7] = oy;
-    }
-    cm_sum(6, 2);
     double change = 0, scale = 0;
-    for (std::size_t k = 0; k < ns; ++k) {
-      const double* n = cm_node_.data() + kCmNode * k;
-      const double ox = cm_[kCm * k + 6], oy = cm_[kCm * k + 7];
-      const double bx = n[0] - (n[2] * ox + n[3] * oy);
-      const double by = n[1] - (n[3] * ox + n[4] * oy);
-      change = std::max(change, std::max(std::abs(bx - vb[2 * k]), std::abs(by - vb[2 * k + 1])));
-      scale = std::max(scale, std::max(std::abs(bx), std::abs(by)));
-      vb[2 * k] = bx;
-      vb[2 * k + 1] = by;
-      g[2 * k] = n[5] * (n[7] * bx + n[8] * by);
-      g[2 * k + 1] = n[6] * (n[8] * bx + n[9] * by);
-    }
     if (dist_) {
+      for (std::size_t k = 0; k < ns; ++k) {
+        const V2 o = row_sum(k, g.data());
+        cm_[kCm * k + 6] = o[0];
+        cm_[kCm * k + 7] = o[1];
+      }
+      cm_sum(6, 2);
+      for (std::size_t k = 0; k < ns; ++k)
+        update(k, cm_[kCm * k + 6], cm_[kCm * k + 7], g.data(), change, scale);
       double v[2] = {change, scale};
       dist_->max(v, 2);
       change = v[0];
       scale = v[1];
+    } else {
+      for (std::size_t k = 0; k < ns; ++k) {
+        const V2 o = row_sum(k, g.data());
+        update(k, o[0], o[1], cm_g_.data(), change, scale);
+      }
+      g.swap(cm_g_);
     }
     if (change <= 1e-13 * scale) break;
     if (it + 1 == kCmMaxIterations) {  // the last iterate stands; the run's summary counts it

@@ -291,6 +291,7 @@ class Solver {
   std::vector<double> cm_pm_;           // their masses
   std::vector<double> cm_s_;            // 2 per particle: its sum N . dv (scratch)
   std::vector<double> cm_dv_;           // 2 per slot: dt f / m (scratch)
+  std::vector<double> cm_g_;            // 2 per slot: an iteration's new g (scratch)
   static constexpr int kCmRow = 24;     // the slots a row of the consistent mass can hold
   std::vector<int> cm_cnt_, cm_col_;    // the consistent mass between slots, kCmRow per row
   std::vector<double> cm_w_;
