@@ -68,9 +68,9 @@ std::size_t Solver::pml_tensor_cells() const {
   const Impl::Pml& P = impl_->pml;
   if (!P.tensor_found) return 0;
   const Impl::Part* part = impl_->part.get();
-  const std::size_t n = part ? part->pml_cells.size() : P.cell.size();
   std::size_t k = 0;
-  for (std::size_t cc = 0; cc < n; ++cc) k += P.tensor_ok[P.shape[part ? part->pml_cells[cc] : cc]];
+  for (std::size_t cc = 0; cc < pml_cells(); ++cc)
+    k += P.tensor_ok[P.shape[part ? part->pml_cells[cc] : cc]];
   return k;
 }
 std::size_t Solver::cells() const { return impl_->n_cells; }
