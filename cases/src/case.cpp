@@ -1329,8 +1329,16 @@ class Builder {
       if (!(band.r0 > 0 && band.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(band.r0));
       band.power = o.num("power", 2.0);
       o.ge("power", band.power, 0);
-      band.alpha = o.num("alpha", 0.0);
-      o.ge("alpha", band.alpha, 0);
+      // "auto": the least shift the scheme needs (below), 0 where it needs none.
+      const ojson* given_alpha = o.find("alpha");
+      const bool auto_alpha = given_alpha && given_alpha->is_string();
+      if (auto_alpha) {
+        const std::string a = o.str("alpha");
+        if (a != "auto") o.fail("alpha", "must be a number >= 0 or \"auto\", got \"" + a + "\"");
+      } else {
+        band.alpha = o.num("alpha", 0.0);
+        o.ge("alpha", band.alpha, 0);
+      }
       if (damps && b.ppc < 4) {
         // At 1 particle per cell MUSL and USF carry slow backward waves (the odd-even branch
         // near the grid's shortest wavelength), which a stretching amplifies; a layer of enough
@@ -1348,9 +1356,11 @@ class Builder {
                               fmt(kPmlOnePpcCells * h) + " m), got " + fmt(band.width) + or_else);
         const double cd = s_->materials[static_cast<std::size_t>(b.material)].cd;
         const double need = pml_one_ppc_alpha(cd, band.r0, band.power, band.width, h);
+        if (auto_alpha) band.alpha = need;
         if (!(band.alpha >= need))
           o.fail("alpha", why + "alpha >= " + fmt(kPmlOnePpcShift) + " sqrt(d0 c_d / h) = " +
-                              fmt(need) + " 1/s for this layer, got " + fmt(band.alpha) + or_else);
+                              fmt(need) + " 1/s for this layer (\"auto\" takes it), got " +
+                              fmt(band.alpha) + or_else);
       }
       band.parallel = o.num("parallel", 0.0);
       o.ge("parallel", band.parallel, 0);
@@ -1358,7 +1368,9 @@ class Builder {
       for (const PmlBand& other : s_->pml_bands)
         if (other.alpha != band.alpha)
           o.fail("alpha", "every pml must have the same alpha (\"" + other.name + "\" has " +
-                              fmt(other.alpha) + ", this one " + fmt(band.alpha) + ")");
+                              fmt(other.alpha) + ", this one " + fmt(band.alpha) +
+                              (auto_alpha ? " from \"auto\"; give every pml the larger number" : "") +
+                              ")");
       o.done();
       std::size_t inside = 0;  // particles inside the band (its depth > 0 at their centre)
       if (!checking_ && !skeleton_) {
@@ -1374,7 +1386,8 @@ class Builder {
       }
       c.notes.push_back("pml \"" + name + "\" inside the " + side + " of body \"" + b.name +
                         "\": " + fmt(band.width) + " m, r0 " + fmt(band.r0) + ", power " +
-                        fmt(band.power) + ", alpha " + fmt(band.alpha) + " 1/s, " +
+                        fmt(band.power) + ", alpha " + fmt(band.alpha) + " 1/s" +
+                        (auto_alpha ? " (auto)" : "") + ", " +
                         (band.parallel > 0 ? "multi-axial share " + fmt(band.parallel) + ", " : "") +
                         std::to_string(inside) + " particles");
       s_->pml_bands.push_back(std::move(band));

@@ -320,6 +320,23 @@ std::vector<Bad> bad_cases() {
                       {"alpha", -1}};
        },
        "boundaries[2].alpha: must be >= 0"},
+      {"pml_alpha_not_auto",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "bottom"}, {"width", 0.002},
+                      {"alpha", "automatic"}};
+       },
+       "boundaries[2].alpha: must be a number >= 0 or \"auto\", got \"automatic\""},
+      {"pml_alpha_auto_differs",
+       [](ojson& j) {
+         j["bodies"][0]["particles_per_cell"] = 1;
+         bnd(j, 1)["width"] = 0.001;
+         bnd(j, 2) = {{"type", "pml"}, {"body", "plate"}, {"side", "left"}, {"width", 0.01},
+                      {"alpha", "auto"}};
+         j["boundaries"].push_back({{"type", "pml"}, {"body", "plate"}, {"side", "right"},
+                                    {"width", 0.01}, {"r0", 0.01}, {"alpha", "auto"}});
+       },
+       "boundaries[4].alpha: every pml must have the same alpha (\"pml2\" has "},
       {"pml_side_and_curve",
        [](ojson& j) {
          j["scheme"]["update"] = "USL";

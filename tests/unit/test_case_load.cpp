@@ -141,6 +141,35 @@ TEST(CaseLoad, KelvinVoigtBoundary) {
   EXPECT_NE(c.notes[1].find("delta 0.02 m"), std::string::npos) << c.notes[1];
 }
 
+// A pml's "alpha": "auto" is the least frequency shift the scheme needs: under MUSL and USF at
+// 1 particle per cell 0.04 sqrt(d0 c_d / h), d0 = (power + 1) c_d ln(1/r0) / (2 width)
+// (docs/physics.md section 9.3), the closed form below; none under USL or at 4 particles per cell.
+TEST(CaseLoad, PmlAlphaAuto) {
+  const fs::path file = write_file("valid_pml_auto.json", kValid);
+  const std::string pml = "boundaries.2={\"type\": \"pml\", \"body\": \"plate\", \"side\": "
+                          "\"left\", \"width\": 0.01, \"r0\": 0.01, \"power\": 2, "
+                          "\"alpha\": \"auto\"}";
+  const smpm::Case c = smpm::load_case(
+      file.string(), {"bodies.0.particles_per_cell=1", "boundaries.1.width=0.001", pml});
+  const smpm::Solver& s = *c.solver;
+  ASSERT_EQ(s.pml_bands.size(), 1u);
+  const smpm::Material& m = s.materials[0];
+  const double d0 = 3 * m.cd * std::log(100.0) / (2 * 0.01);
+  const double want = 0.04 * std::sqrt(d0 * m.cd / 0.001);
+  EXPECT_NEAR(s.pml_bands[0].alpha, want, 1e-12 * want);
+  bool noted = false;
+  for (const std::string& n : c.notes) noted = noted || n.find("1/s (auto)") != std::string::npos;
+  EXPECT_TRUE(noted);
+  for (const std::vector<std::string>& o :
+       {std::vector<std::string>{"bodies.0.particles_per_cell=1", "boundaries.1.width=0.001",
+                                  "scheme.update=USL", pml},
+        std::vector<std::string>{pml}}) {  // USL; MUSL at 4 particles per cell
+    const smpm::Case u = smpm::load_case(file.string(), o);
+    ASSERT_EQ(u.solver->pml_bands.size(), 1u);
+    EXPECT_EQ(u.solver->pml_bands[0].alpha, 0.0);
+  }
+}
+
 // A traction on part of a side ("interval"): the layer's particles are those whose centres lie
 // in the interval, and their boundary weights sum to its length, so the load is t (b - a).
 TEST(CaseLoad, TractionOnAnInterval) {
