@@ -13,6 +13,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <type_traits>
 #include <limits>
 
 #include "silentmpm/film.hpp"
@@ -189,6 +191,89 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
 // Stress update over [b, e) for one material group with model MODEL: velocity gradient from the
 // nodal velocity (gx, gy), Jaumann rotation, strain increment, material update, volume. MOVE:
 // the particle advances with the updated nodal velocity (ux, uy). Returns the energy dissipated.
+// update_stress for bilinear shapes and the elastic model, four particles at a time (one SIMD
+// register per quantity, each lane the scalar loop's operations in its order: the same bits).
+// Returns the first particle left for the scalar loop.
+template <bool MOVE>
+inline uint32_t update_stress_elastic4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
+                                       const Material& mat, const double* gx, const double* gy,
+                                       const double* ux, const double* uy, double dt,
+                                       RowSpan& rows) {
+  using V4 = double __attribute__((vector_size(32)));
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
+  const long nnx = g.nnx;
+  double* X = p.x.data(); double* Y = p.y.data();
+  double* V = p.vol.data();
+  double* SXX = p.sxx.data(); double* SYY = p.syy.data();
+  double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
+  const double lam = mat.lambda, mu = mat.mu;
+  auto load = [](const double* a) {
+    V4 v;
+    std::memcpy(&v, a, sizeof v);
+    return v;
+  };
+  auto store = [](double* a, V4 v) { std::memcpy(a, &v, sizeof v); };
+  uint32_t k = b;
+  for (; k + 4 <= e; k += 4) {
+    const V4 gxv = (load(X + k) - x0) * ih, gyv = (load(Y + k) - y0) * ih;
+    V4 cif, cjf;
+    long n0[4];
+    for (int l = 0; l < 4; ++l) {
+      const int ci = static_cast<int>(std::floor(gxv[l])), cj = static_cast<int>(std::floor(gyv[l]));
+      cif[l] = ci;
+      cjf[l] = cj;
+      n0[l] = static_cast<long>(cj) * nnx + ci;
+    }
+    const V4 xi = gxv - cif, eta = gyv - cjf;
+    const V4 a = 1.0 - xi, bb = 1.0 - eta;
+    const V4 dNx[4] = {-bb * ih, bb * ih, eta * ih, -eta * ih};
+    const V4 dNy[4] = {-a * ih, -xi * ih, xi * ih, a * ih};
+    [[maybe_unused]] const V4 N[4] = {a * bb, xi * bb, xi * eta, a * eta};
+    const long off[4] = {0, 1, nnx + 1, nnx};
+    V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
+    for (int c = 0; c < 4; ++c) {
+      V4 Gx, Gy;
+      for (int l = 0; l < 4; ++l) {
+        Gx[l] = gx[n0[l] + off[c]];
+        Gy[l] = gy[n0[l] + off[c]];
+      }
+      lxx += Gx * dNx[c];
+      lxy += Gx * dNy[c];
+      lyx += Gy * dNx[c];
+      lyy += Gy * dNy[c];
+      if constexpr (MOVE) {
+        V4 Ux, Uy;
+        for (int l = 0; l < 4; ++l) {
+          Ux[l] = ux[n0[l] + off[c]];
+          Uy[l] = uy[n0[l] + off[c]];
+        }
+        wx += N[c] * Ux;
+        wy += N[c] * Uy;
+      }
+    }
+    V4 sxx = load(SXX + k), syy = load(SYY + k), szz = load(SZZ + k), sxy = load(SXY + k);
+    const V4 w = 0.5 * (lxy - lyx) * dt;
+    const V4 rxx = 2 * w * sxy, rxy = w * (syy - sxx);
+    sxx += rxx; syy -= rxx; sxy += rxy;
+    const V4 dexx = lxx * dt, deyy = lyy * dt, dgxy = (lxy + lyx) * dt;
+    const V4 lt = lam * (dexx + deyy);
+    sxx += lt + 2 * mu * dexx;
+    syy += lt + 2 * mu * deyy;
+    szz += lt;
+    sxy += mu * dgxy;
+    store(SXX + k, sxx); store(SYY + k, syy); store(SZZ + k, szz); store(SXY + k, sxy);
+    store(V + k, load(V + k) * ((1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt));
+    if constexpr (MOVE) {
+      const V4 xn = load(X + k) + dt * wx, yn = load(Y + k) + dt * wy;
+      store(X + k, xn);
+      store(Y + k, yn);
+      for (int l = 0; l < 4; ++l)
+        rows.add(static_cast<int>(std::floor((yn[l] - y0) * ih)), !(xn[l] >= x0 && xn[l] < x1));
+    }
+  }
+  return k;
+}
+
 template <class Shape, Model MODEL, bool MOVE>
 inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
                             const Material& mat, const double* gx, const double* gy,
@@ -205,7 +290,10 @@ inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
   double diss = 0;
   Shape sf;
   long nodes[Shape::kNodes];
-  for (uint32_t k = b; k < e; ++k) {
+  uint32_t k = b;
+  if constexpr (std::is_same_v<Shape, Bilinear> && MODEL == Model::Elastic)
+    k = update_stress_elastic4<MOVE>(g, p, b, e, mat, gx, gy, ux, uy, dt, rows);
+  for (; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
