@@ -136,6 +136,103 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
   return (negative ? kInverted : 0u) | (stretched ? kStretched : 0u);
 }
 
+// Four particles at a time (GCC vector extensions): one register per quantity, each lane the
+// scalar code's operations in its order.
+namespace simd {
+using V4 = double __attribute__((vector_size(32)));
+inline V4 load(const double* a) {
+  V4 v;
+  std::memcpy(&v, a, sizeof v);
+  return v;
+}
+inline void store(double* a, V4 v) { std::memcpy(a, &v, sizeof v); }
+// Bilinear::eval of four points: each one's first node n0 (its cell's lower left) and the values
+// N (and gradients dNx, dNy) in Bilinear's node order.
+inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nnx, long n0[4],
+                            V4 N[4], V4* dNx = nullptr, V4* dNy = nullptr) {
+  const V4 gx = (x - x0) * ih, gy = (y - y0) * ih;
+  V4 cif, cjf;
+  for (int l = 0; l < 4; ++l) {
+    const int ci = static_cast<int>(std::floor(gx[l])), cj = static_cast<int>(std::floor(gy[l]));
+    cif[l] = ci;
+    cjf[l] = cj;
+    n0[l] = static_cast<long>(cj) * nnx + ci;
+  }
+  const V4 xi = gx - cif, eta = gy - cjf;
+  const V4 a = 1.0 - xi, b = 1.0 - eta;
+  N[0] = a * b; N[1] = xi * b; N[2] = xi * eta; N[3] = a * eta;
+  if (dNx) {
+    dNx[0] = -b * ih; dNx[1] = b * ih; dNx[2] = eta * ih; dNx[3] = -eta * ih;
+    dNy[0] = -a * ih; dNy[1] = -xi * ih; dNy[2] = xi * ih; dNy[3] = a * ih;
+  }
+}
+}  // namespace simd
+
+// g2p for bilinear shapes, four particles at a time (one SIMD register per quantity, each lane
+// the scalar loop's operations in its order; the sums over particles, the kinetic energy and the
+// re-mapped momenta, taken lane by lane in particle order: the same bits). Returns the first
+// particle left for the scalar loop.
+template <bool REMAP, bool MOVE>
+inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
+                              const NodalField& f, double flip, double dt, RowSpan& rows,
+                              double& kinetic, double& speed2) {
+  using simd::V4;
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
+  const long nnx = g.nnx;
+  const double pic = 1.0 - flip;
+  const double* vx = f.vx; const double* vy = f.vy;
+  const double* ux = f.vnx; const double* uy = f.vny;
+  double* X = p.x.data(); double* Y = p.y.data();
+  double* VX = p.vx.data(); double* VY = p.vy.data();
+  const double* M = p.mass.data();
+  uint32_t k = b;
+  for (; k + 4 <= e; k += 4) {
+    long n0[4];
+    V4 N[4];
+    simd::bilinear_values(simd::load(X + k), simd::load(Y + k), x0, y0, ih, nnx, n0, N);
+    const long off[4] = {0, 1, nnx + 1, nnx};
+    V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
+    for (int c = 0; c < 4; ++c) {
+      V4 Ux, Uy, Vx, Vy;
+      for (int l = 0; l < 4; ++l) {
+        const long i = n0[l] + off[c];
+        Ux[l] = ux[i]; Uy[l] = uy[i]; Vx[l] = vx[i]; Vy[l] = vy[i];
+      }
+      wx += N[c] * Ux;
+      wy += N[c] * Uy;
+      dvx += N[c] * (Ux - Vx);
+      dvy += N[c] * (Uy - Vy);
+    }
+    const V4 nvx = flip * (simd::load(VX + k) + dvx) + pic * wx;
+    const V4 nvy = flip * (simd::load(VY + k) + dvy) + pic * wy;
+    simd::store(VX + k, nvx);
+    simd::store(VY + k, nvy);
+    const V4 v2 = nvx * nvx + nvy * nvy;
+    const V4 mk = simd::load(M + k);
+    // The sums lane by lane, each product taken into its sum as the scalar loop does.
+    for (int l = 0; l < 4; ++l) {
+      kinetic += 0.5 * mk[l] * v2[l];
+      speed2 = v2[l] > speed2 ? v2[l] : speed2;
+    }
+    if constexpr (REMAP) {
+      const V4 mvx = mk * nvx, mvy = mk * nvy;
+      for (int l = 0; l < 4; ++l)
+        for (int c = 0; c < 4; ++c) {
+          f.qx[n0[l] + off[c]] += mvx[l] * N[c][l];
+          f.qy[n0[l] + off[c]] += mvy[l] * N[c][l];
+        }
+    }
+    if constexpr (MOVE) {
+      const V4 xn = simd::load(X + k) + dt * wx, yn = simd::load(Y + k) + dt * wy;
+      simd::store(X + k, xn);
+      simd::store(Y + k, yn);
+      for (int l = 0; l < 4; ++l)
+        rows.add(static_cast<int>(std::floor((yn[l] - y0) * ih)), !(xn[l] >= x0 && xn[l] < x1));
+    }
+  }
+  return k;
+}
+
 // Grid to particle over [b, e): velocities from the field's start (vx, vy) and updated (vnx, vny)
 // nodal velocities with the FLIP/PIC blend (flip = 1: FLIP). REMAP: MUSL's re-map of the new
 // particle momenta into (qx, qy). MOVE: USF's position update with the updated nodal velocity.
@@ -153,7 +250,10 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   double kinetic = 0, speed2 = 0;  // kept local: a reference could alias the particle arrays
   Shape sf;
   long nodes[Shape::kNodes];
-  for (uint32_t k = b; k < e; ++k) {
+  uint32_t k = b;
+  if constexpr (std::is_same_v<Shape, Bilinear>)
+    k = g2p_bilinear4<REMAP, MOVE>(g, p, b, e, f, flip, dt, rows, kinetic, speed2);
+  for (; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
@@ -188,9 +288,6 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   rows.speed2 = speed2 > rows.speed2 ? speed2 : rows.speed2;
 }
 
-// Stress update over [b, e) for one material group with model MODEL: velocity gradient from the
-// nodal velocity (gx, gy), Jaumann rotation, strain increment, material update, volume. MOVE:
-// the particle advances with the updated nodal velocity (ux, uy). Returns the energy dissipated.
 // update_stress for bilinear shapes and the elastic model, four particles at a time (one SIMD
 // register per quantity, each lane the scalar loop's operations in its order: the same bits).
 // Returns the first particle left for the scalar loop.
@@ -199,7 +296,7 @@ inline uint32_t update_stress_elastic4(const Grid& g, Particles& p, uint32_t b, 
                                        const Material& mat, const double* gx, const double* gy,
                                        const double* ux, const double* uy, double dt,
                                        RowSpan& rows) {
-  using V4 = double __attribute__((vector_size(32)));
+  using simd::V4;
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
   const long nnx = g.nnx;
   double* X = p.x.data(); double* Y = p.y.data();
@@ -207,28 +304,12 @@ inline uint32_t update_stress_elastic4(const Grid& g, Particles& p, uint32_t b, 
   double* SXX = p.sxx.data(); double* SYY = p.syy.data();
   double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
   const double lam = mat.lambda, mu = mat.mu;
-  auto load = [](const double* a) {
-    V4 v;
-    std::memcpy(&v, a, sizeof v);
-    return v;
-  };
-  auto store = [](double* a, V4 v) { std::memcpy(a, &v, sizeof v); };
   uint32_t k = b;
   for (; k + 4 <= e; k += 4) {
-    const V4 gxv = (load(X + k) - x0) * ih, gyv = (load(Y + k) - y0) * ih;
-    V4 cif, cjf;
     long n0[4];
-    for (int l = 0; l < 4; ++l) {
-      const int ci = static_cast<int>(std::floor(gxv[l])), cj = static_cast<int>(std::floor(gyv[l]));
-      cif[l] = ci;
-      cjf[l] = cj;
-      n0[l] = static_cast<long>(cj) * nnx + ci;
-    }
-    const V4 xi = gxv - cif, eta = gyv - cjf;
-    const V4 a = 1.0 - xi, bb = 1.0 - eta;
-    const V4 dNx[4] = {-bb * ih, bb * ih, eta * ih, -eta * ih};
-    const V4 dNy[4] = {-a * ih, -xi * ih, xi * ih, a * ih};
-    [[maybe_unused]] const V4 N[4] = {a * bb, xi * bb, xi * eta, a * eta};
+    V4 N[4], dNx[4], dNy[4];
+    simd::bilinear_values(simd::load(X + k), simd::load(Y + k), x0, y0, ih, nnx, n0, N, dNx,
+                          dNy);
     const long off[4] = {0, 1, nnx + 1, nnx};
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
     for (int c = 0; c < 4; ++c) {
@@ -251,22 +332,24 @@ inline uint32_t update_stress_elastic4(const Grid& g, Particles& p, uint32_t b, 
         wy += N[c] * Uy;
       }
     }
-    V4 sxx = load(SXX + k), syy = load(SYY + k), szz = load(SZZ + k), sxy = load(SXY + k);
+    V4 sxx = simd::load(SXX + k), syy = simd::load(SYY + k), szz = simd::load(SZZ + k),
+       sxy = simd::load(SXY + k);
     const V4 w = 0.5 * (lxy - lyx) * dt;
     const V4 rxx = 2 * w * sxy, rxy = w * (syy - sxx);
     sxx += rxx; syy -= rxx; sxy += rxy;
     const V4 dexx = lxx * dt, deyy = lyy * dt, dgxy = (lxy + lyx) * dt;
-    const V4 lt = lam * (dexx + deyy);
+    const V4 lt = lam * (dexx + deyy);  // elastic_increment
     sxx += lt + 2 * mu * dexx;
     syy += lt + 2 * mu * deyy;
     szz += lt;
     sxy += mu * dgxy;
-    store(SXX + k, sxx); store(SYY + k, syy); store(SZZ + k, szz); store(SXY + k, sxy);
-    store(V + k, load(V + k) * ((1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt));
+    simd::store(SXX + k, sxx); simd::store(SYY + k, syy);
+    simd::store(SZZ + k, szz); simd::store(SXY + k, sxy);
+    simd::store(V + k, simd::load(V + k) * ((1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt));
     if constexpr (MOVE) {
-      const V4 xn = load(X + k) + dt * wx, yn = load(Y + k) + dt * wy;
-      store(X + k, xn);
-      store(Y + k, yn);
+      const V4 xn = simd::load(X + k) + dt * wx, yn = simd::load(Y + k) + dt * wy;
+      simd::store(X + k, xn);
+      simd::store(Y + k, yn);
       for (int l = 0; l < 4; ++l)
         rows.add(static_cast<int>(std::floor((yn[l] - y0) * ih)), !(xn[l] >= x0 && xn[l] < x1));
     }
@@ -274,6 +357,9 @@ inline uint32_t update_stress_elastic4(const Grid& g, Particles& p, uint32_t b, 
   return k;
 }
 
+// Stress update over [b, e) for one material group with model MODEL: velocity gradient from the
+// nodal velocity (gx, gy), Jaumann rotation, strain increment, material update, volume. MOVE:
+// the particle advances with the updated nodal velocity (ux, uy). Returns the energy dissipated.
 template <class Shape, Model MODEL, bool MOVE>
 inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
                             const Material& mat, const double* gx, const double* gy,
