@@ -75,6 +75,85 @@ struct RowSpan {
 
 namespace kernels {
 
+// Four particles at a time (GCC vector extensions): one register per quantity, each lane the
+// scalar code's operations in its order.
+namespace simd {
+using V4 = double __attribute__((vector_size(32)));
+inline V4 load(const double* a) {
+  V4 v;
+  std::memcpy(&v, a, sizeof v);
+  return v;
+}
+inline void store(double* a, V4 v) { std::memcpy(a, &v, sizeof v); }
+// Bilinear::eval of four points: each one's first node n0 (its cell's lower left) and the values
+// N (and gradients dNx, dNy) in Bilinear's node order.
+inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nnx, long n0[4],
+                            V4 N[4], V4* dNx = nullptr, V4* dNy = nullptr) {
+  const V4 gx = (x - x0) * ih, gy = (y - y0) * ih;
+  V4 cif, cjf;
+  for (int l = 0; l < 4; ++l) {
+    const int ci = static_cast<int>(std::floor(gx[l])), cj = static_cast<int>(std::floor(gy[l]));
+    cif[l] = ci;
+    cjf[l] = cj;
+    n0[l] = static_cast<long>(cj) * nnx + ci;
+  }
+  const V4 xi = gx - cif, eta = gy - cjf;
+  const V4 a = 1.0 - xi, b = 1.0 - eta;
+  N[0] = a * b; N[1] = xi * b; N[2] = xi * eta; N[3] = a * eta;
+  if (dNx) {
+    dNx[0] = -b * ih; dNx[1] = b * ih; dNx[2] = eta * ih; dNx[3] = -eta * ih;
+    dNy[0] = -a * ih; dNy[1] = -xi * ih; dNy[2] = xi * ih; dNy[3] = a * ih;
+  }
+}
+}  // namespace simd
+
+// p2g with bilinear shapes (no contact fields), four particles at a time: the shape values in
+// SIMD registers, the sums into the nodes lane by lane in particle order, each term as the
+// scalar loop writes it (the same bits). Returns the first particle left for the scalar loop.
+template <unsigned WHAT>
+inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uint32_t e,
+                              const NodalField& f, double stretch_limit, bool& negative,
+                              bool& stretched) {
+  using simd::V4;
+  const double ih = g.inv_h;
+  const long nnx = g.nnx;
+  const double* X = p.x.data(); const double* Y = p.y.data();
+  const double* VX = p.vx.data(); const double* VY = p.vy.data();
+  const double* M = p.mass.data(); const double* V = p.vol.data();
+  const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
+  uint32_t k = b;
+  for (; k + 4 <= e; k += 4) {
+    long n0[4];
+    V4 N[4], dNx[4], dNy[4];
+    simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
+                          dNy);
+    const long off[4] = {0, 1, nnx + 1, nnx};
+    for (int l = 0; l < 4; ++l) {
+      const uint32_t q = k + l;
+      if constexpr ((WHAT & kMomentum) != 0) {
+        const double mk = M[q], mvx = mk * VX[q], mvy = mk * VY[q];
+        for (int a = 0; a < 4; ++a) {
+          const long i = n0[l] + off[a];
+          f.m[i] += mk * N[a][l];
+          f.px[i] += mvx * N[a][l];
+          f.py[i] += mvy * N[a][l];
+        }
+      }
+      if constexpr ((WHAT & kForce) != 0) {
+        const double v = V[q], sxx = SXX[q], syy = SYY[q], sxy = SXY[q];
+        negative |= std::signbit(v);
+        stretched |= v > stretch_limit * M[q];
+        for (int a = 0; a < 4; ++a) {
+          const long i = n0[l] + off[a];
+          f.fx[i] -= v * (sxx * dNx[a][l] + sxy * dNy[a][l]);
+          f.fy[i] -= v * (sxy * dNx[a][l] + syy * dNy[a][l]);
+        }
+      }
+    }
+  }
+  return k;
+}
+
 // Particle to grid over [b, e) (paper Eq. 15, 18): mass and momentum, and/or the internal force.
 // With kContact the node box the particles touch is grown in `box`.
 // inv_rho: 1 / density of the range's material (shapes that need the particle size).
@@ -95,7 +174,10 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
   Shape sf;
   long nodes[Shape::kNodes];
   bool negative = false, stretched = false;
-  for (uint32_t k = b; k < e; ++k) {
+  uint32_t k = b;
+  if constexpr (std::is_same_v<Shape, Bilinear> && (WHAT & kContact) == 0)
+    k = p2g_bilinear4<WHAT>(g, p, b, e, f, stretch_limit, negative, stretched);
+  for (; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
@@ -135,38 +217,6 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
   }
   return (negative ? kInverted : 0u) | (stretched ? kStretched : 0u);
 }
-
-// Four particles at a time (GCC vector extensions): one register per quantity, each lane the
-// scalar code's operations in its order.
-namespace simd {
-using V4 = double __attribute__((vector_size(32)));
-inline V4 load(const double* a) {
-  V4 v;
-  std::memcpy(&v, a, sizeof v);
-  return v;
-}
-inline void store(double* a, V4 v) { std::memcpy(a, &v, sizeof v); }
-// Bilinear::eval of four points: each one's first node n0 (its cell's lower left) and the values
-// N (and gradients dNx, dNy) in Bilinear's node order.
-inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nnx, long n0[4],
-                            V4 N[4], V4* dNx = nullptr, V4* dNy = nullptr) {
-  const V4 gx = (x - x0) * ih, gy = (y - y0) * ih;
-  V4 cif, cjf;
-  for (int l = 0; l < 4; ++l) {
-    const int ci = static_cast<int>(std::floor(gx[l])), cj = static_cast<int>(std::floor(gy[l]));
-    cif[l] = ci;
-    cjf[l] = cj;
-    n0[l] = static_cast<long>(cj) * nnx + ci;
-  }
-  const V4 xi = gx - cif, eta = gy - cjf;
-  const V4 a = 1.0 - xi, b = 1.0 - eta;
-  N[0] = a * b; N[1] = xi * b; N[2] = xi * eta; N[3] = a * eta;
-  if (dNx) {
-    dNx[0] = -b * ih; dNx[1] = b * ih; dNx[2] = eta * ih; dNx[3] = -eta * ih;
-    dNy[0] = -a * ih; dNy[1] = -xi * ih; dNy[2] = xi * ih; dNy[3] = a * ih;
-  }
-}
-}  // namespace simd
 
 // g2p for bilinear shapes, four particles at a time (one SIMD register per quantity, each lane
 // the scalar loop's operations in its order; the sums over particles, the kinetic energy and the
