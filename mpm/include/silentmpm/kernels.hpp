@@ -481,34 +481,45 @@ inline void for_box(const NodeBox& bx, long nnx, int threads, Fn&& fn) {
 
 // Nodal velocity v = p / m over the nodes of `box` (nodes lighter than `floor` get zero), with
 // the essential conditions `fix` (bit 0: x held, bit 1: y held). v and p may alias.
+inline void nodal_velocity_range(long i0, long i1, const double* m, const uint8_t* fix,
+                                 const double* qx, const double* qy, double* vx, double* vy,
+                                 double floor) {
+  // Four nodes at a time (each lane the scalar loop's operations), then the rest one by one.
+  using simd::V4;
+  using M4 = long __attribute__((vector_size(32)));
+  const V4 zero = {0, 0, 0, 0};
+  long i = i0;
+  for (; i + 4 <= i1; i += 4) {
+    const V4 mi = simd::load(m + i);
+    M4 hx, hy;
+    for (int l = 0; l < 4; ++l) {
+      hx[l] = (fix[i + l] & 1) ? -1 : 0;
+      hy[l] = (fix[i + l] & 2) ? -1 : 0;
+    }
+    const M4 heavy = mi > floor;
+    const V4 ax = (heavy & ~hx) ? simd::load(qx + i) / mi : zero;
+    const V4 ay = (heavy & ~hy) ? simd::load(qy + i) / mi : zero;
+    simd::store(vx + i, ax);
+    simd::store(vy + i, ay);
+  }
+  for (; i < i1; ++i) {
+    if (m[i] > floor) {
+      vx[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
+      vy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
+    } else {
+      vx[i] = 0; vy[i] = 0;
+    }
+  }
+}
+
 inline void nodal_velocity(const Grid& g, const NodeBox& box, const double* m, const uint8_t* fix,
                            const double* qx, const double* qy, double* vx, double* vy,
                            double floor, int threads) {
   if (box_empty(box)) return;
   const long nnx = g.nnx;
-  if (box[0] == 0 && box[1] == g.nnx - 1) {  // whole rows: one flat loop
-    const long i0 = box[2] * nnx, i1 = (box[3] + 1) * nnx;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (long i = i0; i < i1; ++i) {
-      if (m[i] > floor) {
-        vx[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
-        vy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
-      } else {
-        vx[i] = 0; vy[i] = 0;
-      }
-    }
-    return;
-  }
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int j = box[2]; j <= box[3]; ++j)
-    for (long i = j * nnx + box[0]; i <= j * nnx + box[1]; ++i) {
-      if (m[i] > floor) {
-        vx[i] = (fix[i] & 1) ? 0.0 : qx[i] / m[i];
-        vy[i] = (fix[i] & 2) ? 0.0 : qy[i] / m[i];
-      } else {
-        vx[i] = 0; vy[i] = 0;
-      }
-    }
+    nodal_velocity_range(j * nnx + box[0], j * nnx + box[1] + 1, m, fix, qx, qy, vx, vy, floor);
 }
 
 }  // namespace kernels
