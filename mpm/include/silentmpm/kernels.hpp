@@ -338,14 +338,15 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   rows.speed2 = speed2 > rows.speed2 ? speed2 : rows.speed2;
 }
 
-// update_stress for bilinear shapes and the elastic model, four particles at a time (one SIMD
-// register per quantity, each lane the scalar loop's operations in its order: the same bits).
-// Returns the first particle left for the scalar loop.
-template <bool MOVE>
-inline uint32_t update_stress_elastic4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
-                                       const Material& mat, const double* gx, const double* gy,
-                                       const double* ux, const double* uy, double dt,
-                                       RowSpan& rows) {
+// update_stress for bilinear shapes and the elastic and von Mises models, four particles at a
+// time (one SIMD register per quantity, each lane the scalar loop's operations in its order; the
+// dissipation summed lane by lane in particle order: the same bits). Returns the first particle
+// left for the scalar loop.
+template <Model MODEL, bool MOVE>
+inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
+                                        const Material& mat, const double* gx, const double* gy,
+                                        const double* ux, const double* uy, double dt,
+                                        RowSpan& rows, double& diss) {
   using simd::V4;
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
   const long nnx = g.nnx;
@@ -393,9 +394,34 @@ inline uint32_t update_stress_elastic4(const Grid& g, Particles& p, uint32_t b, 
     syy += lt + 2 * mu * deyy;
     szz += lt;
     sxy += mu * dgxy;
+    [[maybe_unused]] V4 wp = {0, 0, 0, 0};
+    if constexpr (MODEL == Model::VonMises) {  // stress_update<VonMises>, the return where q > sigma_y
+      using M4 = long __attribute__((vector_size(32)));
+      const V4 pm = (sxx + syy + szz) / 3.0;
+      const V4 a = sxx - pm, bd = syy - pm, c = szz - pm;
+      const V4 ss = a * a + bd * bd + c * c + 2 * sxy * sxy;
+      V4 q = {0, 0, 0, 0};
+      for (int l = 0; l < 4; ++l) q[l] = std::sqrt(1.5 * ss[l]);
+      const M4 plastic = !(q <= mat.sigma_y);
+      if (plastic[0] | plastic[1] | plastic[2] | plastic[3]) {
+        const V4 scale = mat.sigma_y / q;
+        const V4 dgamma = (q - mat.sigma_y) / (3 * mu);
+        wp = plastic ? scale * (1 - scale) * ss / (2 * mu) : wp;
+        sxx = plastic ? pm + a * scale : sxx;
+        syy = plastic ? pm + bd * scale : syy;
+        szz = plastic ? pm + c * scale : szz;
+        sxy = plastic ? sxy * scale : sxy;
+        double* EP = p.eps_p.data() + k;
+        for (int l = 0; l < 4; ++l)
+          if (plastic[l]) EP[l] += dgamma[l];
+      }
+    }
     simd::store(SXX + k, sxx); simd::store(SYY + k, syy);
     simd::store(SZZ + k, szz); simd::store(SXY + k, sxy);
-    simd::store(V + k, simd::load(V + k) * ((1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt));
+    const V4 vn = simd::load(V + k) * ((1 + lxx * dt) * (1 + lyy * dt) - lxy * lyx * dt * dt);
+    simd::store(V + k, vn);
+    if constexpr (MODEL == Model::VonMises)
+      for (int l = 0; l < 4; ++l) diss += wp[l] * vn[l];  // in particle order, as the scalar loop
     if constexpr (MOVE) {
       const V4 xn = simd::load(X + k) + dt * wx, yn = simd::load(Y + k) + dt * wy;
       simd::store(X + k, xn);
@@ -427,8 +453,9 @@ inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
   Shape sf;
   long nodes[Shape::kNodes];
   uint32_t k = b;
-  if constexpr (std::is_same_v<Shape, Bilinear> && MODEL == Model::Elastic)
-    k = update_stress_elastic4<MOVE>(g, p, b, e, mat, gx, gy, ux, uy, dt, rows);
+  if constexpr (std::is_same_v<Shape, Bilinear> &&
+                (MODEL == Model::Elastic || MODEL == Model::VonMises))
+    k = update_stress_bilinear4<MODEL, MOVE>(g, p, b, e, mat, gx, gy, ux, uy, dt, rows, diss);
   for (; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
