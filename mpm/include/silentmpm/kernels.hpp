@@ -105,6 +105,19 @@ inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nn
     dNy[0] = -a * ih; dNy[1] = -xi * ih; dNy[2] = xi * ih; dNy[3] = a * ih;
   }
 }
+// The four points' values of a nodal array at their node `off` from their first node n0.
+inline V4 gather(const double* a, const long n0[4], long off) {
+  return V4{a[n0[0] + off], a[n0[1] + off], a[n0[2] + off], a[n0[3] + off]};
+}
+// Four particles advance by dt (wx, wy) and their rows are tracked, as the scalar passes do.
+inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, RowSpan& rows) {
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
+  const V4 xn = load(X) + dt * wx, yn = load(Y) + dt * wy;
+  store(X, xn);
+  store(Y, yn);
+  for (int l = 0; l < 4; ++l)
+    rows.add(static_cast<int>(std::floor((yn[l] - y0) * ih)), !(xn[l] >= x0 && xn[l] < x1));
+}
 }  // namespace simd
 
 // p2g with bilinear shapes (no contact fields), four particles at a time: the shape values in
@@ -227,7 +240,7 @@ inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t 
                               const NodalField& f, double flip, double dt, RowSpan& rows,
                               double& kinetic, double& speed2) {
   using simd::V4;
-  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h;
   const long nnx = g.nnx;
   const double pic = 1.0 - flip;
   const double* vx = f.vx; const double* vy = f.vy;
@@ -243,11 +256,8 @@ inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t 
     const long off[4] = {0, 1, nnx + 1, nnx};
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
     for (int c = 0; c < 4; ++c) {
-      V4 Ux, Uy, Vx, Vy;
-      for (int l = 0; l < 4; ++l) {
-        const long i = n0[l] + off[c];
-        Ux[l] = ux[i]; Uy[l] = uy[i]; Vx[l] = vx[i]; Vy[l] = vy[i];
-      }
+      const V4 Ux = simd::gather(ux, n0, off[c]), Uy = simd::gather(uy, n0, off[c]);
+      const V4 Vx = simd::gather(vx, n0, off[c]), Vy = simd::gather(vy, n0, off[c]);
       wx += N[c] * Ux;
       wy += N[c] * Uy;
       dvx += N[c] * (Ux - Vx);
@@ -272,13 +282,7 @@ inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t 
           f.qy[n0[l] + off[c]] += mvy[l] * N[c][l];
         }
     }
-    if constexpr (MOVE) {
-      const V4 xn = simd::load(X + k) + dt * wx, yn = simd::load(Y + k) + dt * wy;
-      simd::store(X + k, xn);
-      simd::store(Y + k, yn);
-      for (int l = 0; l < 4; ++l)
-        rows.add(static_cast<int>(std::floor((yn[l] - y0) * ih)), !(xn[l] >= x0 && xn[l] < x1));
-    }
+    if constexpr (MOVE) simd::move(X + k, Y + k, wx, wy, dt, g, rows);
   }
   return k;
 }
@@ -348,7 +352,7 @@ inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b,
                                         const double* ux, const double* uy, double dt,
                                         RowSpan& rows, double& diss) {
   using simd::V4;
-  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
+  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h;
   const long nnx = g.nnx;
   double* X = p.x.data(); double* Y = p.y.data();
   double* V = p.vol.data();
@@ -364,23 +368,14 @@ inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b,
     const long off[4] = {0, 1, nnx + 1, nnx};
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
     for (int c = 0; c < 4; ++c) {
-      V4 Gx, Gy;
-      for (int l = 0; l < 4; ++l) {
-        Gx[l] = gx[n0[l] + off[c]];
-        Gy[l] = gy[n0[l] + off[c]];
-      }
+      const V4 Gx = simd::gather(gx, n0, off[c]), Gy = simd::gather(gy, n0, off[c]);
       lxx += Gx * dNx[c];
       lxy += Gx * dNy[c];
       lyx += Gy * dNx[c];
       lyy += Gy * dNy[c];
       if constexpr (MOVE) {
-        V4 Ux, Uy;
-        for (int l = 0; l < 4; ++l) {
-          Ux[l] = ux[n0[l] + off[c]];
-          Uy[l] = uy[n0[l] + off[c]];
-        }
-        wx += N[c] * Ux;
-        wy += N[c] * Uy;
+        wx += N[c] * simd::gather(ux, n0, off[c]);
+        wy += N[c] * simd::gather(uy, n0, off[c]);
       }
     }
     V4 sxx = simd::load(SXX + k), syy = simd::load(SYY + k), szz = simd::load(SZZ + k),
@@ -422,13 +417,7 @@ inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b,
     simd::store(V + k, vn);
     if constexpr (MODEL == Model::VonMises)
       for (int l = 0; l < 4; ++l) diss += wp[l] * vn[l];  // in particle order, as the scalar loop
-    if constexpr (MOVE) {
-      const V4 xn = simd::load(X + k) + dt * wx, yn = simd::load(Y + k) + dt * wy;
-      simd::store(X + k, xn);
-      simd::store(Y + k, yn);
-      for (int l = 0; l < 4; ++l)
-        rows.add(static_cast<int>(std::floor((yn[l] - y0) * ih)), !(xn[l] >= x0 && xn[l] < x1));
-    }
+    if constexpr (MOVE) simd::move(X + k, Y + k, wx, wy, dt, g, rows);
   }
   return k;
 }
