@@ -1,9 +1,14 @@
-// Bilinear shape functions (exact identities, to round-off) and the grid check of moving particles.
+// Bilinear shape functions (exact identities, to round-off), the grid check of moving particles,
+// and the passes that take four particles at a time against the scalar loop (bit for bit).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <random>
+#include <vector>
+
+#include "silentmpm/kernels.hpp"
 
 #include "common.hpp"
 #include "silentmpm/shape.hpp"
@@ -110,5 +115,143 @@ TEST(Transfer, NodalProjectionConservesMassAndMomentum) {
     EXPECT_NEAR(PY, py, 1e-12 * m) << name;
     EXPECT_LT(worst, 1e-6) << name << ": a uniform stress of 1e8 Pa comes back to round-off";
     EXPECT_GT(empty, 0u) << name << ": the grid's cells beyond the column hold no mass";
+  }
+}
+
+// The MPM passes take four particles (nodes) at a time with bilinear shapes and leave the last one
+// to three of a range to the scalar loop. Each range here runs once whole (four at a time) and
+// once particle by particle (ranges of one: the scalar loop), from the same state; every particle
+// array and every nodal sum must come out with the same bits: p2g's mass, momenta and forces,
+// g2p's velocities, positions and re-mapped momenta, the stress update's stresses, volumes,
+// plastic strains and positions (elastic, and von Mises with about half the particles yielding),
+// and the nodal velocities q / m against their formula. The sums over a range's particles in
+// one number (g2p's kinetic energy, the plastic dissipation) are taken into a running sum per
+// call, so a range of one rounds once more: those agree to 1e-14.
+namespace {
+struct KernelState {
+  Grid g;
+  Particles p;
+  std::vector<double> a[11];  // m px py fx fy vx vy vnx vny qx qy
+  NodalField f;
+  KernelState(int n, unsigned seed) {
+    const double h = 1e-3;
+    g.init(0, 0, h, 16, 16);
+    p.resize(n);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int k = 0; k < n; ++k) {
+      p.x[k] = (1.5 + 13 * u(rng)) * h;
+      p.y[k] = (1.5 + 13 * u(rng)) * h;
+      p.vx[k] = u(rng) - 0.5;
+      p.vy[k] = u(rng) - 0.5;
+      p.mass[k] = 1e-3 * (0.5 + u(rng));
+      p.vol[k] = 1e-7 * (0.5 + u(rng));
+      p.sxx[k] = 2e9 * (u(rng) - 0.5);
+      p.syy[k] = 2e9 * (u(rng) - 0.5);
+      p.szz[k] = 2e9 * (u(rng) - 0.5);
+      p.sxy[k] = 1e9 * (u(rng) - 0.5);
+    }
+    for (auto& v : a) {
+      v.resize(g.nodes());
+      for (double& x : v) x = u(rng) + 0.1;  // positive: a mass
+    }
+    f.m = a[0].data(); f.px = a[1].data(); f.py = a[2].data(); f.fx = a[3].data();
+    f.fy = a[4].data(); f.vx = a[5].data(); f.vy = a[6].data(); f.vnx = a[7].data();
+    f.vny = a[8].data(); f.qx = a[9].data(); f.qy = a[10].data();
+  }
+  KernelState(const KernelState& o) : g(o.g), p(o.p) {
+    for (int i = 0; i < 11; ++i) a[i] = o.a[i];
+    f = o.f;
+    double** ptr[11] = {&f.m, &f.px, &f.py, &f.fx, &f.fy, &f.vx, &f.vy, &f.vnx, &f.vny, &f.qx, &f.qy};
+    for (int i = 0; i < 11; ++i) *ptr[i] = a[i].data();
+  }
+};
+
+bool same_bits(const std::vector<double>& x, const std::vector<double>& y) {
+  return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
+}
+
+void expect_same(const KernelState& w, const KernelState& s, const char* pass) {
+  const Particles &a = w.p, &b = s.p;
+  EXPECT_TRUE(same_bits(a.x, b.x) && same_bits(a.y, b.y)) << pass << ": positions";
+  EXPECT_TRUE(same_bits(a.vx, b.vx) && same_bits(a.vy, b.vy)) << pass << ": velocities";
+  EXPECT_TRUE(same_bits(a.sxx, b.sxx) && same_bits(a.syy, b.syy) && same_bits(a.szz, b.szz) &&
+              same_bits(a.sxy, b.sxy))
+      << pass << ": stresses";
+  EXPECT_TRUE(same_bits(a.vol, b.vol) && same_bits(a.eps_p, b.eps_p)) << pass << ": volumes";
+  for (int i = 0; i < 11; ++i) EXPECT_TRUE(same_bits(w.a[i], s.a[i])) << pass << ": nodal array " << i;
+}
+}  // namespace
+
+TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
+  const int n = 103;  // 25 groups of four and a tail of three
+  const KernelState start(n, 11);
+  const double dt = 1e-8, inv_rho = 1.0 / tungsten().rho;
+  {  // p2g: mass, momenta, forces
+    KernelState w = start, s = start;
+    kernels::p2g<Bilinear, kMomentum | kForce>(w.g, w.p, 0, n, w.f, inv_rho);
+    for (int k = 0; k < n; ++k)
+      kernels::p2g<Bilinear, kMomentum | kForce>(s.g, s.p, k, k + 1, s.f, inv_rho);
+    expect_same(w, s, "p2g");
+  }
+  for (double flip : {1.0, 0.95}) {  // g2p with the re-map and the move (USF's)
+    KernelState w = start, s = start;
+    RowSpan rw, rs;
+    kernels::g2p<Bilinear, true, true>(w.g, w.p, 0, n, w.f, inv_rho, flip, dt, rw);
+    for (int k = 0; k < n; ++k)
+      kernels::g2p<Bilinear, true, true>(s.g, s.p, k, k + 1, s.f, inv_rho, flip, dt, rs);
+    expect_same(w, s, "g2p");
+    EXPECT_EQ(rw.lo, rs.lo);
+    EXPECT_EQ(rw.hi, rs.hi);
+    EXPECT_EQ(rw.out, rs.out);
+    EXPECT_EQ(rw.speed2, rs.speed2);
+    EXPECT_NEAR(rw.kinetic, rs.kinetic, 1e-14 * rs.kinetic);
+  }
+  for (Model model : {Model::Elastic, Model::VonMises}) {  // the stress update, moving
+    const Material mat = tungsten(model, 1.2e9);
+    KernelState w = start, s = start;
+    RowSpan rw, rs;
+    const double dw = kernels::update_stress<Bilinear, Model::Elastic, true>(
+        w.g, w.p, 0, 0, mat, w.f.qx, w.f.qy, w.f.vnx, w.f.vny, dt, rw);  // an empty range
+    EXPECT_EQ(dw, 0.0);
+    double a = 0, b = 0;
+    if (model == Model::Elastic) {
+      a = kernels::update_stress<Bilinear, Model::Elastic, true>(w.g, w.p, 0, n, mat, w.f.qx, w.f.qy,
+                                                                 w.f.vnx, w.f.vny, dt, rw);
+      for (int k = 0; k < n; ++k)
+        b += kernels::update_stress<Bilinear, Model::Elastic, true>(
+            s.g, s.p, k, k + 1, mat, s.f.qx, s.f.qy, s.f.vnx, s.f.vny, dt, rs);
+    } else {
+      a = kernels::update_stress<Bilinear, Model::VonMises, true>(
+          w.g, w.p, 0, n, mat, w.f.qx, w.f.qy, w.f.vnx, w.f.vny, dt, rw);
+      for (int k = 0; k < n; ++k)
+        b += kernels::update_stress<Bilinear, Model::VonMises, true>(
+            s.g, s.p, k, k + 1, mat, s.f.qx, s.f.qy, s.f.vnx, s.f.vny, dt, rs);
+      int yielded = 0;
+      for (int k = 0; k < n; ++k) yielded += w.p.eps_p[k] > 0;
+      EXPECT_GT(yielded, n / 4) << "the von Mises lanes take the return";
+      EXPECT_LT(yielded, n) << "and some stay elastic";
+      EXPECT_GT(a, 0.0);
+    }
+    expect_same(w, s, model == Model::Elastic ? "stress, elastic" : "stress, von Mises");
+    EXPECT_NEAR(a, b, 1e-14 * std::abs(b) + 1e-300);
+    EXPECT_EQ(rw.lo, rs.lo);
+    EXPECT_EQ(rw.hi, rs.hi);
+  }
+  {  // the nodal velocities q / m, with fixed components and light nodes
+    KernelState w = start;
+    std::vector<uint8_t> fix(w.g.nodes());
+    for (std::size_t i = 0; i < fix.size(); ++i) fix[i] = static_cast<uint8_t>(i % 4);
+    for (std::size_t i = 0; i < fix.size(); i += 7) w.a[0][i] = 1e-30;  // below the floor
+    std::vector<double> ux(fix.size()), uy(fix.size());
+    kernels::nodal_velocity(w.g, NodeBox{0, w.g.nnx - 1, 0, w.g.nny - 1}, w.f.m, fix.data(),
+                            w.f.qx, w.f.qy, ux.data(), uy.data(), 1e-20, 1);
+    for (std::size_t i = 0; i < fix.size(); ++i) {
+      const bool heavy = w.a[0][i] > 1e-20;
+      const double ex = heavy && !(fix[i] & 1) ? w.a[9][i] / w.a[0][i] : 0.0;
+      const double ey = heavy && !(fix[i] & 2) ? w.a[10][i] / w.a[0][i] : 0.0;
+      ASSERT_EQ(std::memcmp(&ux[i], &ex, sizeof ex), 0) << "node " << i;
+      ASSERT_EQ(std::memcmp(&uy[i], &ey, sizeof ey), 0) << "node " << i;
+    }
   }
 }
