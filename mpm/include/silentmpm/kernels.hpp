@@ -134,22 +134,49 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
   const double* VX = p.vx.data(); const double* VY = p.vy.data();
   const double* M = p.mass.data(); const double* V = p.vol.data();
   const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
+  // The nodal arrays this pass sums into: m, px, py with the momenta, fx, fy with the force.
+  constexpr bool kM = (WHAT & kMomentum) != 0, kFo = (WHAT & kForce) != 0;
+  constexpr int kF = (kM ? 3 : 0) + (kFo ? 2 : 0), kFx = kM ? 3 : 0;
+  double* fld[kF];
+  if constexpr (kM) { fld[0] = f.m; fld[1] = f.px; fld[2] = f.py; }
+  if constexpr (kFo) { fld[kFx] = f.fx; fld[kFx + 1] = f.fy; }
+  // The right column of the last particle's nodes (bottom n = cn, top cn + nnx), its sums kept
+  // in registers: a particle in the next cell of the row starts from them (the same additions
+  // in the same order as through memory), any other particle has them written back first.
+  long cn = -1;
+  double cb[kF], ct[kF];
+  auto flush = [&] {
+    if (cn < 0) return;
+    for (int c = 0; c < kF; ++c) { fld[c][cn] = cb[c]; fld[c][cn + nnx] = ct[c]; }
+    cn = -1;
+  };
   uint32_t k = b;
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[4], dNx[4], dNy[4];
     simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
                           dNy);
-    const long off[4] = {0, 1, nnx + 1, nnx};
     for (int l = 0; l < 4; ++l) {
       const uint32_t q = k + l;
+      // The node sums of this particle in node order 0 (n0), 1 (n0 + 1), 2 (n0 + nnx + 1),
+      // 3 (n0 + nnx): its left column from the carried values or from memory, its right column
+      // from memory, kept for the next particle.
+      const long i0 = n0[l];
+      double L0[kF], L3[kF], R1[kF], R2[kF];
+      if (cn == i0) {
+        for (int c = 0; c < kF; ++c) { L0[c] = cb[c]; L3[c] = ct[c]; }
+      } else {
+        flush();
+        for (int c = 0; c < kF; ++c) { L0[c] = fld[c][i0]; L3[c] = fld[c][i0 + nnx]; }
+      }
+      for (int c = 0; c < kF; ++c) { R1[c] = fld[c][i0 + 1]; R2[c] = fld[c][i0 + nnx + 1]; }
+      double* node[4] = {L0, R1, R2, L3};
       if constexpr ((WHAT & kMomentum) != 0) {
         const double mk = M[q], mvx = mk * VX[q], mvy = mk * VY[q];
         for (int a = 0; a < 4; ++a) {
-          const long i = n0[l] + off[a];
-          f.m[i] += mk * N[a][l];
-          f.px[i] += mvx * N[a][l];
-          f.py[i] += mvy * N[a][l];
+          node[a][0] += mk * N[a][l];
+          node[a][1] += mvx * N[a][l];
+          node[a][2] += mvy * N[a][l];
         }
       }
       if constexpr ((WHAT & kForce) != 0) {
@@ -157,13 +184,16 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
         negative |= std::signbit(v);
         stretched |= v > stretch_limit * M[q];
         for (int a = 0; a < 4; ++a) {
-          const long i = n0[l] + off[a];
-          f.fx[i] -= v * (sxx * dNx[a][l] + sxy * dNy[a][l]);
-          f.fy[i] -= v * (sxy * dNx[a][l] + syy * dNy[a][l]);
+          node[a][kFx] -= v * (sxx * dNx[a][l] + sxy * dNy[a][l]);
+          node[a][kFx + 1] -= v * (sxy * dNx[a][l] + syy * dNy[a][l]);
         }
       }
+      for (int c = 0; c < kF; ++c) { fld[c][i0] = L0[c]; fld[c][i0 + nnx] = L3[c]; }
+      for (int c = 0; c < kF; ++c) { cb[c] = R1[c]; ct[c] = R2[c]; }
+      cn = i0 + 1;
     }
   }
+  flush();
   return k;
 }
 
