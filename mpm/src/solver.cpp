@@ -1239,17 +1239,14 @@ struct NodeUpdate {
   int run(long i0, long i1) const {
     // Four nodes at a time (each lane the scalar loop's operations), then the rest one by one.
     using kernels::simd::V4;
-    using M4 = long __attribute__((vector_size(32)));
+    using kernels::simd::M4;
     long i = i0;
     M4 any_bad = {0, 0, 0, 0};
     const V4 zero = {0, 0, 0, 0};
     for (; i + 4 <= i1; i += 4) {
       const V4 mi = kernels::simd::load(m + i);
       M4 hx, hy;
-      for (int l = 0; l < 4; ++l) {
-        hx[l] = (fix[i + l] & 1) ? -1 : 0;
-        hy[l] = (fix[i + l] & 2) ? -1 : 0;
-      }
+      kernels::simd::held(fix + i, hx, hy);
       const M4 heavy = mi > floor, light = mi <= floor;
       const V4 vxi = (heavy & ~hx) ? kernels::simd::load(px + i) / mi : zero;
       const V4 vyi = (heavy & ~hy) ? kernels::simd::load(py + i) / mi : zero;

@@ -105,6 +105,14 @@ inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nn
     dNy[0] = -a * ih; dNy[1] = -xi * ih; dNy[2] = xi * ih; dNy[3] = a * ih;
   }
 }
+// The essential conditions of four nodes as lane masks: x held (fix bit 0) and y held (bit 1).
+using M4 = long __attribute__((vector_size(32)));
+inline void held(const uint8_t* fix, M4& hx, M4& hy) {
+  for (int l = 0; l < 4; ++l) {
+    hx[l] = (fix[l] & 1) ? -1 : 0;
+    hy[l] = (fix[l] & 2) ? -1 : 0;
+  }
+}
 // The four points' values of a nodal array at their node `off` from their first node n0.
 inline V4 gather(const double* a, const long n0[4], long off) {
   return V4{a[n0[0] + off], a[n0[1] + off], a[n0[2] + off], a[n0[3] + off]};
@@ -171,7 +179,7 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
       }
       for (int c = 0; c < kF; ++c) { R1[c] = fld[c][i0 + 1]; R2[c] = fld[c][i0 + nnx + 1]; }
       double* node[4] = {L0, R1, R2, L3};
-      if constexpr ((WHAT & kMomentum) != 0) {
+      if constexpr (kM) {
         const double mk = M[q], mvx = mk * VX[q], mvy = mk * VY[q];
         for (int a = 0; a < 4; ++a) {
           node[a][0] += mk * N[a][l];
@@ -179,7 +187,7 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
           node[a][2] += mvy * N[a][l];
         }
       }
-      if constexpr ((WHAT & kForce) != 0) {
+      if constexpr (kFo) {
         const double v = V[q], sxx = SXX[q], syy = SYY[q], sxy = SXY[q];
         negative |= std::signbit(v);
         stretched |= v > stretch_limit * M[q];
@@ -388,7 +396,7 @@ inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b,
   double* V = p.vol.data();
   double* SXX = p.sxx.data(); double* SYY = p.syy.data();
   double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
-  const double lam = mat.lambda, mu = mat.mu;
+  const double mu = mat.mu;
   uint32_t k = b;
   for (; k + 4 <= e; k += 4) {
     long n0[4];
@@ -413,12 +421,7 @@ inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b,
     const V4 w = 0.5 * (lxy - lyx) * dt;
     const V4 rxx = 2 * w * sxy, rxy = w * (syy - sxx);
     sxx += rxx; syy -= rxx; sxy += rxy;
-    const V4 dexx = lxx * dt, deyy = lyy * dt, dgxy = (lxy + lyx) * dt;
-    const V4 lt = lam * (dexx + deyy);  // elastic_increment
-    sxx += lt + 2 * mu * dexx;
-    syy += lt + 2 * mu * deyy;
-    szz += lt;
-    sxy += mu * dgxy;
+    elastic_increment(mat, lxx * dt, lyy * dt, (lxy + lyx) * dt, sxx, syy, szz, sxy);
     [[maybe_unused]] V4 wp = {0, 0, 0, 0};
     if constexpr (MODEL == Model::VonMises) {  // stress_update<VonMises>, the return where q > sigma_y
       using M4 = long __attribute__((vector_size(32)));
@@ -532,16 +535,13 @@ inline void nodal_velocity_range(long i0, long i1, const double* m, const uint8_
                                  double floor) {
   // Four nodes at a time (each lane the scalar loop's operations), then the rest one by one.
   using simd::V4;
-  using M4 = long __attribute__((vector_size(32)));
+  using simd::M4;
   const V4 zero = {0, 0, 0, 0};
   long i = i0;
   for (; i + 4 <= i1; i += 4) {
     const V4 mi = simd::load(m + i);
     M4 hx, hy;
-    for (int l = 0; l < 4; ++l) {
-      hx[l] = (fix[i + l] & 1) ? -1 : 0;
-      hy[l] = (fix[i + l] & 2) ? -1 : 0;
-    }
+    simd::held(fix + i, hx, hy);
     const M4 heavy = mi > floor;
     const V4 ax = (heavy & ~hx) ? simd::load(qx + i) / mi : zero;
     const V4 ay = (heavy & ~hy) ? simd::load(qy + i) / mi : zero;

@@ -1,4 +1,6 @@
 #pragma once
+
+#include <type_traits>
 // Materials: constants, derived wave speeds, and the stress updates used by the MPM kernels.
 //
 // Stresses are kept as four components (xx, yy, zz, xy) in plane strain: sigma_zz is integrated
@@ -67,9 +69,12 @@ inline double elastic_energy_density(const Material& m, double sxx, double syy, 
 }
 
 // Elastic trial update from a plane-strain strain increment (dexx, deyy, dgxy = 2 dexy).
-inline void elastic_increment(const Material& m, double dexx, double deyy, double dgxy,
-                              double& sxx, double& syy, double& szz, double& sxy) {
-  const double lt = m.lambda * (dexx + deyy);
+template <class T>  // double, or a SIMD register of four (the MPM kernels): the same operations
+inline void elastic_increment(const Material& m, typename std::common_type<T>::type dexx,
+                              typename std::common_type<T>::type deyy,
+                              typename std::common_type<T>::type dgxy, T& sxx, T& syy, T& szz,
+                              T& sxy) {
+  const T lt = m.lambda * (dexx + deyy);
   sxx += lt + 2 * m.mu * dexx;
   syy += lt + 2 * m.mu * deyy;
   szz += lt;
