@@ -9,8 +9,7 @@
 // counted as STREAM counts it, 24 bytes per element), and counts the bytes one step of its case
 // moves: each particle array and each grid field a pass of the step reads is counted once per
 // pass, each one it writes once more (the same convention, no write-allocate; the table of
-// passes is printed). A nodal sum the pass clears itself as it reaches each row (p2g's, the
-// re-map's) is counted as written only: its row is zeroed in the cache, as STREAM's stores are. Bytes per update times updates per second is the bandwidth the step
+// passes is printed). Bytes per update times updates per second is the bandwidth the step
 // would need if every byte came from memory; its fraction of the triad says how far the step is
 // from the limit. Where the problem fits in the last-level cache the fraction can pass 1.
 //
@@ -97,9 +96,10 @@ struct PassBytes {
   double particle, node;
 };
 const PassBytes kMuslStep[] = {
-    {"p2g", "R x y m vx vy vol sxx syy sxy; W m px py fx fy", 9 * 8, 5 * 8},
+    {"reset_grid", "W m px py fx fy qx qy", 0, 7 * 8},
+    {"p2g", "R x y m vx vy vol sxx syy sxy; RW m px py fx fy", 9 * 8, 5 * 16},
     {"grid_update", "R m fix px py fx fy; W vx vy vnx vny", 0, 5 * 8 + 1 + 4 * 8},
-    {"g2p + re-map", "R x y m, RW vx vy; R vx vy vnx vny, W qx qy", 3 * 8 + 2 * 16, 4 * 8 + 2 * 8},
+    {"g2p + re-map", "R x y m, RW vx vy; R vx vy vnx vny, RW qx qy", 3 * 8 + 2 * 16, 4 * 8 + 2 * 16},
     {"re-mapped velocity", "R m fix; RW qx qy", 0, 8 + 1 + 2 * 16},
     {"stress + move", "RW x y vol sxx syy szz sxy; R qx qy vnx vny", 7 * 16, 4 * 8},
 };

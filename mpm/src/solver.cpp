@@ -501,7 +501,7 @@ void Solver::parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& f
 // Stages
 // ------------------------------------------------------------------------------------------
 
-void Solver::full_reset(bool remapped) {
+void Solver::reset_grid() {
   const long n = static_cast<long>(grid.nodes());
   double* m = grid.m.data();
   double* px = grid.px.data();
@@ -512,62 +512,10 @@ void Solver::full_reset(bool remapped) {
   for (long i = 0; i < n; ++i) {
     m[i] = 0; px[i] = 0; py[i] = 0; fx[i] = 0; fy[i] = 0;
   }
-  if (remapped) {
+  if (opt.scheme != Scheme::USL) {  // MUSL's re-map (USF: for the loads' power)
     std::fill(grid.qx.begin(), grid.qx.end(), 0.0);
     std::fill(grid.qy.begin(), grid.qy.end(), 0.0);
   }
-}
-
-// The nodal sums start from zero. With the grid's own field only, each pass that sums into an
-// array clears the rows it reaches first (kernels::RowClear): here each node row gets the strip
-// that clears it, the first in the scatter's order whose rows hold it, and the rows no strip
-// holds are cleared. Otherwise the whole grid is cleared here.
-void Solver::reset_grid() {
-  const bool remapped = opt.scheme != Scheme::USL;  // MUSL's re-map (USF: for the loads' power)
-  row_clear_ = body_of_group_.empty() && fields_.size() == 1 && fields_[0].body < 0;
-  if (!row_clear_) return full_reset(remapped);
-  const int nny = grid.nny;
-  const bool bilinear = opt.shape == ShapeKind::Bilinear;
-  const int below = bilinear ? Bilinear::kRowsBelow : BSpline2::kRowsBelow;
-  const int above = bilinear ? Bilinear::kRowsAbove : BSpline2::kRowsAbove;
-  clear_owner_.assign(nny, -1);
-  clear_rows_.assign(nstrips_, {0, -1});
-  auto own = [&](int s) {
-    if (strip_lo_[s] > strip_hi_[s]) return;
-    const int lo = std::max(0, strip_lo_[s] - below), hi = std::min(nny - 1, strip_hi_[s] + above);
-    clear_rows_[s] = {lo, hi};
-    for (int r = lo; r <= hi; ++r)
-      if (clear_owner_[r] < 0) clear_owner_[r] = s;
-  };
-  if (!strips_ok_ || nthreads_ == 1) {  // scatter()'s order
-    for (int s = 0; s < nstrips_; ++s) own(s);
-  } else {
-    for (int colour = 0; colour < 2; ++colour)
-      for (int s = colour; s < nstrips_; s += 2) own(s);
-  }
-  // USF clears its re-mapped momenta here: its g2p re-maps only on some steps.
-  const bool q_here = opt.scheme == Scheme::USF;
-  const long nnx = grid.nnx;
-#pragma omp parallel for schedule(static) num_threads(nthreads_)
-  for (int r = 0; r < nny; ++r) {
-    if (clear_owner_[r] >= 0) continue;
-    for (std::vector<double>* a : {&grid.m, &grid.px, &grid.py, &grid.fx, &grid.fy, &grid.qx, &grid.qy})
-      std::fill(a->begin() + r * nnx, a->begin() + (r + 1) * nnx, 0.0);
-  }
-  if (q_here) {
-    std::fill(grid.qx.begin(), grid.qx.end(), 0.0);
-    std::fill(grid.qy.begin(), grid.qy.end(), 0.0);
-  }
-}
-
-std::vector<kernels::RowClear> Solver::row_clears(std::initializer_list<double*> arrays) const {
-  if (!row_clear_) return {};
-  std::vector<kernels::RowClear> c(nstrips_);
-  for (int s = 0; s < nstrips_; ++s) {
-    c[s].start(s, clear_rows_[s][0], clear_rows_[s][1], clear_owner_.data(), grid.nnx);
-    for (double* a : arrays) c[s].add(a);
-  }
-  return c;
 }
 
 // p2g over every field. A body's field clears its arrays over last step's box first and finds
@@ -591,32 +539,10 @@ void Solver::p2g(unsigned what) {
     auto run = [&](auto what_c) {
       constexpr unsigned W = decltype(what_c)::value;
       std::vector<unsigned> flags(nstrips_, 0);
-      std::vector<kernels::RowClear> clear;
-      if (!body) {
-        if (momentum && force) clear = row_clears({f.m, f.px, f.py, f.fx, f.fy});
-        else if (momentum) clear = row_clears({f.m, f.px, f.py});
-        else clear = row_clears({f.fx, f.fy});
-      }
-      const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
-      auto pass = [&] {
-        scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
-          kernels::RowClear* c = clear.empty() ? nullptr : &clear[s];
-          flags[s] |= kernels::p2g<S, W>(grid, p, b, e, f, inv_rho(g),
-                                         (W & kContact) ? &sbox[s] : nullptr, stretch_limit(g), c);
-          if (c && g == G - 1) c->finish();
-        });
-      };
-      pass();
-      // A particle outside its strip's rows (moved since the last moving pass): the whole grid
-      // cleared and the pass again, as the step did before the passes cleared their own rows.
-      if (std::any_of(clear.begin(), clear.end(), [](const kernels::RowClear& c) { return c.outside; })) {
-        refresh_strip_rows();
-        row_clear_ = false;
-        full_reset(opt.scheme != Scheme::USL);
-        clear.clear();
-        std::fill(flags.begin(), flags.end(), 0u);
-        pass();
-      }
+      scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
+        flags[s] |= kernels::p2g<S, W>(grid, p, b, e, f, inv_rho(g),
+                                       (W & kContact) ? &sbox[s] : nullptr, stretch_limit(g));
+      });
       for (unsigned n : flags) {
         collapsed_ += (n & kernels::kInverted) != 0;
         stretched_ += (n & kernels::kStretched) != 0;
@@ -2165,28 +2091,19 @@ void Solver::g2p(bool remap, bool move) {
       f.qx[i] = 0; f.qy[i] = 0;
     });
     std::vector<double> ke(nstrips_, 0.0), v2(nstrips_, 0.0);
-    // MUSL's re-map clears its rows (USF's re-mapped momenta were cleared by reset_grid).
-    std::vector<kernels::RowClear> clear;
-    if (remap && F.body < 0 && opt.scheme == Scheme::MUSL) clear = row_clears({f.qx, f.qy});
-    const int G = static_cast<int>(std::max<std::size_t>(1, materials.size()));
     auto body = [&](uint32_t b, uint32_t e, int g, int s) {
       RowSpan r;
       const double ir = inv_rho(g);
-      kernels::RowClear* c = clear.empty() ? nullptr : &clear[s];
       if (remap && move) kernels::g2p<S, true, true>(grid, p, b, e, f, ir, flip, DT, r);
-      else if (remap) kernels::g2p<S, true, false>(grid, p, b, e, f, ir, flip, DT, r, c);
+      else if (remap) kernels::g2p<S, true, false>(grid, p, b, e, f, ir, flip, DT, r);
       else if (move) kernels::g2p<S, false, true>(grid, p, b, e, f, ir, flip, DT, r);
       else kernels::g2p<S, false, false>(grid, p, b, e, f, ir, flip, DT, r);
-      if (c && g == G - 1) c->finish();
       if (move) merge_rows(s, r);
       ke[s] += r.kinetic;
       v2[s] = std::max(v2[s], r.speed2);
     };
     if (remap) scatter(F.ranges, body);
     else parallel(F.ranges, body);
-    // The particles have not moved since p2g, which checked their rows.
-    for (const kernels::RowClear& c : clear)
-      if (c.outside) throw std::logic_error("g2p: a particle outside the rows p2g found its strip in");
     for (int s = 0; s < nstrips_; ++s) {
       step_kinetic_ += ke[s];
       step_speed2_ = std::max(step_speed2_, v2[s]);

@@ -69,52 +69,6 @@ TEST(Transfer, ParticleLeavingTheGridIsAnError) {
   }
 }
 
-// The passes clear their nodal sums row by row, each strip the rows it reaches first, from the
-// rows its particles were found in by the last moving pass. A particle moved between steps (here
-// the lowest strip's first one, taken to the top of the block, into the last strip's rows, which
-// that strip clears after the first has run) must not lose its share: the step notices and
-// clears the whole grid first. After the step the nodal masses and start momenta sum to the
-// particles' (partition of unity, to round-off), for every scheme, shape and 1 or 2 threads; a
-// lost share would be a particle's whole mass (1/200 of the sum).
-TEST(Transfer, AParticleMovedBetweenStepsKeepsItsShareOfTheGrid) {
-  for (Scheme scheme : {Scheme::MUSL, Scheme::USF, Scheme::USL})
-    for (ShapeKind shape : {ShapeKind::Bilinear, ShapeKind::BSpline2})
-      for (int threads : {1, 2}) {
-        Solver s;
-        s.opt.scheme = scheme;
-        s.opt.shape = shape;
-        s.opt.threads = threads;
-        s.materials.push_back(tungsten());
-        s.grid.init(0, 0, 1e-3, 16, 28);
-        s.seed_rectangle(3e-3, 3e-3, 13e-3, 23e-3, 1, 0, 0, 1.0, -2.0);
-        s.dt = 0.2 * s.critical_dt();
-        s.finalize();
-        for (int i = 0; i < 3; ++i) s.step();
-        std::size_t low = 0;
-        for (std::size_t k = 1; k < s.p.size(); ++k)
-          if (s.p.y[k] < s.p.y[low]) low = k;
-        s.p.y[low] += 19e-3;  // from the first cell row of the block to its last
-        double m = 0, px = 0, py = 0;
-        for (std::size_t k = 0; k < s.p.size(); ++k) {
-          m += s.p.mass[k];
-          px += s.p.mass[k] * s.p.vx[k];
-          py += s.p.mass[k] * s.p.vy[k];
-        }
-        s.step();
-        double M = 0, PX = 0, PY = 0;
-        for (std::size_t i = 0; i < s.grid.nodes(); ++i) {
-          M += s.grid.m[i];
-          PX += s.grid.px[i];
-          PY += s.grid.py[i];
-        }
-        const std::string name = std::string(scheme_name(scheme)) + " " + shape_name(shape) +
-                                 " threads " + std::to_string(threads);
-        EXPECT_NEAR(M, m, 1e-13 * m) << name;
-        EXPECT_NEAR(PX, px, 1e-13 * m) << name;
-        EXPECT_NEAR(PY, py, 2e-13 * m) << name;
-      }
-}
-
 // Solver::nodal_projection (the MPM grid's snapshots, output.grid): for every shape, the nodal
 // masses sum to the particles' mass and the nodal momenta to theirs (partition of unity, to
 // round-off), a uniform stress comes back exactly at every node with mass, and nodes out of

@@ -74,43 +74,6 @@ struct RowSpan {
 };
 
 namespace kernels {
-// The nodal sums a scatter pass starts from zero, cleared row by row by the pass itself (instead
-// of a sweep over the whole grid before it): a strip zeroes a node row it owns just before its
-// particles first add into it, while the row is on its way into the cache anyway. That saves
-// the clearing sweep's writes, one per field and node. A row is owned by the first strip, in the
-// order the scatter runs them, whose rows [lo, hi] hold it (Solver::reset_grid); rows no strip
-// holds were cleared there. The strip's rows come from the last moving pass: a particle whose
-// stencil leaves them (moved since, outside the step) sets `outside`, and the solver redoes the
-// pass after clearing the whole grid.
-struct RowClear {
-  const int* owner = nullptr;  // per node row: the strip that clears it, or -1
-  int strip = 0;
-  int lo = 0, hi = -1;         // the node rows the strip's particles may touch
-  int done = -1;               // rows up to `done` are cleared (or not this strip's)
-  long nnx = 0;
-  double* field[5] = {};
-  int nfields = 0;
-  bool outside = false;
-  void start(int s, int lo_, int hi_, const int* own, long nnx_) {
-    strip = s; lo = lo_; hi = hi_; done = lo_ - 1; owner = own; nnx = nnx_; outside = false;
-  }
-  void add(double* f) { field[nfields++] = f; }
-  // The pass is about to add into node rows [bottom, top].
-  void touch(int bottom, int top) {
-    if (bottom < lo || top > hi) {
-      outside = true;
-      top = top > hi ? hi : top;
-    }
-    while (done < top) {
-      ++done;
-      if (owner[done] != strip) continue;
-      for (int c = 0; c < nfields; ++c)
-        std::memset(field[c] + done * nnx, 0, sizeof(double) * static_cast<std::size_t>(nnx));
-    }
-  }
-  void finish() { touch(lo, hi); }  // the strip's rows its particles did not reach
-};
-
 
 // Four particles at a time (GCC vector extensions): one register per quantity, each lane the
 // scalar code's operations in its order.
@@ -125,7 +88,7 @@ inline void store(double* a, V4 v) { std::memcpy(a, &v, sizeof v); }
 // Bilinear::eval of four points: each one's first node n0 (its cell's lower left) and the values
 // N (and gradients dNx, dNy) in Bilinear's node order.
 inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nnx, long n0[4],
-                            V4 N[4], V4* dNx = nullptr, V4* dNy = nullptr, int* rows = nullptr) {
+                            V4 N[4], V4* dNx = nullptr, V4* dNy = nullptr) {
   const V4 gx = (x - x0) * ih, gy = (y - y0) * ih;
   V4 cif, cjf;
   for (int l = 0; l < 4; ++l) {
@@ -133,7 +96,6 @@ inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nn
     cif[l] = ci;
     cjf[l] = cj;
     n0[l] = static_cast<long>(cj) * nnx + ci;
-    if (rows) rows[l] = cj;
   }
   const V4 xi = gx - cif, eta = gy - cjf;
   const V4 a = 1.0 - xi, b = 1.0 - eta;
@@ -142,15 +104,6 @@ inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nn
     dNx[0] = -b * ih; dNx[1] = b * ih; dNx[2] = eta * ih; dNx[3] = -eta * ih;
     dNy[0] = -a * ih; dNy[1] = -xi * ih; dNy[2] = xi * ih; dNy[3] = a * ih;
   }
-}
-// The lowest and highest of four cell rows.
-inline int lowest(const int r[4]) {
-  const int a = r[0] < r[1] ? r[0] : r[1], b = r[2] < r[3] ? r[2] : r[3];
-  return a < b ? a : b;
-}
-inline int highest(const int r[4]) {
-  const int a = r[0] > r[1] ? r[0] : r[1], b = r[2] > r[3] ? r[2] : r[3];
-  return a > b ? a : b;
 }
 // The essential conditions of four nodes as lane masks: x held (fix bit 0) and y held (bit 1).
 using M4 = long __attribute__((vector_size(32)));
@@ -181,7 +134,7 @@ inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, R
 template <unsigned WHAT>
 inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uint32_t e,
                               const NodalField& f, double stretch_limit, bool& negative,
-                              bool& stretched, RowClear* clear) {
+                              bool& stretched) {
   using simd::V4;
   const double ih = g.inv_h;
   const long nnx = g.nnx;
@@ -209,10 +162,8 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[4], dNx[4], dNy[4];
-    int row[4];
     simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
-                          dNy, row);
-    if (clear) clear->touch(simd::lowest(row), simd::highest(row) + 1);
+                          dNy);
     for (int l = 0; l < 4; ++l) {
       const uint32_t q = k + l;
       // The node sums of this particle in node order 0 (n0), 1 (n0 + 1), 2 (n0 + nnx + 1),
@@ -264,8 +215,7 @@ constexpr unsigned kInverted = 1, kStretched = 2;
 template <class Shape, unsigned WHAT>
 inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
                     double inv_rho, NodeBox* box = nullptr,
-                    double stretch_limit = std::numeric_limits<double>::infinity(),
-                    RowClear* clear = nullptr) {
+                    double stretch_limit = std::numeric_limits<double>::infinity()) {
   const double ih = g.inv_h;
   const long nnx = g.nnx;
   const double* X = p.x.data(); const double* Y = p.y.data();
@@ -277,12 +227,11 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
   bool negative = false, stretched = false;
   uint32_t k = b;
   if constexpr (std::is_same_v<Shape, Bilinear> && (WHAT & kContact) == 0)
-    k = p2g_bilinear4<WHAT>(g, p, b, e, f, stretch_limit, negative, stretched, clear);
+    k = p2g_bilinear4<WHAT>(g, p, b, e, f, stretch_limit, negative, stretched);
   for (; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
-    if (clear) clear->touch(sf.first_row(), sf.first_row() + Shape::kRowSpan - 1);
     if constexpr ((WHAT & kMomentum) != 0) {
       const double mk = M[k], mvx = mk * VX[k], mvy = mk * VY[k];
       if constexpr ((WHAT & kContact) != 0) {
@@ -327,7 +276,7 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
 template <bool REMAP, bool MOVE>
 inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
                               const NodalField& f, double flip, double dt, RowSpan& rows,
-                              double& kinetic, double& speed2, RowClear* clear) {
+                              double& kinetic, double& speed2) {
   using simd::V4;
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h;
   const long nnx = g.nnx;
@@ -341,10 +290,7 @@ inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t 
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[4];
-    int row[4];
-    simd::bilinear_values(simd::load(X + k), simd::load(Y + k), x0, y0, ih, nnx, n0, N, nullptr,
-                          nullptr, row);
-    if (REMAP && clear) clear->touch(simd::lowest(row), simd::highest(row) + 1);
+    simd::bilinear_values(simd::load(X + k), simd::load(Y + k), x0, y0, ih, nnx, n0, N);
     const long off[4] = {0, 1, nnx + 1, nnx};
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
     for (int c = 0; c < 4; ++c) {
@@ -384,8 +330,7 @@ inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t 
 // particle momenta into (qx, qy). MOVE: USF's position update with the updated nodal velocity.
 template <class Shape, bool REMAP, bool MOVE>
 inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const NodalField& f,
-                double inv_rho, double flip, double dt, RowSpan& rows,
-                RowClear* clear = nullptr) {
+                double inv_rho, double flip, double dt, RowSpan& rows) {
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
   const long nnx = g.nnx;
   const double pic = 1.0 - flip;
@@ -399,12 +344,11 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   long nodes[Shape::kNodes];
   uint32_t k = b;
   if constexpr (std::is_same_v<Shape, Bilinear>)
-    k = g2p_bilinear4<REMAP, MOVE>(g, p, b, e, f, flip, dt, rows, kinetic, speed2, clear);
+    k = g2p_bilinear4<REMAP, MOVE>(g, p, b, e, f, flip, dt, rows, kinetic, speed2);
   for (; k < e; ++k) {
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
-    if (REMAP && clear) clear->touch(sf.first_row(), sf.first_row() + Shape::kRowSpan - 1);
     double dvx = 0, dvy = 0, wx = 0, wy = 0;
     for (int a = 0; a < Shape::kNodes; ++a) {
       const long i = nodes[a];

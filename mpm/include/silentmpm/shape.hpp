@@ -7,7 +7,6 @@
 //   eval(grid, x, y)       values N[a] and gradients dNx[a], dNy[a] at a point of the grid
 //   eval_clamped(grid, x, y)   the same for a boundary point that may sit on the grid's edge
 //   node_indices(nnx, nodes)   grid node index of each a
-//   first_row(), kRowSpan  the node rows of the evaluated support: first_row() + 0 .. kRowSpan - 1
 //   grow_box(box)          widen a node box {i0, i1, j0, j1} to the support
 // Three shapes: Bilinear (the paper's), UGimp (uniform GIMP) and BSpline2 (quadratic B-spline).
 // Each is a partition of unity and reproduces linear fields, up to the grid's edges included.
@@ -33,7 +32,6 @@ namespace smpm {
 struct Bilinear {
   static constexpr int kNodes = 4;
   static constexpr int kRowsBelow = 0, kRowsAbove = 1;
-  static constexpr int kRowSpan = 2;  // node rows of the stencil, from first_row()
   static constexpr bool kSized = false;
   int ci = 0, cj = 0;   // cell index
   double N[4];          // shape function values
@@ -66,8 +64,6 @@ struct Bilinear {
     const long n0 = static_cast<long>(cj) * nnx + ci;
     nodes[0] = n0; nodes[1] = n0 + 1; nodes[2] = n0 + nnx + 1; nodes[3] = n0 + nnx;
   }
-
-  int first_row() const { return cj; }
 
   inline void grow_box(std::array<int, 4>& b) const {
     b[0] = ci < b[0] ? ci : b[0];
@@ -160,9 +156,7 @@ template <class Derived>
 struct Shape3x3 {
   static constexpr int kNodes = 9;
   static constexpr int kRowsBelow = 1, kRowsAbove = 2;
-  static constexpr int kRowSpan = 3;  // node rows of the stencil, from first_row()
   int bi = 0, bj = 0;  // lower-left node of the support
-  int first_row() const { return bj; }
   double N[9], dNx[9], dNy[9];
 
   SMPM_SHAPE_INLINE void eval(const Grid& g, double x, double y) {

@@ -27,7 +27,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -404,15 +403,6 @@ class Solver {
   void refresh_fields();
   bool strips_conflict() const;
   void reset_grid();
-  // The passes clear their own nodal sums row by row (kernels::RowClear) when the step has the
-  // grid's own field only: each node row's clearing strip (-1: cleared by reset_grid), and each
-  // strip's node rows.
-  bool row_clear_ = false;
-  std::vector<int> clear_owner_;
-  std::vector<std::array<int, 2>> clear_rows_;
-  void full_reset(bool remapped);
-  // One RowClear per strip over the arrays given, started on the strips' rows (none: empty).
-  std::vector<kernels::RowClear> row_clears(std::initializer_list<double*> arrays) const;
   template <class Fn> void scatter(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void call(Fn&& fn);
