@@ -126,6 +126,79 @@ inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, R
   for (int l = 0; l < 4; ++l)
     rows.add(static_cast<int>(std::floor((yn[l] - y0) * ih)), !(xn[l] >= x0 && xn[l] < x1));
 }
+// Four points' shape functions in registers, for the passes that take four particles at a time:
+// each lane's first node n0 (the scalar shape's node a is n0 + off[a]), the values N[a] and
+// gradients dNx[a], dNy[a], each the scalar shape's arithmetic. eval() returns false when a lane
+// needs what the vector form leaves to the scalar shape (the 3 x 3 supports folded at the
+// grid's edge): those four particles take the scalar loop.
+struct Bilinear4 {
+  static constexpr int kNodes = 4;
+  long off[4];
+  explicit Bilinear4(long nnx) : off{0, 1, nnx + 1, nnx} {}
+  bool eval(V4 x, V4 y, const Grid& g, long n0[4], V4 N[4], V4* dNx, V4* dNy) const {
+    bilinear_values(x, y, g.x0, g.y0, g.inv_h, g.nnx, n0, N, dNx, dNy);
+    return true;
+  }
+};
+// The quadratic B-spline (BSpline2): per axis the support's first node floor(g - 1/2) and the
+// weights of shape_detail::bspline2_1d.
+struct BSpline4 {
+  static constexpr int kNodes = 9;
+  long off[9];
+  explicit BSpline4(long nnx) {
+    for (int jj = 0; jj < 3; ++jj)
+      for (int ii = 0; ii < 3; ++ii) off[3 * jj + ii] = jj * nnx + ii;
+  }
+  // One axis (coordinates x, the grid's origin x0): false if a lane's support leaves the nodes
+  // 0 .. nn - 1. The grid coordinate's product (x - x0) / h goes into both of its uses, the first
+  // node floor(g - 1/2) and the offset g - base, as one multiply-add each where GCC builds
+  // Shape3x3::eval with them (it fuses a product into every use that adds it), as two roundings
+  // otherwise: the same bits (Kernels.FourAtATimeEqualsTheScalarLoopBitForBit).
+  static bool axis(V4 x, double x0, double ih, int nn, int base[4], V4 w[3], V4 d[3]) {
+    V4 f;
+    bool inside = true;
+    for (int l = 0; l < 4; ++l) {
+      const double dx = x[l] - x0;
+#if defined(__FMA__) && !defined(__clang__)
+      base[l] = static_cast<int>(std::floor(std::fma(dx, ih, -0.5)));
+      f[l] = std::fma(dx, ih, -static_cast<double>(base[l]));
+#else
+      const double gc = dx * ih;
+      base[l] = static_cast<int>(std::floor(gc - 0.5));
+      f[l] = gc - base[l];
+#endif
+      inside = inside && base[l] >= 0 && base[l] + 2 < nn;
+    }
+    const V4 a = 1.5 - f, b = f - 1.0, c = f - 0.5;
+    w[0] = 0.5 * a * a;  d[0] = -a;
+    w[1] = 0.75 - b * b; d[1] = -2 * b;
+    w[2] = 0.5 * c * c;  d[2] = c;
+    return inside;
+  }
+  bool eval(V4 x, V4 y, const Grid& g, long n0[4], V4 N[9], V4* dNx, V4* dNy) const {
+    const double ih = g.inv_h;
+    int bi[4], bj[4];
+    V4 wx[3], dx[3], wy[3], dy[3];
+    const bool in_x = axis(x, g.x0, ih, g.nnx, bi, wx, dx);
+    const bool in_y = axis(y, g.y0, ih, g.nny, bj, wy, dy);
+    if (!(in_x && in_y)) return false;
+    for (int l = 0; l < 4; ++l) n0[l] = static_cast<long>(bj[l]) * g.nnx + bi[l];
+    for (int jj = 0; jj < 3; ++jj)
+      for (int ii = 0; ii < 3; ++ii) {
+        const int a = 3 * jj + ii;
+        N[a] = wx[ii] * wy[jj];
+        if (dNx) {
+          dNx[a] = dx[ii] * ih * wy[jj];
+          dNy[a] = wx[ii] * dy[jj] * ih;
+        }
+      }
+    return true;
+  }
+};
+// The four-particle form of a scalar shape (void: none).
+template <class Shape> struct Vector4 { using type = void; };
+template <> struct Vector4<Bilinear> { using type = Bilinear4; };
+template <> struct Vector4<BSpline2> { using type = BSpline4; };
 }  // namespace simd
 
 // p2g with bilinear shapes (no contact fields), four particles at a time: the shape values in
@@ -380,18 +453,20 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   rows.speed2 = speed2 > rows.speed2 ? speed2 : rows.speed2;
 }
 
-// update_stress for bilinear shapes and the elastic and von Mises models, four particles at a
-// time (one SIMD register per quantity, each lane the scalar loop's operations in its order; the
-// dissipation summed lane by lane in particle order: the same bits). Returns the first particle
-// left for the scalar loop.
-template <Model MODEL, bool MOVE>
-inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
-                                        const Material& mat, const double* gx, const double* gy,
-                                        const double* ux, const double* uy, double dt,
-                                        RowSpan& rows, double& diss) {
+// update_stress for the elastic and von Mises models, four particles at a time, with the shape
+// functions of S4 (simd::Bilinear4, simd::BSpline4): one SIMD register per quantity, each lane
+// the scalar loop's operations in its order; the dissipation summed lane by lane in particle
+// order: the same bits. Returns the first particle left for the scalar loop: the range's last
+// one to three, or the first of four that S4 leaves to the scalar shape.
+template <class S4, Model MODEL, bool MOVE>
+inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
+                               const Material& mat, const double* gx, const double* gy,
+                               const double* ux, const double* uy, double dt, RowSpan& rows,
+                               double& diss) {
   using simd::V4;
-  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h;
-  const long nnx = g.nnx;
+  constexpr int K = S4::kNodes;
+  const S4 shape(g.nnx);
+  const long* off = shape.off;
   double* X = p.x.data(); double* Y = p.y.data();
   double* V = p.vol.data();
   double* SXX = p.sxx.data(); double* SYY = p.syy.data();
@@ -400,12 +475,10 @@ inline uint32_t update_stress_bilinear4(const Grid& g, Particles& p, uint32_t b,
   uint32_t k = b;
   for (; k + 4 <= e; k += 4) {
     long n0[4];
-    V4 N[4], dNx[4], dNy[4];
-    simd::bilinear_values(simd::load(X + k), simd::load(Y + k), x0, y0, ih, nnx, n0, N, dNx,
-                          dNy);
-    const long off[4] = {0, 1, nnx + 1, nnx};
+    V4 N[K], dNx[K], dNy[K];
+    if (!shape.eval(simd::load(X + k), simd::load(Y + k), g, n0, N, dNx, dNy)) return k;
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
-    for (int c = 0; c < 4; ++c) {
+    for (int c = 0; c < K; ++c) {
       const V4 Gx = simd::gather(gx, n0, off[c]), Gy = simd::gather(gy, n0, off[c]);
       lxx += Gx * dNx[c];
       lxy += Gx * dNy[c];
@@ -474,11 +547,19 @@ inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
   double diss = 0;
   Shape sf;
   long nodes[Shape::kNodes];
-  uint32_t k = b;
-  if constexpr (std::is_same_v<Shape, Bilinear> &&
-                (MODEL == Model::Elastic || MODEL == Model::VonMises))
-    k = update_stress_bilinear4<MODEL, MOVE>(g, p, b, e, mat, gx, gy, ux, uy, dt, rows, diss);
+  using S4 = typename simd::Vector4<Shape>::type;
+  constexpr bool kFour = !std::is_void_v<S4> && (MODEL == Model::Elastic || MODEL == Model::VonMises);
+  // Four at a time where the vector shape takes them; four it leaves (a 3 x 3 support folded at
+  // the grid's edge) go one by one until it takes four again.
+  uint32_t k = b, retry = b;
   for (; k < e; ++k) {
+    if constexpr (kFour) {
+      if (k == retry) {
+        k = update_stress4<S4, MODEL, MOVE>(g, p, k, e, mat, gx, gy, ux, uy, dt, rows, diss);
+        retry = k + 1;
+        if (k == e) break;
+      }
+    }
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
