@@ -192,25 +192,36 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   const int n = 103;  // 25 groups of four and a tail of three
   const KernelState start(n, 11);
   const double dt = 1e-8, inv_rho = 1.0 / tungsten().rho;
-  {  // p2g: mass, momenta, forces
+  auto p2g = [&](auto shape_c) {  // p2g: mass, momenta, forces
+    using S = decltype(shape_c);
     KernelState w = start, s = start;
-    kernels::p2g<Bilinear, kMomentum | kForce>(w.g, w.p, 0, n, w.f, inv_rho);
+    kernels::p2g<S, kMomentum | kForce>(w.g, w.p, 0, n, w.f, inv_rho);
     for (int k = 0; k < n; ++k)
-      kernels::p2g<Bilinear, kMomentum | kForce>(s.g, s.p, k, k + 1, s.f, inv_rho);
-    expect_same(w, s, "p2g");
-  }
-  for (double flip : {1.0, 0.95}) {  // g2p with the re-map and the move (USF's)
+      kernels::p2g<S, kMomentum | kForce>(s.g, s.p, k, k + 1, s.f, inv_rho);
+    expect_same(w, s, std::is_same_v<S, Bilinear> ? "p2g, bilinear" : "p2g, B-spline");
+  };
+  p2g(Bilinear());
+  p2g(BSpline2());
+  // g2p with the re-map and the move (USF's), bilinear and B-spline.
+  auto g2p = [&](auto shape_c, double flip) {
+    using S = decltype(shape_c);
+    const std::string pass = std::string("g2p, flip ") + std::to_string(flip) +
+                             (std::is_same_v<S, Bilinear> ? ", bilinear" : ", B-spline");
     KernelState w = start, s = start;
     RowSpan rw, rs;
-    kernels::g2p<Bilinear, true, true>(w.g, w.p, 0, n, w.f, inv_rho, flip, dt, rw);
+    kernels::g2p<S, true, true>(w.g, w.p, 0, n, w.f, inv_rho, flip, dt, rw);
     for (int k = 0; k < n; ++k)
-      kernels::g2p<Bilinear, true, true>(s.g, s.p, k, k + 1, s.f, inv_rho, flip, dt, rs);
-    expect_same(w, s, "g2p");
-    EXPECT_EQ(rw.lo, rs.lo);
-    EXPECT_EQ(rw.hi, rs.hi);
-    EXPECT_EQ(rw.out, rs.out);
-    EXPECT_EQ(rw.speed2, rs.speed2);
-    EXPECT_NEAR(rw.kinetic, rs.kinetic, 1e-14 * rs.kinetic);
+      kernels::g2p<S, true, true>(s.g, s.p, k, k + 1, s.f, inv_rho, flip, dt, rs);
+    expect_same(w, s, pass.c_str());
+    EXPECT_EQ(rw.lo, rs.lo) << pass;
+    EXPECT_EQ(rw.hi, rs.hi) << pass;
+    EXPECT_EQ(rw.out, rs.out) << pass;
+    EXPECT_EQ(rw.speed2, rs.speed2) << pass;
+    EXPECT_NEAR(rw.kinetic, rs.kinetic, 1e-14 * rs.kinetic) << pass;
+  };
+  for (double flip : {1.0, 0.95}) {
+    g2p(Bilinear(), flip);
+    g2p(BSpline2(), flip);
   }
   // The stress update, moving, with the bilinear and the quadratic B-spline shapes.
   auto stress = [&](auto shape_c, Model model) {

@@ -278,6 +278,53 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
   return k;
 }
 
+// p2g four particles at a time with the 3 x 3 shapes of S4 (simd::BSpline4; no contact fields):
+// the shape values in SIMD registers, the sums into the nodes lane by lane in particle order,
+// each term as the scalar loop writes it (the same bits). Returns the first particle left for
+// the scalar loop: the range's last one to three, or the first of four that S4 leaves to the
+// scalar shape.
+template <class S4, unsigned WHAT>
+inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
+                     double stretch_limit, bool& negative, bool& stretched) {
+  using simd::V4;
+  constexpr int K = S4::kNodes;
+  const S4 shape(g.nnx);
+  const long* off = shape.off;
+  const double* X = p.x.data(); const double* Y = p.y.data();
+  const double* VX = p.vx.data(); const double* VY = p.vy.data();
+  const double* M = p.mass.data(); const double* V = p.vol.data();
+  const double* SXX = p.sxx.data(); const double* SYY = p.syy.data(); const double* SXY = p.sxy.data();
+  uint32_t k = b;
+  for (; k + 4 <= e; k += 4) {
+    long n0[4];
+    V4 N[K], dNx[K], dNy[K];
+    if (!shape.eval(simd::load(X + k), simd::load(Y + k), g, n0, N, dNx, dNy)) return k;
+    for (int l = 0; l < 4; ++l) {
+      const uint32_t q = k + l;
+      if constexpr ((WHAT & kMomentum) != 0) {
+        const double mk = M[q], mvx = mk * VX[q], mvy = mk * VY[q];
+        for (int a = 0; a < K; ++a) {
+          const long i = n0[l] + off[a];
+          f.m[i] += mk * N[a][l];
+          f.px[i] += mvx * N[a][l];
+          f.py[i] += mvy * N[a][l];
+        }
+      }
+      if constexpr ((WHAT & kForce) != 0) {
+        const double v = V[q], sxx = SXX[q], syy = SYY[q], sxy = SXY[q];
+        negative |= std::signbit(v);
+        stretched |= v > stretch_limit * M[q];
+        for (int a = 0; a < K; ++a) {
+          const long i = n0[l] + off[a];
+          f.fx[i] -= v * (sxx * dNx[a][l] + sxy * dNy[a][l]);
+          f.fy[i] -= v * (sxy * dNx[a][l] + syy * dNy[a][l]);
+        }
+      }
+    }
+  }
+  return k;
+}
+
 // Particle to grid over [b, e) (paper Eq. 15, 18): mass and momentum, and/or the internal force.
 // With kContact the node box the particles touch is grown in `box`.
 // inv_rho: 1 / density of the range's material (shapes that need the particle size).
@@ -298,10 +345,20 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
   Shape sf;
   long nodes[Shape::kNodes];
   bool negative = false, stretched = false;
-  uint32_t k = b;
-  if constexpr (std::is_same_v<Shape, Bilinear> && (WHAT & kContact) == 0)
-    k = p2g_bilinear4<WHAT>(g, p, b, e, f, stretch_limit, negative, stretched);
+  using S4 = typename simd::Vector4<Shape>::type;
+  // Four at a time where the vector shape takes them (see update_stress).
+  uint32_t k = b, retry = b;
   for (; k < e; ++k) {
+    if constexpr (!std::is_void_v<S4> && (WHAT & kContact) == 0) {
+      if (k == retry) {
+        if constexpr (std::is_same_v<Shape, Bilinear>)
+          k = p2g_bilinear4<WHAT>(g, p, k, e, f, stretch_limit, negative, stretched);
+        else
+          k = p2g4<S4, WHAT>(g, p, k, e, f, stretch_limit, negative, stretched);
+        retry = k + 1;
+        if (k == e) break;
+      }
+    }
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
@@ -342,17 +399,18 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
   return (negative ? kInverted : 0u) | (stretched ? kStretched : 0u);
 }
 
-// g2p for bilinear shapes, four particles at a time (one SIMD register per quantity, each lane
-// the scalar loop's operations in its order; the sums over particles, the kinetic energy and the
-// re-mapped momenta, taken lane by lane in particle order: the same bits). Returns the first
-// particle left for the scalar loop.
-template <bool REMAP, bool MOVE>
-inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t e,
-                              const NodalField& f, double flip, double dt, RowSpan& rows,
-                              double& kinetic, double& speed2) {
+// g2p four particles at a time, with the shape functions of S4 (simd::Bilinear4,
+// simd::BSpline4): one SIMD register per quantity, each lane the scalar loop's operations in its
+// order; the sums over particles, the kinetic energy and the re-mapped momenta, taken lane by
+// lane in particle order: the same bits. Returns the first particle left for the scalar loop:
+// the range's last one to three, or the first of four that S4 leaves to the scalar shape.
+template <class S4, bool REMAP, bool MOVE>
+inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const NodalField& f,
+                     double flip, double dt, RowSpan& rows, double& kinetic, double& speed2) {
   using simd::V4;
-  const double x0 = g.x0, y0 = g.y0, ih = g.inv_h;
-  const long nnx = g.nnx;
+  constexpr int K = S4::kNodes;
+  const S4 shape(g.nnx);
+  const long* off = shape.off;
   const double pic = 1.0 - flip;
   const double* vx = f.vx; const double* vy = f.vy;
   const double* ux = f.vnx; const double* uy = f.vny;
@@ -362,11 +420,10 @@ inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t 
   uint32_t k = b;
   for (; k + 4 <= e; k += 4) {
     long n0[4];
-    V4 N[4];
-    simd::bilinear_values(simd::load(X + k), simd::load(Y + k), x0, y0, ih, nnx, n0, N);
-    const long off[4] = {0, 1, nnx + 1, nnx};
+    V4 N[K];
+    if (!shape.eval(simd::load(X + k), simd::load(Y + k), g, n0, N, nullptr, nullptr)) return k;
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
-    for (int c = 0; c < 4; ++c) {
+    for (int c = 0; c < K; ++c) {
       const V4 Ux = simd::gather(ux, n0, off[c]), Uy = simd::gather(uy, n0, off[c]);
       const V4 Vx = simd::gather(vx, n0, off[c]), Vy = simd::gather(vy, n0, off[c]);
       wx += N[c] * Ux;
@@ -388,7 +445,7 @@ inline uint32_t g2p_bilinear4(const Grid& g, Particles& p, uint32_t b, uint32_t 
     if constexpr (REMAP) {
       const V4 mvx = mk * nvx, mvy = mk * nvy;
       for (int l = 0; l < 4; ++l)
-        for (int c = 0; c < 4; ++c) {
+        for (int c = 0; c < K; ++c) {
           f.qx[n0[l] + off[c]] += mvx[l] * N[c][l];
           f.qy[n0[l] + off[c]] += mvy[l] * N[c][l];
         }
@@ -415,10 +472,17 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   double kinetic = 0, speed2 = 0;  // kept local: a reference could alias the particle arrays
   Shape sf;
   long nodes[Shape::kNodes];
-  uint32_t k = b;
-  if constexpr (std::is_same_v<Shape, Bilinear>)
-    k = g2p_bilinear4<REMAP, MOVE>(g, p, b, e, f, flip, dt, rows, kinetic, speed2);
+  using S4 = typename simd::Vector4<Shape>::type;
+  // Four at a time where the vector shape takes them (see update_stress).
+  uint32_t k = b, retry = b;
   for (; k < e; ++k) {
+    if constexpr (!std::is_void_v<S4>) {
+      if (k == retry) {
+        k = g2p4<S4, REMAP, MOVE>(g, p, k, e, f, flip, dt, rows, kinetic, speed2);
+        retry = k + 1;
+        if (k == e) break;
+      }
+    }
     if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
     sf.eval(g, X[k], Y[k]);
     sf.node_indices(nnx, nodes);
