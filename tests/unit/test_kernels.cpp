@@ -172,6 +172,11 @@ struct KernelState {
   }
 };
 
+template <class S>
+const char* shape_of() {
+  return std::is_same_v<S, Bilinear> ? ", bilinear" : ", B-spline";
+}
+
 bool same_bits(const std::vector<double>& x, const std::vector<double>& y) {
   return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
 }
@@ -198,7 +203,7 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
     kernels::p2g<S, kMomentum | kForce>(w.g, w.p, 0, n, w.f, inv_rho);
     for (int k = 0; k < n; ++k)
       kernels::p2g<S, kMomentum | kForce>(s.g, s.p, k, k + 1, s.f, inv_rho);
-    expect_same(w, s, std::is_same_v<S, Bilinear> ? "p2g, bilinear" : "p2g, B-spline");
+    expect_same(w, s, (std::string("p2g") + shape_of<S>()).c_str());
   };
   p2g(Bilinear());
   p2g(BSpline2());
@@ -206,7 +211,7 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   auto g2p = [&](auto shape_c, double flip) {
     using S = decltype(shape_c);
     const std::string pass = std::string("g2p, flip ") + std::to_string(flip) +
-                             (std::is_same_v<S, Bilinear> ? ", bilinear" : ", B-spline");
+                             shape_of<S>();
     KernelState w = start, s = start;
     RowSpan rw, rs;
     kernels::g2p<S, true, true>(w.g, w.p, 0, n, w.f, inv_rho, flip, dt, rw);
@@ -252,7 +257,7 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
       EXPECT_GT(a, 0.0);
     }
     const std::string pass = std::string("stress, ") + (model == Model::Elastic ? "elastic" : "von Mises") +
-                             (std::is_same_v<S, Bilinear> ? ", bilinear" : ", B-spline");
+                             shape_of<S>();
     expect_same(w, s, pass.c_str());
     EXPECT_NEAR(a, b, 1e-14 * std::abs(b) + 1e-300) << pass;
     EXPECT_EQ(rw.lo, rs.lo) << pass;

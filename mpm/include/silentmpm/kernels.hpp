@@ -134,18 +134,22 @@ inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, R
 struct Bilinear4 {
   static constexpr int kNodes = 4;
   long off[4];
-  explicit Bilinear4(long nnx) : off{0, 1, nnx + 1, nnx} {}
-  bool eval(V4 x, V4 y, const Grid& g, long n0[4], V4 N[4], V4* dNx, V4* dNy) const {
+  Bilinear4(long nnx, double) : off{0, 1, nnx + 1, nnx} {}
+  bool eval(V4 x, V4 y, const double*, const Grid& g, long n0[4], V4 N[4], V4* dNx,
+            V4* dNy) const {
     bilinear_values(x, y, g.x0, g.y0, g.inv_h, g.nnx, n0, N, dNx, dNy);
     return true;
   }
 };
-// The quadratic B-spline (BSpline2): per axis the support's first node floor(g - 1/2) and the
-// weights of shape_detail::bspline2_1d.
-struct BSpline4 {
+// The 3 x 3 shapes (Shape3x3): per axis the support's first node floor(g - 1/2), the offset
+// from it and the weights of the shape's 1D rule (W::weights: four lanes' w[3], d[3]; given the
+// particles' masses for the sized ones).
+template <class W>
+struct Shape3x3_4 {
   static constexpr int kNodes = 9;
   long off[9];
-  explicit BSpline4(long nnx) {
+  W rule;
+  Shape3x3_4(long nnx, double inv_rho) : rule{inv_rho} {
     for (int jj = 0; jj < 3; ++jj)
       for (int ii = 0; ii < 3; ++ii) off[3 * jj + ii] = jj * nnx + ii;
   }
@@ -154,8 +158,7 @@ struct BSpline4 {
   // node floor(g - 1/2) and the offset g - base, as one multiply-add each where GCC builds
   // Shape3x3::eval with them (it fuses a product into every use that adds it), as two roundings
   // otherwise: the same bits (Kernels.FourAtATimeEqualsTheScalarLoopBitForBit).
-  static bool axis(V4 x, double x0, double ih, int nn, int base[4], V4 w[3], V4 d[3]) {
-    V4 f;
+  static bool axis(V4 x, double x0, double ih, int nn, int base[4], V4& f) {
     bool inside = true;
     for (int l = 0; l < 4; ++l) {
       const double dx = x[l] - x0;
@@ -169,19 +172,18 @@ struct BSpline4 {
 #endif
       inside = inside && base[l] >= 0 && base[l] + 2 < nn;
     }
-    const V4 a = 1.5 - f, b = f - 1.0, c = f - 0.5;
-    w[0] = 0.5 * a * a;  d[0] = -a;
-    w[1] = 0.75 - b * b; d[1] = -2 * b;
-    w[2] = 0.5 * c * c;  d[2] = c;
     return inside;
   }
-  bool eval(V4 x, V4 y, const Grid& g, long n0[4], V4 N[9], V4* dNx, V4* dNy) const {
+  bool eval(V4 x, V4 y, const double* mass, const Grid& g, long n0[4], V4 N[9], V4* dNx,
+            V4* dNy) const {
     const double ih = g.inv_h;
     int bi[4], bj[4];
-    V4 wx[3], dx[3], wy[3], dy[3];
-    const bool in_x = axis(x, g.x0, ih, g.nnx, bi, wx, dx);
-    const bool in_y = axis(y, g.y0, ih, g.nny, bj, wy, dy);
+    V4 fx, fy;
+    const bool in_x = axis(x, g.x0, ih, g.nnx, bi, fx);
+    const bool in_y = axis(y, g.y0, ih, g.nny, bj, fy);
     if (!(in_x && in_y)) return false;
+    V4 wx[3], dx[3], wy[3], dy[3];
+    rule.weights(fx, fy, mass, ih, wx, dx, wy, dy);
     for (int l = 0; l < 4; ++l) n0[l] = static_cast<long>(bj[l]) * g.nnx + bi[l];
     for (int jj = 0; jj < 3; ++jj)
       for (int ii = 0; ii < 3; ++ii) {
@@ -195,7 +197,25 @@ struct BSpline4 {
     return true;
   }
 };
-// The four-particle form of a scalar shape (void: none).
+// The quadratic B-spline's rule (shape_detail::bspline2_1d), in registers.
+struct BSplineRule4 {
+  double inv_rho;
+  static void one(V4 f, V4 w[3], V4 d[3]) {
+    const V4 a = 1.5 - f, b = f - 1.0, c = f - 0.5;
+    w[0] = 0.5 * a * a;  d[0] = -a;
+    w[1] = 0.75 - b * b; d[1] = -2 * b;
+    w[2] = 0.5 * c * c;  d[2] = c;
+  }
+  void weights(V4 fx, V4 fy, const double*, double, V4 wx[3], V4 dx[3], V4 wy[3],
+               V4 dy[3]) const {
+    one(fx, wx, dx);
+    one(fy, wy, dy);
+  }
+};
+using BSpline4 = Shape3x3_4<BSplineRule4>;
+// The four-particle form of a scalar shape (void: none). Uniform GIMP has none: its 1D rule
+// written lane by lane came out fused differently from the scalar shape's in the kernels (an ulp
+// in a third of the values), so its passes keep the scalar loop.
 template <class Shape> struct Vector4 { using type = void; };
 template <> struct Vector4<Bilinear> { using type = Bilinear4; };
 template <> struct Vector4<BSpline2> { using type = BSpline4; };
@@ -285,10 +305,10 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
 // scalar shape.
 template <class S4, unsigned WHAT>
 inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
-                     double stretch_limit, bool& negative, bool& stretched) {
+                     double inv_rho, double stretch_limit, bool& negative, bool& stretched) {
   using simd::V4;
   constexpr int K = S4::kNodes;
-  const S4 shape(g.nnx);
+  const S4 shape(g.nnx, inv_rho);
   const long* off = shape.off;
   const double* X = p.x.data(); const double* Y = p.y.data();
   const double* VX = p.vx.data(); const double* VY = p.vy.data();
@@ -298,7 +318,7 @@ inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, 
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[K], dNx[K], dNy[K];
-    if (!shape.eval(simd::load(X + k), simd::load(Y + k), g, n0, N, dNx, dNy)) return k;
+    if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
     for (int l = 0; l < 4; ++l) {
       const uint32_t q = k + l;
       if constexpr ((WHAT & kMomentum) != 0) {
@@ -354,7 +374,7 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
         if constexpr (std::is_same_v<Shape, Bilinear>)
           k = p2g_bilinear4<WHAT>(g, p, k, e, f, stretch_limit, negative, stretched);
         else
-          k = p2g4<S4, WHAT>(g, p, k, e, f, stretch_limit, negative, stretched);
+          k = p2g4<S4, WHAT>(g, p, k, e, f, inv_rho, stretch_limit, negative, stretched);
         retry = k + 1;
         if (k == e) break;
       }
@@ -406,10 +426,11 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
 // the range's last one to three, or the first of four that S4 leaves to the scalar shape.
 template <class S4, bool REMAP, bool MOVE>
 inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const NodalField& f,
-                     double flip, double dt, RowSpan& rows, double& kinetic, double& speed2) {
+                     double inv_rho, double flip, double dt, RowSpan& rows, double& kinetic,
+                     double& speed2) {
   using simd::V4;
   constexpr int K = S4::kNodes;
-  const S4 shape(g.nnx);
+  const S4 shape(g.nnx, inv_rho);
   const long* off = shape.off;
   const double pic = 1.0 - flip;
   const double* vx = f.vx; const double* vy = f.vy;
@@ -421,7 +442,7 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[K];
-    if (!shape.eval(simd::load(X + k), simd::load(Y + k), g, n0, N, nullptr, nullptr)) return k;
+    if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, nullptr, nullptr)) return k;
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
     for (int c = 0; c < K; ++c) {
       const V4 Ux = simd::gather(ux, n0, off[c]), Uy = simd::gather(uy, n0, off[c]);
@@ -478,7 +499,7 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
   for (; k < e; ++k) {
     if constexpr (!std::is_void_v<S4>) {
       if (k == retry) {
-        k = g2p4<S4, REMAP, MOVE>(g, p, k, e, f, flip, dt, rows, kinetic, speed2);
+        k = g2p4<S4, REMAP, MOVE>(g, p, k, e, f, inv_rho, flip, dt, rows, kinetic, speed2);
         retry = k + 1;
         if (k == e) break;
       }
@@ -529,9 +550,10 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
                                double& diss) {
   using simd::V4;
   constexpr int K = S4::kNodes;
-  const S4 shape(g.nnx);
+  const S4 shape(g.nnx, 1.0 / mat.rho);
   const long* off = shape.off;
   double* X = p.x.data(); double* Y = p.y.data();
+  const double* M = p.mass.data();
   double* V = p.vol.data();
   double* SXX = p.sxx.data(); double* SYY = p.syy.data();
   double* SZZ = p.szz.data(); double* SXY = p.sxy.data();
@@ -540,7 +562,7 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[K], dNx[K], dNy[K];
-    if (!shape.eval(simd::load(X + k), simd::load(Y + k), g, n0, N, dNx, dNy)) return k;
+    if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
     for (int c = 0; c < K; ++c) {
       const V4 Gx = simd::gather(gx, n0, off[c]), Gy = simd::gather(gy, n0, off[c]);
