@@ -174,7 +174,7 @@ struct KernelState {
 
 template <class S>
 const char* shape_of() {
-  return std::is_same_v<S, Bilinear> ? ", bilinear" : ", B-spline";
+  return std::is_same_v<S, Bilinear> ? ", bilinear" : std::is_same_v<S, BSpline2> ? ", B-spline" : ", uGIMP";
 }
 
 bool same_bits(const std::vector<double>& x, const std::vector<double>& y) {
@@ -207,6 +207,7 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   };
   p2g(Bilinear());
   p2g(BSpline2());
+  p2g(UGimp());
   // g2p with the re-map and the move (USF's), bilinear and B-spline.
   auto g2p = [&](auto shape_c, double flip) {
     using S = decltype(shape_c);
@@ -227,6 +228,7 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   for (double flip : {1.0, 0.95}) {
     g2p(Bilinear(), flip);
     g2p(BSpline2(), flip);
+    g2p(UGimp(), flip);
   }
   // The stress update, moving, with the bilinear and the quadratic B-spline shapes.
   auto stress = [&](auto shape_c, Model model) {
@@ -266,6 +268,7 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   for (Model model : {Model::Elastic, Model::VonMises}) {
     stress(Bilinear(), model);
     stress(BSpline2(), model);
+    stress(UGimp(), model);
   }
   {  // the nodal velocities q / m, with fixed components and light nodes
     KernelState w = start;

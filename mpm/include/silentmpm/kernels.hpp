@@ -154,22 +154,13 @@ struct Shape3x3_4 {
       for (int ii = 0; ii < 3; ++ii) off[3 * jj + ii] = jj * nnx + ii;
   }
   // One axis (coordinates x, the grid's origin x0): false if a lane's support leaves the nodes
-  // 0 .. nn - 1. The grid coordinate's product (x - x0) / h goes into both of its uses, the first
-  // node floor(g - 1/2) and the offset g - base, as one multiply-add each where GCC builds
-  // Shape3x3::eval with them (it fuses a product into every use that adds it), as two roundings
-  // otherwise: the same bits (Kernels.FourAtATimeEqualsTheScalarLoopBitForBit).
+  // 0 .. nn - 1. Each lane's first node and offset as Shape3x3::eval takes them.
   static bool axis(V4 x, double x0, double ih, int nn, int base[4], V4& f) {
     bool inside = true;
     for (int l = 0; l < 4; ++l) {
-      const double dx = x[l] - x0;
-#if defined(__FMA__) && !defined(__clang__)
-      base[l] = static_cast<int>(std::floor(std::fma(dx, ih, -0.5)));
-      f[l] = std::fma(dx, ih, -static_cast<double>(base[l]));
-#else
-      const double gc = dx * ih;
-      base[l] = static_cast<int>(std::floor(gc - 0.5));
-      f[l] = gc - base[l];
-#endif
+      double fl;
+      shape_detail::first_node(x[l] - x0, ih, base[l], fl);
+      f[l] = fl;
       inside = inside && base[l] >= 0 && base[l] + 2 < nn;
     }
     return inside;
@@ -212,13 +203,34 @@ struct BSplineRule4 {
     one(fy, wy, dy);
   }
 };
+// Uniform GIMP's rule (UGimp::size, shape_detail::ugimp_1d), lane by lane: its branches on the
+// distance pick a formula per node.
+struct UGimpRule4 {
+  double inv_rho;
+  void weights(V4 fx, V4 fy, const double* mass, double ih, V4 wx[3], V4 dx[3], V4 wy[3],
+               V4 dy[3]) const {
+    for (int l = 0; l < 4; ++l) {
+      UGimp sf;
+      sf.size(mass[l], inv_rho, ih);
+      for (int a = 0; a < 3; ++a) {
+        double w, d;
+        shape_detail::ugimp_1d(fx[l] - a, sf.lp, w, d);
+        wx[a][l] = w;
+        dx[a][l] = d;
+        shape_detail::ugimp_1d(fy[l] - a, sf.lp, w, d);
+        wy[a][l] = w;
+        dy[a][l] = d;
+      }
+    }
+  }
+};
 using BSpline4 = Shape3x3_4<BSplineRule4>;
-// The four-particle form of a scalar shape (void: none). Uniform GIMP has none: its 1D rule
-// written lane by lane came out fused differently from the scalar shape's in the kernels (an ulp
-// in a third of the values), so its passes keep the scalar loop.
+using UGimp4 = Shape3x3_4<UGimpRule4>;
+// The four-particle form of a scalar shape (void: none).
 template <class Shape> struct Vector4 { using type = void; };
 template <> struct Vector4<Bilinear> { using type = Bilinear4; };
 template <> struct Vector4<BSpline2> { using type = BSpline4; };
+template <> struct Vector4<UGimp> { using type = UGimp4; };
 }  // namespace simd
 
 // p2g with bilinear shapes (no contact fields), four particles at a time: the shape values in

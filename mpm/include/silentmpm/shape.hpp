@@ -119,6 +119,22 @@ SMPM_SHAPE_INLINE void fold_edges(int& base, int nn, double w[3], double d[3]) {
   }
 }
 
+// The first node floor(g - 1/2) of a 3 x 3 support and the offset g - base, g = d / h the grid
+// coordinate of a point at d from the grid's origin. Written out as multiply-adds where the
+// host has them (GCC would otherwise fuse the product into its uses or not depending on the
+// code around it), so that the kernels' four-particle form (kernels.hpp, simd::Shape3x3_4)
+// computes the same bits.
+SMPM_SHAPE_INLINE void first_node(double d, double ih, int& base, double& f) {
+#if defined(__FMA__) && !defined(__clang__)
+  base = static_cast<int>(std::floor(std::fma(d, ih, -0.5)));
+  f = std::fma(d, ih, -static_cast<double>(base));
+#else
+  const double g = d * ih;
+  base = static_cast<int>(std::floor(g - 0.5));
+  f = g - base;
+#endif
+}
+
 // Quadratic B-spline weights (and d/dg) of the nodes base..base+2 for fx = g - base in [1/2, 3/2).
 SMPM_SHAPE_INLINE void bspline2_1d(double fx, double w[3], double d[3]) {
   const double a = 1.5 - fx, b = fx - 1.0, c = fx - 0.5;
@@ -133,7 +149,11 @@ SMPM_SHAPE_INLINE void bspline2_1d(double fx, double w[3], double d[3]) {
 SMPM_SHAPE_INLINE void ugimp_1d(double xi, double lp, double& w, double& d) {
   const double r = std::abs(xi), sg = xi < 0 ? -1.0 : 1.0;
   if (r < lp) {
+#if defined(__FMA__) && !defined(__clang__)
+    w = 1 - std::fma(xi, xi, lp * lp) / (2 * lp);  // written out: see first_node
+#else
     w = 1 - (xi * xi + lp * lp) / (2 * lp);
+#endif
     d = -xi / lp;
   } else if (r <= 1 - lp) {
     w = 1 - r;
@@ -160,14 +180,19 @@ struct Shape3x3 {
   double N[9], dNx[9], dNy[9];
 
   SMPM_SHAPE_INLINE void eval(const Grid& g, double x, double y) {
-    eval_g(g, (x - g.x0) * g.inv_h, (y - g.y0) * g.inv_h);
+    double fx, fy;
+    shape_detail::first_node(x - g.x0, g.inv_h, bi, fx);
+    shape_detail::first_node(y - g.y0, g.inv_h, bj, fy);
+    eval_f(g, fx, fy);
   }
   // A boundary point: its grid coordinates are clamped to the grid.
   SMPM_SHAPE_INLINE void eval_clamped(const Grid& g, double x, double y) {
     double gx = (x - g.x0) * g.inv_h, gy = (y - g.y0) * g.inv_h;
     gx = gx < 0 ? 0 : (gx > g.nx ? g.nx : gx);
     gy = gy < 0 ? 0 : (gy > g.ny ? g.ny : gy);
-    eval_g(g, gx, gy);
+    bi = static_cast<int>(std::floor(gx - 0.5));
+    bj = static_cast<int>(std::floor(gy - 0.5));
+    eval_f(g, gx - bi, gy - bj);
   }
   inline void node_indices(long nnx, long nodes[9]) const {
     for (int jj = 0; jj < 3; ++jj)
@@ -181,12 +206,11 @@ struct Shape3x3 {
   }
 
  private:
-  SMPM_SHAPE_INLINE void eval_g(const Grid& g, double gx, double gy) {
+  // The values and gradients from the first nodes (bi, bj) and the offsets from them.
+  SMPM_SHAPE_INLINE void eval_f(const Grid& g, double fx, double fy) {
     double wx[3], dx[3], wy[3], dy[3];
-    bi = static_cast<int>(std::floor(gx - 0.5));
-    bj = static_cast<int>(std::floor(gy - 0.5));
-    static_cast<Derived*>(this)->weights(gx - bi, wx, dx);
-    static_cast<Derived*>(this)->weights(gy - bj, wy, dy);
+    static_cast<Derived*>(this)->weights(fx, wx, dx);
+    static_cast<Derived*>(this)->weights(fy, wy, dy);
     shape_detail::fold_edges(bi, g.nnx, wx, dx);
     shape_detail::fold_edges(bj, g.nny, wy, dy);
     const double ih = g.inv_h;
