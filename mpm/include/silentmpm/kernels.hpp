@@ -310,10 +310,10 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
   return k;
 }
 
-// p2g four particles at a time with the 3 x 3 shapes of S4 (simd::BSpline4; no contact fields):
-// the shape values in SIMD registers, the sums into the nodes lane by lane in particle order,
-// each term as the scalar loop writes it (the same bits). Returns the first particle left for
-// the scalar loop: the range's last one to three, or the first of four that S4 leaves to the
+// p2g four particles at a time with the 3 x 3 shapes of S4 (simd::BSpline4, UGimp4; no contact
+// fields): the shape values in SIMD registers, the sums into the nodes lane by lane in particle
+// order, each term as the scalar loop writes it (the same bits). Returns the first particle left
+// for the scalar loop: the range's last one to three, or the first of four that S4 leaves to the
 // scalar shape.
 template <class S4, unsigned WHAT>
 inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, const NodalField& f,
@@ -431,11 +431,11 @@ inline unsigned p2g(const Grid& g, const Particles& p, uint32_t b, uint32_t e, c
   return (negative ? kInverted : 0u) | (stretched ? kStretched : 0u);
 }
 
-// g2p four particles at a time, with the shape functions of S4 (simd::Bilinear4,
-// simd::BSpline4): one SIMD register per quantity, each lane the scalar loop's operations in its
-// order; the sums over particles, the kinetic energy and the re-mapped momenta, taken lane by
-// lane in particle order: the same bits. Returns the first particle left for the scalar loop:
-// the range's last one to three, or the first of four that S4 leaves to the scalar shape.
+// g2p four particles at a time, with the shape functions of S4 (simd::Bilinear4, BSpline4,
+// UGimp4): one SIMD register per quantity, each lane the scalar loop's operations in its order;
+// the sums over particles, the kinetic energy and the re-mapped momenta, taken lane by lane in
+// particle order: the same bits. Returns the first particle left for the scalar loop: the
+// range's last one to three, or the first of four that S4 leaves to the scalar shape.
 template <class S4, bool REMAP, bool MOVE>
 inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const NodalField& f,
                      double inv_rho, double flip, double dt, RowSpan& rows, double& kinetic,
@@ -551,7 +551,7 @@ inline void g2p(const Grid& g, Particles& p, uint32_t b, uint32_t e, const Nodal
 }
 
 // update_stress for the elastic and von Mises models, four particles at a time, with the shape
-// functions of S4 (simd::Bilinear4, simd::BSpline4): one SIMD register per quantity, each lane
+// functions of S4 (simd::Bilinear4, BSpline4, UGimp4): one SIMD register per quantity, each lane
 // the scalar loop's operations in its order; the dissipation summed lane by lane in particle
 // order: the same bits. Returns the first particle left for the scalar loop: the range's last
 // one to three, or the first of four that S4 leaves to the scalar shape.
