@@ -203,24 +203,36 @@ struct BSplineRule4 {
     one(fy, wy, dy);
   }
 };
-// Uniform GIMP's rule (UGimp::size, shape_detail::ugimp_1d), lane by lane: its branches on the
-// distance pick a formula per node.
+// Uniform GIMP's rule (UGimp::size, shape_detail::ugimp_1d) in registers: each of its four
+// formulas for every lane, then the one the lane's distance picks (the scalar rule's branches).
 struct UGimpRule4 {
   double inv_rho;
+  static void one(V4 xi, V4 lp, V4& w, V4& d) {
+    V4 r, ss;
+    for (int l = 0; l < 4; ++l) {
+      r[l] = std::abs(xi[l]);
+      ss[l] = shape_detail::ugimp_squares(xi[l], lp[l]);
+    }
+    const V4 one = {1, 1, 1, 1}, zero = {0, 0, 0, 0};
+    const V4 sg = xi < 0 ? -one : one;
+    const V4 q = 1 + lp - r;
+    const V4 w1 = 1 - ss / (2 * lp), d1 = -xi / lp;
+    const V4 w2 = 1 - r, d2 = -sg;
+    const V4 w3 = q * q / (4 * lp), d3 = -sg * q / (2 * lp);
+    w = r < lp ? w1 : r <= 1 - lp ? w2 : r < 1 + lp ? w3 : zero;
+    d = r < lp ? d1 : r <= 1 - lp ? d2 : r < 1 + lp ? d3 : zero;
+  }
   void weights(V4 fx, V4 fy, const double* mass, double ih, V4 wx[3], V4 dx[3], V4 wy[3],
                V4 dy[3]) const {
+    V4 lp;
     for (int l = 0; l < 4; ++l) {
       UGimp sf;
       sf.size(mass[l], inv_rho, ih);
-      for (int a = 0; a < 3; ++a) {
-        double w, d;
-        shape_detail::ugimp_1d(fx[l] - a, sf.lp, w, d);
-        wx[a][l] = w;
-        dx[a][l] = d;
-        shape_detail::ugimp_1d(fy[l] - a, sf.lp, w, d);
-        wy[a][l] = w;
-        dy[a][l] = d;
-      }
+      lp[l] = sf.lp;
+    }
+    for (int a = 0; a < 3; ++a) {
+      one(fx - static_cast<double>(a), lp, wx[a], dx[a]);
+      one(fy - static_cast<double>(a), lp, wy[a], dy[a]);
     }
   }
 };

@@ -146,14 +146,19 @@ SMPM_SHAPE_INLINE void bspline2_1d(double fx, double w[3], double d[3]) {
 // Uniform GIMP weight (and d/dxi) of one node at distance xi (cell units) from a particle of
 // half-width lp (cell units, 0 < lp <= 1/2): the hat function convolved with the particle's
 // characteristic function (Bardenhagen & Kober 2004).
+// xi^2 + lp^2 (a multiply-add written out: see first_node).
+SMPM_SHAPE_INLINE double ugimp_squares(double xi, double lp) {
+#if defined(__FMA__) && !defined(__clang__)
+  return std::fma(xi, xi, lp * lp);
+#else
+  return xi * xi + lp * lp;
+#endif
+}
+
 SMPM_SHAPE_INLINE void ugimp_1d(double xi, double lp, double& w, double& d) {
   const double r = std::abs(xi), sg = xi < 0 ? -1.0 : 1.0;
   if (r < lp) {
-#if defined(__FMA__) && !defined(__clang__)
-    w = 1 - std::fma(xi, xi, lp * lp) / (2 * lp);  // written out: see first_node
-#else
-    w = 1 - (xi * xi + lp * lp) / (2 * lp);
-#endif
+    w = 1 - ugimp_squares(xi, lp) / (2 * lp);
     d = -xi / lp;
   } else if (r <= 1 - lp) {
     w = 1 - r;
