@@ -191,16 +191,10 @@ struct Shape3x3_4 {
 // The quadratic B-spline's rule (shape_detail::bspline2_1d), in registers.
 struct BSplineRule4 {
   double inv_rho;
-  static void one(V4 f, V4 w[3], V4 d[3]) {
-    const V4 a = 1.5 - f, b = f - 1.0, c = f - 0.5;
-    w[0] = 0.5 * a * a;  d[0] = -a;
-    w[1] = 0.75 - b * b; d[1] = -2 * b;
-    w[2] = 0.5 * c * c;  d[2] = c;
-  }
   void weights(V4 fx, V4 fy, const double*, double, V4 wx[3], V4 dx[3], V4 wy[3],
                V4 dy[3]) const {
-    one(fx, wx, dx);
-    one(fy, wy, dy);
+    shape_detail::bspline2_1d(fx, wx, dx);
+    shape_detail::bspline2_1d(fy, wy, dy);
   }
 };
 // Uniform GIMP's rule (UGimp::size, shape_detail::ugimp_1d) in registers: each of its four

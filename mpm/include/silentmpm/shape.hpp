@@ -136,8 +136,10 @@ SMPM_SHAPE_INLINE void first_node(double d, double ih, int& base, double& f) {
 }
 
 // Quadratic B-spline weights (and d/dg) of the nodes base..base+2 for fx = g - base in [1/2, 3/2).
-SMPM_SHAPE_INLINE void bspline2_1d(double fx, double w[3], double d[3]) {
-  const double a = 1.5 - fx, b = fx - 1.0, c = fx - 0.5;
+// T: double, or a SIMD register of four (the kernels' four-particle form): the same operations.
+template <class T>
+SMPM_SHAPE_INLINE void bspline2_1d(T fx, T w[3], T d[3]) {
+  const T a = 1.5 - fx, b = fx - 1.0, c = fx - 0.5;
   w[0] = 0.5 * a * a;  d[0] = -a;
   w[1] = 0.75 - b * b; d[1] = -2 * b;
   w[2] = 0.5 * c * c;  d[2] = c;
