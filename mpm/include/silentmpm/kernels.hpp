@@ -218,7 +218,7 @@ struct UGimpRule4 {
   }
   void weights(V4 fx, V4 fy, const double* mass, double ih, V4 wx[3], V4 dx[3], V4 wy[3],
                V4 dy[3]) const {
-    V4 lp;
+    V4 lp = {0, 0, 0, 0};  // (every lane set below)
     for (int l = 0; l < 4; ++l) {
       UGimp sf;
       sf.size(mass[l], inv_rho, ih);
@@ -263,7 +263,7 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
   // in registers: a particle in the next cell of the row starts from them (the same additions
   // in the same order as through memory), any other particle has them written back first.
   long cn = -1;
-  double cb[kF], ct[kF];
+  double cb[kF] = {}, ct[kF] = {};  // (read only once cn is set)
   auto flush = [&] {
     if (cn < 0) return;
     for (int c = 0; c < kF; ++c) { fld[c][cn] = cb[c]; fld[c][cn + nnx] = ct[c]; }
