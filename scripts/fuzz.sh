@@ -11,8 +11,10 @@ seed=${SEED:-1}
 case "$secs" in ''|*[!0-9]*) echo "fuzz.sh: SECONDS must be a whole number, got '$secs'" >&2; exit 1;; esac
 "$root/scripts/setup.sh"
 b="$root/build-fuzz"
+# (At -O1 under the sanitizers clang does not vectorize the loops marked `omp simd`, and deal.II's
+# flags carry options of GCC's: neither is a finding, so neither is reported.)
 CC=clang CXX=clang++ cmake -S "$root" -B "$b" -DSILENTMPM_FUZZ=ON -DCMAKE_BUILD_TYPE=Debug \
-  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" >/dev/null
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g -Wno-pass-failed -Wno-unknown-warning-option -Wno-ignored-optimization-argument" >/dev/null
 cmake --build "$b" -j2 --target fuzz_case
 mkdir -p "$b/corpus" "$b/findings"
 cd "$root"  # the seeds name their meshes from the repository root

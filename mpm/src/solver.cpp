@@ -2510,7 +2510,7 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
         for (std::size_t i = 0; i < nb; ++i) {
           const double gx = (px[k0 + i] - grid.x0) * grid.inv_h;
           const double gy = (py[k0 + i] - grid.y0) * grid.inv_h;
-          hit[i] |= static_cast<std::uint8_t>((gx >= r[0]) & (gx < r[1]) & (gy >= r[2]) & (gy < r[3]));
+          hit[i] |= static_cast<std::uint8_t>(int(gx >= r[0]) & int(gx < r[1]) & int(gy >= r[2]) & int(gy < r[3]));
         }
     }
     for (std::size_t k = k0; k < k0 + nb; ++k) {
