@@ -656,6 +656,7 @@ void Solver::delay_prepare() {
     rec[kDelayJ] = static_cast<double>(n / grid.nnx + o[1]);
     rec[kDelayAt] = -1;
     rec[kDelayWritten] = -2;
+    rec[kDelayBookedAt] = -2;
   }
 }
 
@@ -1950,11 +1951,15 @@ void Solver::boundary_work(bool remapped) {
       if (!owns_node(i)) continue;
       double ax, ay, bx, by;
       wbar(i, bx, by);
-      const double* rec = delay_slot_.empty() ? nullptr : delay_record(i);
+      double* rec = delay_slot_.empty() ? nullptr : delay_record(i);
       if (rec && rec[kDelayAt] == now) {
         // The delayed closure: what it takes out against the conservative update, the force
         // and its work with the strain velocity (delay_strain_velocities):
-        // (f + C v_d)/2 . wbar + f . (g - g0), f the force less gravity.
+        // (f + C v_d)/2 . wbar + f_s . (g - g0), f the force less gravity. f_s is the mean of
+        // the forces before and after the stress update that g - g0 strains (the work of the
+        // stresses it changes, to second order in dt): USF's update comes before this step's
+        // forces, so the last step's and this one's; MUSL's after them, so this step's and the
+        // next one's, booked then (a node the closure does not take next step keeps f).
         // The tangential component: C vbar . wbar, vbar the particles' mean where
         // consistent_dashpots solved it.
         const double fx = rec[kDelayFx], fy = rec[kDelayFy];
@@ -1966,6 +1971,20 @@ void Solver::boundary_work(bool remapped) {
         T[2 * k + 1] = delayed_axis(rec[kDelayCyy], rec[kDelayCxx])
                            ? 0.5 * (fy + cy) * by + fy * rec[kDelayDgy]
                            : grid.cyy(i) * ay * by;
+        if (rec[kDelayBookedAt] == now - 1) {
+          if (opt.scheme == Scheme::USF) {
+            T[2 * k] += 0.5 * (rec[kDelayBookedFx] - fx) * rec[kDelayDgx];
+            T[2 * k + 1] += 0.5 * (rec[kDelayBookedFy] - fy) * rec[kDelayDgy];
+          } else {
+            T[2 * k] += 0.5 * (fx - rec[kDelayBookedFx]) * rec[kDelayBookedDgx];
+            T[2 * k + 1] += 0.5 * (fy - rec[kDelayBookedFy]) * rec[kDelayBookedDgy];
+          }
+        }
+        rec[kDelayBookedAt] = now;
+        rec[kDelayBookedDgx] = rec[kDelayDgx];
+        rec[kDelayBookedDgy] = rec[kDelayDgy];
+        rec[kDelayBookedFx] = fx;
+        rec[kDelayBookedFy] = fy;
         terms[k] = 2;
         continue;
       }

@@ -341,6 +341,9 @@ class Solver {
     kDelayDgx, kDelayDgy,      // the change of the strain velocity (boundary_work's account)
     kDelayWritten,             // the last step its ring was written
     kDelayRunFrom,             // the first of that unbroken run of steps
+    kDelayBookedAt,            // the step boundary_work last booked it, and then
+    kDelayBookedDgx, kDelayBookedDgy,  // the change of the strain velocity
+    kDelayBookedFx, kDelayBookedFy,    // and the force less gravity
     kDelayHead
   };
   std::vector<double> delay_rho_;
