@@ -1869,9 +1869,18 @@ void Solver::boundary_work(bool remapped) {
     ax = 0.5 * (grid.vx[i] + grid.vnx[i]);
     ay = 0.5 * (grid.vy[i] + grid.vny[i]);
   };
+  // MUSL: at the delayed closure's nodes the re-mapped velocity holds the strain velocity the
+  // closure made of it (delay_strain_velocities); the power takes the particles' own, which the
+  // kinetic energy follows, that value less the change.
+  const bool strain_closed = remapped && !delay_slot_.empty() && opt.scheme == Scheme::MUSL;
   auto wbar = [&](long i, double& ax, double& ay) {  // the power's velocity
     ax = 0.5 * (grid.vx[i] + ux[i]);
     ay = 0.5 * (grid.vy[i] + uy[i]);
+    if (strain_closed)
+      if (const double* rec = delay_record(i)) {  // (the change is zero where it did not act)
+        ax -= 0.5 * rec[kDelayDgx];
+        ay -= 0.5 * rec[kDelayDgy];
+      }
   };
   // A layer's terms: term(q, t) writes entry q's K terms into t (in parallel, each entry its
   // own; none for an entry with skip(q)), then they are added to (or subtracted from) `acc` in
@@ -1928,6 +1937,17 @@ void Solver::boundary_work(bool remapped) {
       for (long j = j0; j <= j1; ++j)
         for (long i = j * nnx + i0; i <= j * nnx + i1; ++i)
           w += m[i] * (gx * 0.5 * (v0x[i] + wx[i]) + gy * 0.5 * (v0y[i] + wy[i]));
+    }
+    if (strain_closed) {  // at the closure's nodes, with the particles' own velocity (above)
+      const std::size_t R = delay_stride();
+      const std::array<int, 2> o = window_origin();
+      for (std::size_t r = 0; r * R < delay_.size(); ++r) {
+        const double* rec = delay_.data() + r * R;
+        if (rec[kDelayDgx] == 0 && rec[kDelayDgy] == 0) continue;
+        const long i = static_cast<long>(rec[kDelayI]) - o[0], j = static_cast<long>(rec[kDelayJ]) - o[1];
+        if (i < 0 || j < 0 || i >= nnx || j >= grid.nny || !owns_node(j * nnx + i)) continue;
+        w -= grid.m[j * nnx + i] * (gx * 0.5 * rec[kDelayDgx] + gy * 0.5 * rec[kDelayDgy]);
+      }
     }
     energy.external_work += dt * w;
   }

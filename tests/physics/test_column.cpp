@@ -1347,7 +1347,11 @@ TEST(SilentLayer, DelayedClosureOnePpc) {
 // its value at 10^4 steps), except MUSL P at CFL 0.9, which swaps up to 2.4 times its value at
 // 10^4 steps once before it decays to 0.03 of it. With the tangential strain velocity closed
 // as the normal one the run grew within 2 000 steps, and with neither within 4-9 * 10^4.
-// Bounds: the largest value within 3 times that at 10^4 steps, the last below it.
+// The energy account: within 1.5e-4 of the work (2.0e-3 under MUSL at CFL 0.9 while the
+// closure's strain-velocity work took the step's own force and MUSL's power its changed
+// velocity; docs/physics.md section 4).
+// Bounds: the largest value within 3 times that at 10^4 steps, the last below it, the account
+// within 1e-3.
 TEST(SilentStability, DelayedClosureNoGrowthOver100000Steps) {
   for (const Scheme sc : {Scheme::MUSL, Scheme::USF})
     for (const double cfl : {0.3, 0.9})
@@ -1360,6 +1364,6 @@ TEST(SilentStability, DelayedClosureNoGrowthOver100000Steps) {
                                  (shear ? " S" : " P");
         EXPECT_LE(r.emax, 3 * r.e1) << what;
         EXPECT_LE(r.elast, r.e1) << what;
-        EXPECT_LE(std::abs(r.imbalance), 5e-3) << what;
+        EXPECT_LE(std::abs(r.imbalance), 1e-3) << what;
       }
 }
