@@ -628,12 +628,9 @@ void Solver::delay_map() {
   if (delay_rho_.empty() || delay_cap_ == 0) return;
   const std::array<int, 2> o = window_origin();
   const std::size_t R = delay_stride();
-  for (std::size_t r = 0; r * R < delay_.size(); ++r) {
-    const long i = static_cast<long>(delay_[r * R + kDelayI]) - o[0];
-    const long j = static_cast<long>(delay_[r * R + kDelayJ]) - o[1];
-    if (i >= 0 && j >= 0 && i < grid.nnx && j < grid.nny)
-      delay_slot_[j * grid.nnx + i] = static_cast<int>(r);
-  }
+  for (std::size_t r = 0; r * R < delay_.size(); ++r)
+    if (const long n = delay_window_node(delay_.data() + r * R, o); n >= 0)
+      delay_slot_[n] = static_cast<int>(r);
 }
 
 // A record for every node the delayed layers reach this step (in the order of the dashpot
@@ -687,10 +684,8 @@ void Solver::delay_strain_velocities(double* gx, double* gy, bool current) {
     double* rec = delay_.data() + r * R;
     rec[kDelayDgx] = rec[kDelayDgy] = 0;
     if (rec[kDelayAt] != want) continue;
-    const long i = static_cast<long>(rec[kDelayI]) - o[0], j = static_cast<long>(rec[kDelayJ]) - o[1];
-    if (i < 0 || j < 0 || i >= grid.nnx || j >= grid.nny) continue;
-    const long n = j * grid.nnx + i;
-    if (!(grid.m[n] > mass_floor_)) continue;
+    const long n = delay_window_node(rec, o);
+    if (n < 0 || !(grid.m[n] > mass_floor_)) continue;
     const double c[2] = {rec[kDelayCxx], rec[kDelayCyy]};
     double* g[2] = {gx, gy};
     for (int a = 0; a < 2; ++a) {
@@ -1944,9 +1939,9 @@ void Solver::boundary_work(bool remapped) {
       for (std::size_t r = 0; r * R < delay_.size(); ++r) {
         const double* rec = delay_.data() + r * R;
         if (rec[kDelayDgx] == 0 && rec[kDelayDgy] == 0) continue;
-        const long i = static_cast<long>(rec[kDelayI]) - o[0], j = static_cast<long>(rec[kDelayJ]) - o[1];
-        if (i < 0 || j < 0 || i >= nnx || j >= grid.nny || !owns_node(j * nnx + i)) continue;
-        w -= grid.m[j * nnx + i] * (gx * 0.5 * rec[kDelayDgx] + gy * 0.5 * rec[kDelayDgy]);
+        const long nd = delay_window_node(rec, o);
+        if (nd < 0 || !owns_node(nd)) continue;
+        w -= grid.m[nd] * (gx * 0.5 * rec[kDelayDgx] + gy * 0.5 * rec[kDelayDgy]);
       }
     }
     energy.external_work += dt * w;

@@ -368,6 +368,11 @@ class Solver {
                          std::size_t stride, std::vector<double>& v) const;
   void delay_map();  // delay_slot_ from the records' nodes
   double delay_value(const double* rec, int field, double d, long back) const;
+  // A record's node in this window (o its origin, window_origin()), or -1 outside it.
+  long delay_window_node(const double* rec, const std::array<int, 2>& o) const {
+    const long i = static_cast<long>(rec[kDelayI]) - o[0], j = static_cast<long>(rec[kDelayJ]) - o[1];
+    return i >= 0 && j >= 0 && i < grid.nnx && j < grid.nny ? j * grid.nnx + i : -1;
+  }
   void delay_strain_velocities(double* gx, double* gy, bool current);
   // Whether node n, holding `weight` of such layers' impedance, takes v+: it must hold at least
   // dt/2 times that weight of mass (remapped_velocities()).
