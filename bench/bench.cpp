@@ -22,7 +22,9 @@
 //     1e8); --rounds: how many times each free and silent pair runs, alternating (default 1).
 //     Steps per rate: 200, 30 or 10 by size, times half the thread count from 4 threads on.
 //     After each size and thread count a line gives the silent edge's cost over the free one:
-//     from the best rates of the rounds, and the range of the rounds' own pairs.
+//     from the best rates of the rounds, and the range of the rounds' own pairs; another, the
+//     stores of the grid's write-only passes (Solver::streaming: a large grid times both kinds
+//     on its first steps, which the warm-up takes).
 #include <omp.h>
 
 #include <algorithm>
@@ -112,10 +114,14 @@ double step_bytes(double nodes_per_particle) {
 
 // The silent edge's dashpot solve over the last silent rate's timed steps: iterations a step.
 double solve_iterations = 0;
+// The grid's stores the timed runs used (Solver::store_mode): bit 0 plain, bit 1 streaming.
+int stores_seen = 0;
 
 double rate(double h, bool silent, int threads, int steps, ShapeKind shape) {
   auto s = pulse_plate(h, silent, threads, shape, steps);
-  for (int i = 0; i < 3; ++i) s->step();  // warm-up
+  // Warm-up, and the steps on which the solver times its grid's stores both ways.
+  for (int i = 0; i < 3 || s->store_mode() < 0; ++i) s->step();
+  stores_seen |= s->store_mode() > 0 ? 2 : 1;
   const long it0 = s->dashpot_solve.iterations, st0 = s->dashpot_solve.steps;
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < steps; ++i) s->step();
@@ -218,6 +224,7 @@ int main(int argc, char** argv) {
       // Each round's rates, free and silent, per shape: the silent edge's cost over the free one.
       const std::size_t ns = shapes.size();
       std::vector<double> free_rate(ns * rounds), silent_rate(ns * rounds);
+      stores_seen = 0;
       for (int round = 0; round < rounds; ++round)
         for (bool silent : {false, true})
           for (std::size_t si = 0; si < ns; ++si) {
@@ -246,6 +253,10 @@ int main(int argc, char** argv) {
                     100 * (best_free / best_silent - 1), rounds, rounds == 1 ? "" : "s", 100 * lo,
                     100 * hi, solve_iterations);
       }
+      std::printf("# %zu particles, %d thread%s: the grid's write-only passes with %s stores "
+                  "(each run times both on its first steps)\n",
+                  n, th, th == 1 ? "" : "s",
+                  stores_seen == 2 ? "streaming" : stores_seen == 1 ? "plain" : "plain or streaming");
     }
   }
   return 0;
