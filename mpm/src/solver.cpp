@@ -1437,33 +1437,25 @@ void Solver::grid_update() {
 #pragma omp parallel num_threads(nthreads_) reduction(| : bad)
   {
     const NodeUpdate u = nodes;
-    NodeUpdate plain = nodes;  // a block with dashpot nodes, which read it back at once
+    NodeUpdate plain = nodes;  // eight nodes around a dashpot node, which reads them back at once
     plain.stream = false;
     long i0, i1;
     omp_range(n, i0, i1);
     for (long b0 = i0; b0 < i1; b0 += kBlock) {
       const long b1 = std::min(i1, b0 + kBlock);
-      // The flags eight at a time: a block holds one or two dashpot nodes.
-      bool any = false;
-      long i = b0;
-      for (; i + 8 <= b1 && !any; i += 8) {
-        std::uint64_t w;
-        std::memcpy(&w, u.fix + i, 8);
-        any = (w & (0x0101010101010101ull * Grid::kDashpotNode)) != 0;
-      }
-      for (; i < b1 && !any; ++i) any = (u.fix[i] & Grid::kDashpotNode) != 0;
-      if (!any) {
-        bad |= u.run(b0, b1);
-        continue;
-      }
-      bad |= plain.run(b0, b1);
-      for (i = b0; i + 8 <= b1; i += 8) {
+      // The flags eight at a time: a block holds one or two dashpot nodes. The nodes before
+      // each eight that hold one go in one run.
+      long i = b0, from = b0;
+      for (; i + 8 <= b1; i += 8) {
         std::uint64_t w;
         std::memcpy(&w, u.fix + i, 8);
         if (!(w & (0x0101010101010101ull * Grid::kDashpotNode))) continue;
+        bad |= u.run(from, i) | plain.run(i, i + 8);
+        from = i + 8;
         for (long j = i; j < i + 8; ++j)
           if (u.fix[j] & Grid::kDashpotNode) dashpot(j);
       }
+      bad |= u.run(from, i) | plain.run(i, b1);
       for (; i < b1; ++i)
         if (u.fix[i] & Grid::kDashpotNode) dashpot(i);
     }
