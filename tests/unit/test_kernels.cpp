@@ -317,7 +317,9 @@ TEST(Step, StreamingStoresGiveTheSameBits) {
     const double e0[] = {run[0]->energy.absorbed, run[0]->energy.external_work};
     const double e1[] = {run[1]->energy.absorbed, run[1]->energy.external_work};
     EXPECT_EQ(std::memcmp(e0, e1, sizeof e0), 0) << c;
-    if (end == End::Silent) EXPECT_GT(run[0]->energy.absorbed, 0.0) << c;
+    if (end == End::Silent) {
+      EXPECT_GT(run[0]->energy.absorbed, 0.0) << c;
+    }
   }
   ColumnSpec small;
   auto s = make_column(small);

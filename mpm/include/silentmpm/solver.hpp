@@ -425,7 +425,7 @@ class Solver {
   int stream_trial_ = -2;
   double stream_time_[2][4] = {};
   bool reset_streams() const;
-  void time_reset(double seconds);
+  void time_stores(double seconds);  // a trial step's time
   template <class Fn> void scatter(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void call(Fn&& fn);
