@@ -1386,11 +1386,14 @@ void Solver::grid_update() {
   const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
   const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
   const double* ux = grid.vnx.data(); const double* uy = grid.vny.data();
-  // (Streaming in halves of four nodes: each array 16-byte aligned, as the allocator gives them.)
-  const bool aligned = ((reinterpret_cast<std::uintptr_t>(grid.vx.data()) |
-                         reinterpret_cast<std::uintptr_t>(grid.vy.data()) |
-                         reinterpret_cast<std::uintptr_t>(grid.vnx.data()) |
-                         reinterpret_cast<std::uintptr_t>(grid.vny.data())) & 15) == 0;
+  // Streaming in halves of four nodes wants each array 16-byte aligned (as the allocator gives
+  // them). The dashpot nodes' lines below are vx's; large arrays, each mapped on its own pages,
+  // start their lines at the same node.
+  const std::uintptr_t ax = reinterpret_cast<std::uintptr_t>(grid.vx.data());
+  const long line_phase = static_cast<long>((64 - ax % 64) % 64 / 8);
+  bool aligned = true;
+  for (const double* a : {grid.vx.data(), grid.vy.data(), grid.vnx.data(), grid.vny.data()})
+    aligned = aligned && reinterpret_cast<std::uintptr_t>(a) % 16 == 0;
   const NodeUpdate nodes{m, grid.px.data(), grid.py.data(), fx, fy, fix, grid.vx.data(),
                          grid.vy.data(), grid.vnx.data(), grid.vny.data(), mass_floor_, dt,
                          aligned && reset_streams()};
@@ -1438,34 +1441,38 @@ void Solver::grid_update() {
     const int skip = !updated_weight_.empty() && updated_weight_[i] > 0 ? kDnSkip : 0;
     r[kDnFlags] = static_cast<double>((fix[i] & 3) | skip | closure);
   };
-  // In blocks of nodes that stay in the L1 cache: the plain update of a block, then its
-  // dashpot nodes.
-  constexpr long kBlock = 256;
+  // Node by node in order; each line's worth of nodes (eight, where the four velocity arrays
+  // start their cache lines) that holds a dashpot node takes plain stores and then its dashpot
+  // nodes' update, which reads those values back while they are in cache. The runs between go
+  // whole, streamed where the step streams: whole lines, never a line shared with plain stores.
+  const long phase = line_phase;
 #pragma omp parallel num_threads(nthreads_) reduction(| : bad)
   {
     const NodeUpdate u = nodes;
-    NodeUpdate plain = nodes;  // eight nodes around a dashpot node, which reads them back at once
+    NodeUpdate plain = nodes;
     plain.stream = false;
     long i0, i1;
     omp_range(n, i0, i1);
-    for (long b0 = i0; b0 < i1; b0 += kBlock) {
-      const long b1 = std::min(i1, b0 + kBlock);
-      // The flags eight at a time: a block holds one or two dashpot nodes. The nodes before
-      // each eight that hold one go in one run.
-      long i = b0, from = b0;
-      for (; i + 8 <= b1; i += 8) {
+    long from = i0;
+    for (long g = i0; g < i1;) {
+      const long ge = std::min(i1, g + 8 - (((g - phase) % 8) + 8) % 8);  // the next line's start
+      bool any = false;
+      if (ge - g == 8) {  // the flags eight at a time
         std::uint64_t w;
-        std::memcpy(&w, u.fix + i, 8);
-        if (!(w & (0x0101010101010101ull * Grid::kDashpotNode))) continue;
-        bad |= u.run(from, i) | plain.run(i, i + 8);
-        from = i + 8;
-        for (long j = i; j < i + 8; ++j)
-          if (u.fix[j] & Grid::kDashpotNode) dashpot(j);
+        std::memcpy(&w, u.fix + g, 8);
+        any = (w & (0x0101010101010101ull * Grid::kDashpotNode)) != 0;
+      } else {
+        for (long j = g; j < ge; ++j) any = any || (u.fix[j] & Grid::kDashpotNode);
       }
-      bad |= u.run(from, i) | plain.run(i, b1);
-      for (; i < b1; ++i)
-        if (u.fix[i] & Grid::kDashpotNode) dashpot(i);
+      if (any) {
+        bad |= u.run(from, g) | plain.run(g, ge);
+        for (long j = g; j < ge; ++j)
+          if (u.fix[j] & Grid::kDashpotNode) dashpot(j);
+        from = ge;
+      }
+      g = ge;
     }
+    bad |= u.run(from, i1);
     if (u.stream) fence();
   }
   if (bad) fail_nonfinite();
