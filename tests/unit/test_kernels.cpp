@@ -290,13 +290,16 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
 
 // The grid's write-only passes with streaming stores (past the cache) against plain ones
 // (Solver::streaming): every particle array and the energy account bit for bit after 100 steps
-// of a silent plate, on one and two threads; and the choice by timing, which a small grid skips.
+// of a column with a free and with a silent end, under MUSL, USL and USF, on one and two threads;
+// and the choice by timing, which a small grid skips.
 TEST(Step, StreamingStoresGiveTheSameBits) {
-  for (End end : {End::Free, End::Silent})  // (the silent end's blocks store plainly)
+  for (Scheme scheme : {Scheme::MUSL, Scheme::USL, Scheme::USF})
+  for (End end : {End::Free, End::Silent})  // (the dashpot nodes' lines store plainly)
   for (int threads : {1, 2}) {
     std::unique_ptr<Solver> run[2];
     for (int mode : {0, 1}) {
       ColumnSpec spec;
+      spec.scheme = scheme;
       spec.end = end;
       spec.cells = 60;
       spec.height = 6;  // 67 x 7 nodes: the second thread starts at an odd node
@@ -309,8 +312,8 @@ TEST(Step, StreamingStoresGiveTheSameBits) {
       for (int i = 0; i < 100; ++i) run[mode]->step();
     }
     const Particles &p = run[0]->p, &q = run[1]->p;
-    const std::string c = std::to_string(threads) + " threads, " +
-                          (end == End::Free ? "free end" : "silent end");
+    const std::string c = std::string(scheme_name(scheme)) + ", " + std::to_string(threads) +
+                          " threads, " + (end == End::Free ? "free end" : "silent end");
     EXPECT_TRUE(same_bits(p.x, q.x) && same_bits(p.y, q.y)) << c;
     EXPECT_TRUE(same_bits(p.vx, q.vx) && same_bits(p.vy, q.vy)) << c;
     EXPECT_TRUE(same_bits(p.sxx, q.sxx) && same_bits(p.syy, q.syy) && same_bits(p.sxy, q.sxy)) << c;
