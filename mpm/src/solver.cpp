@@ -560,15 +560,14 @@ int Solver::store_mode() const {
   return !kStreamingStores ? 0 : streaming >= 0 ? (streaming > 0 ? 1 : 0) : stream_choice_;
 }
 
-bool Solver::reset_streams() const {
+bool Solver::stores_stream() const {
   const int mode = store_mode();
   return mode > 0 || (mode < 0 && stream_trial_ >= 0 && stream_trial_ % 2 == 1);
 }
 
 void Solver::time_stores(double seconds) {
   if (store_mode() >= 0) return;
-  const double bytes = 8.0 * static_cast<double>(grid.nodes()) *
-                       (opt.scheme != Scheme::USL ? 7 : 5);
+  const double bytes = 8.0 * static_cast<double>(grid.nodes()) * reset_arrays();
   if (!kStreamingStores || bytes < kStreamTrialBytes) {
     stream_choice_ = 0;
     return;
@@ -580,17 +579,20 @@ void Solver::time_stores(double seconds) {
   stream_choice_ = streamed < 0.98 * plain ? 1 : 0;
 }
 
+// The grid arrays the reset clears: mass, momenta and forces, and the re-mapped momenta of
+// MUSL's re-map (USF: for the loads' power).
+int Solver::reset_arrays() const { return opt.scheme != Scheme::USL ? 7 : 5; }
+
 void Solver::reset_grid() {
   const long n = static_cast<long>(grid.nodes());
-  if (reset_streams()) {
+  if (stores_stream()) {
     double* a[7] = {grid.m.data(),  grid.px.data(), grid.py.data(), grid.fx.data(),
                     grid.fy.data(), grid.qx.data(), grid.qy.data()};
-    const int na = opt.scheme != Scheme::USL ? 7 : 5;  // (as below)
 #pragma omp parallel num_threads(nthreads_)
     {
       long i0, i1;
       omp_range(n, i0, i1);
-      for (int k = 0; k < na; ++k) stream_zero(a[k] + i0, i1 - i0);
+      for (int k = 0; k < reset_arrays(); ++k) stream_zero(a[k] + i0, i1 - i0);
     }
     return;
   }
@@ -603,7 +605,7 @@ void Solver::reset_grid() {
   for (long i = 0; i < n; ++i) {
     m[i] = 0; px[i] = 0; py[i] = 0; fx[i] = 0; fy[i] = 0;
   }
-  if (opt.scheme != Scheme::USL) {  // MUSL's re-map (USF: for the loads' power)
+  if (reset_arrays() == 7) {  // the re-mapped momenta too
     std::fill(grid.qx.begin(), grid.qx.end(), 0.0);
     std::fill(grid.qy.begin(), grid.qy.end(), 0.0);
   }
@@ -1316,7 +1318,7 @@ struct NodeUpdate {
   const uint8_t* fix;
   double *vx, *vy, *ux, *uy;
   double floor, dt;
-  bool stream;  // the velocities with streaming stores (see reset_streams), SSE2's two halves
+  bool stream;  // the velocities with streaming stores (see stores_stream), SSE2's two halves
   int run(long i0, long i1) const {
     if (!stream) return run_with<false>(i0, i1);
     // The first node of four on an even index, as the streaming halves want.
@@ -1390,13 +1392,13 @@ void Solver::grid_update() {
   // them). The dashpot nodes' lines below are vx's; large arrays, each mapped on its own pages,
   // start their lines at the same node.
   const std::uintptr_t ax = reinterpret_cast<std::uintptr_t>(grid.vx.data());
-  const long line_phase = static_cast<long>((64 - ax % 64) % 64 / 8);
+  const long phase = static_cast<long>((64 - ax % 64) % 64 / 8);
   bool aligned = true;
   for (const double* a : {grid.vx.data(), grid.vy.data(), grid.vnx.data(), grid.vny.data()})
     aligned = aligned && reinterpret_cast<std::uintptr_t>(a) % 16 == 0;
   const NodeUpdate nodes{m, grid.px.data(), grid.py.data(), fx, fy, fix, grid.vx.data(),
                          grid.vy.data(), grid.vnx.data(), grid.vny.data(), mass_floor_, dt,
-                         aligned && reset_streams()};
+                         aligned && stores_stream()};
   int bad = 0;
   if (!has_nodal_dashpot_) {
 #pragma omp parallel num_threads(nthreads_) reduction(| : bad)
@@ -1445,7 +1447,6 @@ void Solver::grid_update() {
   // start their cache lines) that holds a dashpot node takes plain stores and then its dashpot
   // nodes' update, which reads those values back while they are in cache. The runs between go
   // whole, streamed where the step streams: whole lines, never a line shared with plain stores.
-  const long phase = line_phase;
 #pragma omp parallel num_threads(nthreads_) reduction(| : bad)
   {
     const NodeUpdate u = nodes;

@@ -92,7 +92,7 @@ class Solver {
   SolverOptions opt;
   // The grid's write-only passes (its reset and the update's velocities) with streaming stores,
   // past the cache, or plain ones: -1 (default) tries both on the run's first steps where the
-  // grid is large and keeps the faster (reset_streams in solver.cpp); 0 plain; 1 streaming.
+  // grid is large and keeps the faster (stores_stream in solver.cpp); 0 plain; 1 streaming.
   // The same values either way.
   int streaming = -1;
   // What the step does now: 0 plain stores, 1 streaming, -1 still trying both.
@@ -418,13 +418,14 @@ class Solver {
   void refresh_fields();
   bool strips_conflict() const;
   void reset_grid();
-  // The grid's stores (reset_streams): -1 still timing both ways, 0 plain, 1 streaming; the
+  // The grid's stores (stores_stream): -1 still timing both ways, 0 plain, 1 streaming; the
   // trial's step (from -2: two steps first), and its times.
   static constexpr double kStreamTrialBytes = 32e6;
   int stream_choice_ = -1;
   int stream_trial_ = -2;
   double stream_time_[2][4] = {};
-  bool reset_streams() const;
+  bool stores_stream() const;  // whether this step's write-only passes stream
+  int reset_arrays() const;
   void time_stores(double seconds);  // a trial step's time
   template <class Fn> void scatter(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
   template <class Fn> void parallel(const std::vector<std::array<uint32_t, 2>>& ranges, Fn&& fn);
