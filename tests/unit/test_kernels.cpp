@@ -134,7 +134,9 @@ struct KernelState {
   Particles p;
   std::vector<double> a[11];  // m px py fx fy vx vy vnx vny qx qy
   NodalField f;
-  KernelState(int n, unsigned seed) {
+  // rows: most particles in consecutive cells of a grid row (14 cells to a row, as at one
+  // particle per cell), every eleventh one elsewhere: groups of four in a row and out of it.
+  KernelState(int n, unsigned seed, bool rows = false) {
     const double h = 1e-3;
     g.init(0, 0, h, 16, 16);
     p.resize(n);
@@ -143,6 +145,10 @@ struct KernelState {
     for (int k = 0; k < n; ++k) {
       p.x[k] = (1.5 + 13 * u(rng)) * h;
       p.y[k] = (1.5 + 13 * u(rng)) * h;
+      if (rows && k % 11 != 7) {
+        p.x[k] = (1 + k % 14 + 0.98 * (p.x[k] / h - 1.5) / 13 + 0.01) * h;
+        p.y[k] = (1 + (k / 14) % 14 + 0.98 * (p.y[k] / h - 1.5) / 13 + 0.01) * h;
+      }
       p.vx[k] = u(rng) - 0.5;
       p.vy[k] = u(rng) - 0.5;
       p.mass[k] = 1e-3 * (0.5 + u(rng));
@@ -193,9 +199,23 @@ void expect_same(const KernelState& w, const KernelState& s, const char* pass) {
 }
 }  // namespace
 
-TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
+class Kernels : public ::testing::TestWithParam<bool> {};
+
+TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   const int n = 103;  // 25 groups of four and a tail of three
-  const KernelState start(n, 11);
+  const KernelState start(n, 11, GetParam());
+  {  // the groups of four whose cells follow each other in a row: the row form's share
+    int in_row = 0;
+    for (int k = 0; k + 4 <= n; k += 4) {
+      long n0[4];
+      for (int l = 0; l < 4; ++l)
+        n0[l] = static_cast<long>(std::floor(start.p.y[k + l] / start.g.h)) * start.g.nnx +
+                static_cast<long>(std::floor(start.p.x[k + l] / start.g.h));
+      in_row += kernels::simd::in_a_row(n0);
+    }
+    if (GetParam()) EXPECT_GE(in_row, 10) << "groups in a row";
+    else EXPECT_EQ(in_row, 0) << "groups in a row";
+  }
   const double dt = 1e-8, inv_rho = 1.0 / tungsten().rho;
   auto p2g = [&](auto shape_c) {  // p2g: mass, momenta, forces
     using S = decltype(shape_c);
@@ -287,6 +307,10 @@ TEST(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
     }
   }
 }
+
+// Particles anywhere, and particles in rows of consecutive cells (the passes' row form).
+INSTANTIATE_TEST_SUITE_P(Layouts, Kernels, ::testing::Values(false, true),
+                         [](const auto& i) { return i.param ? "InRows" : "Scattered"; });
 
 // The grid's write-only passes with streaming stores (past the cache) against plain ones
 // (Solver::streaming): every particle array and the energy account bit for bit after 100 steps

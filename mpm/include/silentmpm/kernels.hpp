@@ -117,6 +117,28 @@ inline void held(const uint8_t* fix, M4& hx, M4& hy) {
 inline V4 gather(const double* a, const long n0[4], long off) {
   return V4{a[n0[0] + off], a[n0[1] + off], a[n0[2] + off], a[n0[3] + off]};
 }
+// Whether four points' first nodes are consecutive (four particles in consecutive cells of a row,
+// as at one particle per cell): their values of a nodal array at each node are then one load.
+inline bool in_a_row(const long n0[4]) {
+  return n0[1] == n0[0] + 1 && n0[2] == n0[0] + 2 && n0[3] == n0[0] + 3;
+}
+// gather(a, n0, off), read as one load where in_a_row(n0) (`row`): the same values.
+inline V4 gather(const double* a, const long n0[4], long off, bool row) {
+  return row ? load(a + n0[0] + off) : gather(a, n0, off);
+}
+// Four particles in consecutive cells of a grid row (in_a_row: particle l's cell starts at node
+// n + l) summed into one row of nodes n .. n + 4 of `a`: right(s) adds to s each particle's term
+// at its right node (lane l into node n + l + 1), left(s) each one's term at its left node (lane
+// l into node n). At each node the right term of particle l - 1 comes before the left term of
+// particle l: the particle order of the scalar loop, the same additions.
+template <class Right, class Left>
+inline void add_row(double* a, long n, const Right& right, const Left& left) {
+  const V4 t = right(load(a + n + 1));  // nodes n + 1 .. n + 4
+  const double a0 = a[n];
+  const V4 s = __builtin_shuffle(V4{a0, a0, a0, a0}, t, M4{3, 4, 5, 6});  // nodes n .. n + 3
+  store(a + n, left(s));
+  a[n + 4] = t[3];
+}
 // Four particles advance by dt (wx, wy) and their rows are tracked, as the scalar passes do.
 inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, RowSpan& rows) {
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
@@ -275,6 +297,34 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
     V4 N[4], dNx[4], dNy[4];
     simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
                           dNy);
+    if (simd::in_a_row(n0)) {  // a node row's sums at once, each node's terms in particle order
+      flush();
+      const long n = n0[0], nu = n + nnx;
+      if constexpr (kM) {
+        const V4 mk = simd::load(M + k), mvx = mk * simd::load(VX + k), mvy = mk * simd::load(VY + k);
+        auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
+        for (int c = 0; c < 3; ++c) {
+          const V4 w = c == 0 ? mk : c == 1 ? mvx : mvy;
+          simd::add_row(fld[c], n, term(w, 1), term(w, 0));
+          simd::add_row(fld[c], nu, term(w, 2), term(w, 3));
+        }
+      }
+      if constexpr (kFo) {
+        const V4 v = simd::load(V + k), sxx = simd::load(SXX + k), syy = simd::load(SYY + k),
+                 sxy = simd::load(SXY + k), mk = simd::load(M + k);
+        for (int l = 0; l < 4; ++l) {
+          negative |= std::signbit(v[l]);
+          stretched |= v[l] > stretch_limit * mk[l];
+        }
+        auto tx = [&](int a) { return [&, a](V4 t) { return t - v * (sxx * dNx[a] + sxy * dNy[a]); }; };
+        auto ty = [&](int a) { return [&, a](V4 t) { return t - v * (sxy * dNx[a] + syy * dNy[a]); }; };
+        simd::add_row(fld[kFx], n, tx(1), tx(0));
+        simd::add_row(fld[kFx], nu, tx(2), tx(3));
+        simd::add_row(fld[kFx + 1], n, ty(1), ty(0));
+        simd::add_row(fld[kFx + 1], nu, ty(2), ty(3));
+      }
+      continue;
+    }
     for (int l = 0; l < 4; ++l) {
       const uint32_t q = k + l;
       // The node sums of this particle in node order 0 (n0), 1 (n0 + 1), 2 (n0 + nnx + 1),
@@ -461,10 +511,11 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     long n0[4];
     V4 N[K];
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, nullptr, nullptr)) return k;
+    const bool row = simd::in_a_row(n0);
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
     for (int c = 0; c < K; ++c) {
-      const V4 Ux = simd::gather(ux, n0, off[c]), Uy = simd::gather(uy, n0, off[c]);
-      const V4 Vx = simd::gather(vx, n0, off[c]), Vy = simd::gather(vy, n0, off[c]);
+      const V4 Ux = simd::gather(ux, n0, off[c], row), Uy = simd::gather(uy, n0, off[c], row);
+      const V4 Vx = simd::gather(vx, n0, off[c], row), Vy = simd::gather(vy, n0, off[c], row);
       wx += N[c] * Ux;
       wy += N[c] * Uy;
       dvx += N[c] * (Ux - Vx);
@@ -483,6 +534,13 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     }
     if constexpr (REMAP) {
       const V4 mvx = mk * nvx, mvy = mk * nvy;
+      if (K == 4 && row) {  // bilinear: node a is 0 lower left, 1 lower right, 2 upper right, 3 upper left
+        const long n = n0[0], nu = n + g.nnx;
+        simd::add_row(f.qx, n, [&](V4 t) { return t + mvx * N[1]; }, [&](V4 t) { return t + mvx * N[0]; });
+        simd::add_row(f.qx, nu, [&](V4 t) { return t + mvx * N[2]; }, [&](V4 t) { return t + mvx * N[3]; });
+        simd::add_row(f.qy, n, [&](V4 t) { return t + mvy * N[1]; }, [&](V4 t) { return t + mvy * N[0]; });
+        simd::add_row(f.qy, nu, [&](V4 t) { return t + mvy * N[2]; }, [&](V4 t) { return t + mvy * N[3]; });
+      } else
       for (int l = 0; l < 4; ++l)
         for (int c = 0; c < K; ++c) {
           f.qx[n0[l] + off[c]] += mvx[l] * N[c][l];
@@ -581,16 +639,17 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
     long n0[4];
     V4 N[K], dNx[K], dNy[K];
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
+    const bool row = simd::in_a_row(n0);
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
     for (int c = 0; c < K; ++c) {
-      const V4 Gx = simd::gather(gx, n0, off[c]), Gy = simd::gather(gy, n0, off[c]);
+      const V4 Gx = simd::gather(gx, n0, off[c], row), Gy = simd::gather(gy, n0, off[c], row);
       lxx += Gx * dNx[c];
       lxy += Gx * dNy[c];
       lyx += Gy * dNx[c];
       lyy += Gy * dNy[c];
       if constexpr (MOVE) {
-        wx += N[c] * simd::gather(ux, n0, off[c]);
-        wy += N[c] * simd::gather(uy, n0, off[c]);
+        wx += N[c] * simd::gather(ux, n0, off[c], row);
+        wy += N[c] * simd::gather(uy, n0, off[c], row);
       }
     }
     V4 sxx = simd::load(SXX + k), syy = simd::load(SYY + k), szz = simd::load(SZZ + k),
