@@ -513,6 +513,7 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, nullptr, nullptr)) return k;
     const bool row = simd::in_a_row(n0);
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
+#pragma GCC unroll 9
     for (int c = 0; c < K; ++c) {
       const V4 Ux = simd::gather(ux, n0, off[c], row), Uy = simd::gather(uy, n0, off[c], row);
       const V4 Vx = simd::gather(vx, n0, off[c], row), Vy = simd::gather(vy, n0, off[c], row);
@@ -641,6 +642,7 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
     const bool row = simd::in_a_row(n0);
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
+#pragma GCC unroll 9
     for (int c = 0; c < K; ++c) {
       const V4 Gx = simd::gather(gx, n0, off[c], row), Gy = simd::gather(gy, n0, off[c], row);
       lxx += Gx * dNx[c];
