@@ -134,9 +134,10 @@ struct KernelState {
   Particles p;
   std::vector<double> a[11];  // m px py fx fy vx vy vnx vny qx qy
   NodalField f;
-  // rows: most particles in consecutive cells of a grid row (14 cells to a row, as at one
-  // particle per cell), every eleventh one elsewhere: groups of four in a row and out of it.
-  KernelState(int n, unsigned seed, bool rows = false) {
+  // per_cell > 0: most particles along the grid's rows (14 cells to a row), per_cell of them in
+  // each cell before the next (as a row of particles is seeded at 1, 4 and 9 per cell), every
+  // eleventh one elsewhere: groups of four in a row of cells, in one or two cells, and scattered.
+  KernelState(int n, unsigned seed, int per_cell = 0) {
     const double h = 1e-3;
     g.init(0, 0, h, 16, 16);
     p.resize(n);
@@ -145,9 +146,10 @@ struct KernelState {
     for (int k = 0; k < n; ++k) {
       p.x[k] = (1.5 + 13 * u(rng)) * h;
       p.y[k] = (1.5 + 13 * u(rng)) * h;
-      if (rows && k % 11 != 7) {
-        p.x[k] = (1 + k % 14 + 0.98 * (p.x[k] / h - 1.5) / 13 + 0.01) * h;
-        p.y[k] = (1 + (k / 14) % 14 + 0.98 * (p.y[k] / h - 1.5) / 13 + 0.01) * h;
+      if (per_cell > 0 && k % 11 != 7) {
+        const int c = k / per_cell;  // the cell, counted along rows
+        p.x[k] = (1 + c % 14 + 0.98 * (p.x[k] / h - 1.5) / 13 + 0.01) * h;
+        p.y[k] = (1 + (c / 14) % 14 + 0.98 * (p.y[k] / h - 1.5) / 13 + 0.01) * h;
       }
       p.vx[k] = u(rng) - 0.5;
       p.vy[k] = u(rng) - 0.5;
@@ -199,7 +201,7 @@ void expect_same(const KernelState& w, const KernelState& s, const char* pass) {
 }
 }  // namespace
 
-class Kernels : public ::testing::TestWithParam<bool> {};
+class Kernels : public ::testing::TestWithParam<int> {};
 
 TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   const int n = 103;  // 25 groups of four and a tail of three
@@ -213,7 +215,7 @@ TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
                 static_cast<long>(std::floor(start.p.x[k + l] / start.g.h));
       in_row += kernels::simd::in_a_row(n0);
     }
-    if (GetParam()) EXPECT_GE(in_row, 10) << "groups in a row";
+    if (GetParam() == 1) EXPECT_GE(in_row, 10) << "groups in a row";
     else EXPECT_EQ(in_row, 0) << "groups in a row";
   }
   const double dt = 1e-8, inv_rho = 1.0 / tungsten().rho;
@@ -308,9 +310,11 @@ TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   }
 }
 
-// Particles anywhere, and particles in rows of consecutive cells (the passes' row form).
-INSTANTIATE_TEST_SUITE_P(Layouts, Kernels, ::testing::Values(false, true),
-                         [](const auto& i) { return i.param ? "InRows" : "Scattered"; });
+// Particles anywhere, and along rows of cells 1, 2 and 3 to a cell (p2g's row form and its sums
+// carried from particle to particle).
+INSTANTIATE_TEST_SUITE_P(Layouts, Kernels, ::testing::Values(0, 1, 2, 3), [](const auto& i) {
+  return i.param == 0 ? std::string("Scattered") : "AlongRows" + std::to_string(i.param) + "PerCell";
+});
 
 // The grid's write-only passes with streaming stores (past the cache) against plain ones
 // (Solver::streaming): every particle array and the energy account bit for bit after 100 steps

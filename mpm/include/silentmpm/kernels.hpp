@@ -281,15 +281,19 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
   double* fld[kF];
   if constexpr (kM) { fld[0] = f.m; fld[1] = f.px; fld[2] = f.py; }
   if constexpr (kFo) { fld[kFx] = f.fx; fld[kFx + 1] = f.fy; }
-  // The right column of the last particle's nodes (bottom n = cn, top cn + nnx), its sums kept
-  // in registers: a particle in the next cell of the row starts from them (the same additions
-  // in the same order as through memory), any other particle has them written back first.
-  long cn = -1;
-  double cb[kF] = {}, ct[kF] = {};  // (read only once cn is set)
+  // The last particle's four node sums, kept in registers (node order 0 at cl, 1 at cl + 1, 2 at
+  // cl + nnx + 1, 3 at cl + nnx): a particle of the same cell goes on from all four, one in the
+  // next cell of the row from the right column (the left one written back), any other has them
+  // written back first: the same additions in the same order as through memory.
+  long cl = -1;
+  double L0[kF] = {}, R1[kF] = {}, R2[kF] = {}, L3[kF] = {};  // (read only once cl is set)
   auto flush = [&] {
-    if (cn < 0) return;
-    for (int c = 0; c < kF; ++c) { fld[c][cn] = cb[c]; fld[c][cn + nnx] = ct[c]; }
-    cn = -1;
+    if (cl < 0) return;
+    for (int c = 0; c < kF; ++c) {
+      fld[c][cl] = L0[c]; fld[c][cl + 1] = R1[c];
+      fld[c][cl + nnx + 1] = R2[c]; fld[c][cl + nnx] = L3[c];
+    }
+    cl = -1;
   };
   uint32_t k = b;
   for (; k + 4 <= e; k += 4) {
@@ -327,18 +331,21 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
     }
     for (int l = 0; l < 4; ++l) {
       const uint32_t q = k + l;
-      // The node sums of this particle in node order 0 (n0), 1 (n0 + 1), 2 (n0 + nnx + 1),
-      // 3 (n0 + nnx): its left column from the carried values or from memory, its right column
-      // from memory, kept for the next particle.
       const long i0 = n0[l];
-      double L0[kF], L3[kF], R1[kF], R2[kF];
-      if (cn == i0) {
-        for (int c = 0; c < kF; ++c) { L0[c] = cb[c]; L3[c] = ct[c]; }
-      } else {
+      if (i0 == cl + 1 && cl >= 0) {
+        for (int c = 0; c < kF; ++c) {
+          fld[c][cl] = L0[c]; fld[c][cl + nnx] = L3[c];
+          L0[c] = R1[c]; L3[c] = R2[c];
+          R1[c] = fld[c][i0 + 1]; R2[c] = fld[c][i0 + nnx + 1];
+        }
+      } else if (i0 != cl) {
         flush();
-        for (int c = 0; c < kF; ++c) { L0[c] = fld[c][i0]; L3[c] = fld[c][i0 + nnx]; }
+        for (int c = 0; c < kF; ++c) {
+          L0[c] = fld[c][i0]; R1[c] = fld[c][i0 + 1];
+          R2[c] = fld[c][i0 + nnx + 1]; L3[c] = fld[c][i0 + nnx];
+        }
       }
-      for (int c = 0; c < kF; ++c) { R1[c] = fld[c][i0 + 1]; R2[c] = fld[c][i0 + nnx + 1]; }
+      cl = i0;
       double* node[4] = {L0, R1, R2, L3};
       if constexpr (kM) {
         const double mk = M[q], mvx = mk * VX[q], mvy = mk * VY[q];
@@ -357,9 +364,6 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
           node[a][kFx + 1] -= v * (sxy * dNx[a][l] + syy * dNy[a][l]);
         }
       }
-      for (int c = 0; c < kF; ++c) { fld[c][i0] = L0[c]; fld[c][i0 + nnx] = L3[c]; }
-      for (int c = 0; c < kF; ++c) { cb[c] = R1[c]; ct[c] = R2[c]; }
-      cn = i0 + 1;
     }
   }
   flush();
