@@ -85,6 +85,15 @@ inline V4 load(const double* a) {
   return v;
 }
 inline void store(double* a, V4 v) { std::memcpy(a, &v, sizeof v); }
+// The particle passes ask for their arrays' lines kAhead particles ahead: the hardware's stream
+// prefetchers alone fall behind the ten or so arrays a pass reads (AMD EPYC host, one thread,
+// 1e6 particles: 7-9 % of the MUSL step at 1 ppc, 14-18 % at 4 ppc; 5-7 % in cache at 1e5).
+// W: the pass writes them too. A prefetch has no effect on the values and never faults.
+constexpr uint32_t kAhead = 64;
+template <int W = 0, class... A>
+inline void prefetch_ahead(uint32_t k, const A*... a) {
+  (__builtin_prefetch(a + k + kAhead, W), ...);
+}
 // Bilinear::eval of four points: each one's first node n0 (its cell's lower left) and the values
 // N (and gradients dNx, dNy) in Bilinear's node order.
 inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nnx, long n0[4],
@@ -299,6 +308,9 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[4], dNx[4], dNy[4];
+    simd::prefetch_ahead(k, X, Y);
+    if constexpr (kM) simd::prefetch_ahead(k, M, VX, VY);
+    if constexpr (kFo) simd::prefetch_ahead(k, V, SXX, SYY, SXY);
     simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
                           dNy);
     if (simd::in_a_row(n0)) {  // a node row's sums at once, each node's terms in particle order
@@ -390,6 +402,9 @@ inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, 
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[K], dNx[K], dNy[K];
+    simd::prefetch_ahead(k, X, Y, M);
+    if constexpr ((WHAT & kMomentum) != 0) simd::prefetch_ahead(k, VX, VY);
+    if constexpr ((WHAT & kForce) != 0) simd::prefetch_ahead(k, V, SXX, SYY, SXY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
     for (int l = 0; l < 4; ++l) {
       const uint32_t q = k + l;
@@ -514,6 +529,8 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[K];
+    simd::prefetch_ahead(k, X, Y, M);
+    simd::prefetch_ahead<1>(k, VX, VY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, nullptr, nullptr)) return k;
     const bool row = simd::in_a_row(n0);
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
@@ -643,6 +660,7 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
   for (; k + 4 <= e; k += 4) {
     long n0[4];
     V4 N[K], dNx[K], dNy[K];
+    simd::prefetch_ahead<1>(k, X, Y, V, SXX, SYY, SZZ, SXY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
     const bool row = simd::in_a_row(n0);
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
