@@ -136,7 +136,8 @@ struct KernelState {
   NodalField f;
   // per_cell > 0: most particles along the grid's rows (14 cells to a row), per_cell of them in
   // each cell before the next (as a row of particles is seeded at 1, 4 and 9 per cell), every
-  // eleventh one elsewhere: groups of four in a row of cells, in one or two cells, and scattered.
+  // eleventh one elsewhere: groups of four in a row of cells (bilinear and 3 x 3 supports), in
+  // one or two cells, and scattered.
   KernelState(int n, unsigned seed, int per_cell = 0) {
     const double h = 1e-3;
     g.init(0, 0, h, 16, 16);
@@ -148,7 +149,10 @@ struct KernelState {
       p.y[k] = (1.5 + 13 * u(rng)) * h;
       if (per_cell > 0 && k % 11 != 7) {
         const int c = k / per_cell;  // the cell, counted along rows
-        p.x[k] = (1 + c % 14 + 0.98 * (p.x[k] / h - 1.5) / 13 + 0.01) * h;
+        // (at 1 per cell in the cells' right halves, so that the 3 x 3 supports, which start
+        // half a cell to the left, also follow each other)
+        const double lo = per_cell == 1 ? 0.51 : 0.01, span = 0.99 - lo;
+        p.x[k] = (1 + c % 14 + span * (p.x[k] / h - 1.5) / 13 + lo) * h;
         p.y[k] = (1 + (c / 14) % 14 + 0.98 * (p.y[k] / h - 1.5) / 13 + 0.01) * h;
       }
       p.vx[k] = u(rng) - 0.5;

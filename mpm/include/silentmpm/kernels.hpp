@@ -148,6 +148,19 @@ inline void add_row(double* a, long n, const Right& right, const Left& left) {
   store(a + n, left(s));
   a[n + 4] = t[3];
 }
+// The same for supports three nodes wide (the 3 x 3 shapes: particle l's nodes n + l .. n + l + 2
+// in the row, terms third(s), second(s), first(s) in that order at each node: those of particle
+// l - 2, l - 1 and l, as the scalar loop adds them), into nodes n .. n + 5.
+template <class Third, class Second, class First>
+inline void add_row3(double* a, long n, const Third& third, const Second& second, const First& first) {
+  const V4 t = third(load(a + n + 2));  // nodes n + 2 .. n + 5
+  const double a1 = a[n + 1], a0 = a[n];
+  const V4 u = second(__builtin_shuffle(V4{a1, a1, a1, a1}, t, M4{3, 4, 5, 6}));  // n + 1 .. n + 4
+  const V4 s = __builtin_shuffle(V4{a0, a0, a0, a0}, u, M4{3, 4, 5, 6});           // n .. n + 3
+  store(a + n, first(s));
+  a[n + 4] = u[3];
+  a[n + 5] = t[3];
+}
 // Four particles advance by dt (wx, wy) and their rows are tracked, as the scalar passes do.
 inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, RowSpan& rows) {
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
@@ -406,6 +419,36 @@ inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, 
     if constexpr ((WHAT & kMomentum) != 0) simd::prefetch_ahead(k, VX, VY);
     if constexpr ((WHAT & kForce) != 0) simd::prefetch_ahead(k, V, SXX, SYY, SXY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
+    if (K == 9 && simd::in_a_row(n0)) {  // each node row's sums at once, in particle order
+      const long nnx = g.nnx;
+      if constexpr ((WHAT & kMomentum) != 0) {
+        const V4 mk = simd::load(M + k), mvx = mk * simd::load(VX + k), mvy = mk * simd::load(VY + k);
+        auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
+        double* fm[3] = {f.m, f.px, f.py};
+        for (int c = 0; c < 3; ++c) {
+          const V4 w = c == 0 ? mk : c == 1 ? mvx : mvy;
+          for (int jj = 0; jj < 3; ++jj)
+            simd::add_row3(fm[c], n0[0] + jj * nnx, term(w, 3 * jj + 2), term(w, 3 * jj + 1),
+                           term(w, 3 * jj));
+        }
+      }
+      if constexpr ((WHAT & kForce) != 0) {
+        const V4 v = simd::load(V + k), sxx = simd::load(SXX + k), syy = simd::load(SYY + k),
+                 sxy = simd::load(SXY + k), mk = simd::load(M + k);
+        for (int l = 0; l < 4; ++l) {
+          negative |= std::signbit(v[l]);
+          stretched |= v[l] > stretch_limit * mk[l];
+        }
+        auto tx = [&](int a) { return [&, a](V4 t) { return t - v * (sxx * dNx[a] + sxy * dNy[a]); }; };
+        auto ty = [&](int a) { return [&, a](V4 t) { return t - v * (sxy * dNx[a] + syy * dNy[a]); }; };
+        for (int jj = 0; jj < 3; ++jj) {
+          const long n = n0[0] + jj * nnx;
+          simd::add_row3(f.fx, n, tx(3 * jj + 2), tx(3 * jj + 1), tx(3 * jj));
+          simd::add_row3(f.fy, n, ty(3 * jj + 2), ty(3 * jj + 1), ty(3 * jj));
+        }
+      }
+      continue;
+    }
     for (int l = 0; l < 4; ++l) {
       const uint32_t q = k + l;
       if constexpr ((WHAT & kMomentum) != 0) {
@@ -562,6 +605,13 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
         simd::add_row(f.qx, nu, [&](V4 t) { return t + mvx * N[2]; }, [&](V4 t) { return t + mvx * N[3]; });
         simd::add_row(f.qy, n, [&](V4 t) { return t + mvy * N[1]; }, [&](V4 t) { return t + mvy * N[0]; });
         simd::add_row(f.qy, nu, [&](V4 t) { return t + mvy * N[2]; }, [&](V4 t) { return t + mvy * N[3]; });
+      } else if (K == 9 && row) {  // the 3 x 3 shapes: node a = 3 jj + ii at n0 + jj nnx + ii
+        auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
+        for (int jj = 0; jj < 3; ++jj) {
+          const long n = n0[0] + jj * g.nnx;
+          simd::add_row3(f.qx, n, term(mvx, 3 * jj + 2), term(mvx, 3 * jj + 1), term(mvx, 3 * jj));
+          simd::add_row3(f.qy, n, term(mvy, 3 * jj + 2), term(mvy, 3 * jj + 1), term(mvy, 3 * jj));
+        }
       } else
       for (int l = 0; l < 4; ++l)
         for (int c = 0; c < K; ++c) {
