@@ -144,7 +144,7 @@ template <class Right, class Left>
 inline void add_row(double* a, long n, const Right& right, const Left& left) {
   const V4 t = right(load(a + n + 1));  // nodes n + 1 .. n + 4
   const double a0 = a[n];
-  const V4 s = __builtin_shuffle(V4{a0, a0, a0, a0}, t, M4{3, 4, 5, 6});  // nodes n .. n + 3
+  const V4 s = __builtin_shufflevector(V4{a0, a0, a0, a0}, t, 3, 4, 5, 6);  // nodes n .. n + 3
   store(a + n, left(s));
   a[n + 4] = t[3];
 }
@@ -155,8 +155,8 @@ template <class Third, class Second, class First>
 inline void add_row3(double* a, long n, const Third& third, const Second& second, const First& first) {
   const V4 t = third(load(a + n + 2));  // nodes n + 2 .. n + 5
   const double a1 = a[n + 1], a0 = a[n];
-  const V4 u = second(__builtin_shuffle(V4{a1, a1, a1, a1}, t, M4{3, 4, 5, 6}));  // n + 1 .. n + 4
-  const V4 s = __builtin_shuffle(V4{a0, a0, a0, a0}, u, M4{3, 4, 5, 6});           // n .. n + 3
+  const V4 u = second(__builtin_shufflevector(V4{a1, a1, a1, a1}, t, 3, 4, 5, 6));  // n + 1 .. n + 4
+  const V4 s = __builtin_shufflevector(V4{a0, a0, a0, a0}, u, 3, 4, 5, 6);           // n .. n + 3
   store(a + n, first(s));
   a[n + 4] = u[3];
   a[n + 5] = t[3];
