@@ -131,9 +131,26 @@ inline V4 gather(const double* a, const long n0[4], long off) {
 inline bool in_a_row(const long n0[4]) {
   return n0[1] == n0[0] + 1 && n0[2] == n0[0] + 2 && n0[3] == n0[0] + 3;
 }
-// gather(a, n0, off), read as one load where in_a_row(n0) (`row`): the same values.
-inline V4 gather(const double* a, const long n0[4], long off, bool row) {
-  return row ? load(a + n0[0] + off) : gather(a, n0, off);
+// Whether the four points lie two by two in two neighbouring cells of a row (n0 = c, c, c + 1,
+// c + 1: a row of particles seeded at four per cell): their values at each node are then two.
+inline bool in_pairs(const long n0[4]) {
+  return n0[1] == n0[0] && n0[2] == n0[0] + 1 && n0[3] == n0[2];
+}
+// How four points' nodes lie: kInRow (in_a_row), kInPairs (in_pairs), else kScattered.
+constexpr int kScattered = 0, kInRow = 1, kInPairs = 2;
+inline int layout(const long n0[4]) {
+  return in_a_row(n0) ? kInRow : in_pairs(n0) ? kInPairs : kScattered;
+}
+// gather(a, n0, off), read as one load where layout(n0) (`lay`) allows: the same values.
+inline V4 gather(const double* a, const long n0[4], long off, int lay) {
+  if (lay == kInRow) return load(a + n0[0] + off);
+  if (lay == kInPairs) {
+    using V2 = double __attribute__((vector_size(16)));
+    V2 two;
+    std::memcpy(&two, a + n0[0] + off, sizeof two);
+    return __builtin_shufflevector(two, two, 0, 0, 1, 1);
+  }
+  return gather(a, n0, off);
 }
 // Four particles in consecutive cells of a grid row (in_a_row: particle l's cell starts at node
 // n + l) summed into one row of nodes n .. n + 4 of `a`: right(s) adds to s each particle's term
@@ -575,12 +592,13 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     simd::prefetch_ahead(k, X, Y, M);
     simd::prefetch_ahead<1>(k, VX, VY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, nullptr, nullptr)) return k;
-    const bool row = simd::in_a_row(n0);
+    const int lay = simd::layout(n0);
+    const bool row = lay == simd::kInRow;
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
 #pragma GCC unroll 9
     for (int c = 0; c < K; ++c) {
-      const V4 Ux = simd::gather(ux, n0, off[c], row), Uy = simd::gather(uy, n0, off[c], row);
-      const V4 Vx = simd::gather(vx, n0, off[c], row), Vy = simd::gather(vy, n0, off[c], row);
+      const V4 Ux = simd::gather(ux, n0, off[c], lay), Uy = simd::gather(uy, n0, off[c], lay);
+      const V4 Vx = simd::gather(vx, n0, off[c], lay), Vy = simd::gather(vy, n0, off[c], lay);
       wx += N[c] * Ux;
       wy += N[c] * Uy;
       dvx += N[c] * (Ux - Vx);
@@ -712,18 +730,18 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
     V4 N[K], dNx[K], dNy[K];
     simd::prefetch_ahead<1>(k, X, Y, V, SXX, SYY, SZZ, SXY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
-    const bool row = simd::in_a_row(n0);
+    const int lay = simd::layout(n0);
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
 #pragma GCC unroll 9
     for (int c = 0; c < K; ++c) {
-      const V4 Gx = simd::gather(gx, n0, off[c], row), Gy = simd::gather(gy, n0, off[c], row);
+      const V4 Gx = simd::gather(gx, n0, off[c], lay), Gy = simd::gather(gy, n0, off[c], lay);
       lxx += Gx * dNx[c];
       lxy += Gx * dNy[c];
       lyx += Gy * dNx[c];
       lyy += Gy * dNy[c];
       if constexpr (MOVE) {
-        wx += N[c] * simd::gather(ux, n0, off[c], row);
-        wy += N[c] * simd::gather(uy, n0, off[c], row);
+        wx += N[c] * simd::gather(ux, n0, off[c], lay);
+        wy += N[c] * simd::gather(uy, n0, off[c], lay);
       }
     }
     V4 sxx = simd::load(SXX + k), syy = simd::load(SYY + k), szz = simd::load(SZZ + k),
