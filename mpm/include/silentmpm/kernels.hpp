@@ -178,6 +178,25 @@ inline void add_row3(double* a, long n, const Third& third, const Second& second
   a[n + 4] = u[3];
   a[n + 5] = t[3];
 }
+// Four particles two by two in cells n and n + 1 of a row (in_pairs) summed into nodes n .. n + 2
+// of `a`, as two pairs of lanes, one particle of each cell: pair 0 the particles 0 and 2, pair 1
+// the particles 1 and 3. right(s, j) adds pair j's terms at their right nodes (n + 1, n + 2),
+// left(s, j) at their left nodes (n, n + 1). At node n + 1 the right terms of particles 0 and 1
+// come before the left terms of 2 and 3: particle order at every node, the scalar loop's sums.
+using V2 = double __attribute__((vector_size(16)));
+inline V2 pair_of(V4 w, int j) {
+  return j == 0 ? __builtin_shufflevector(w, w, 0, 2) : __builtin_shufflevector(w, w, 1, 3);
+}
+template <class Right, class Left>
+inline void add_pairs(double* a, long n, const Right& right, const Left& left) {
+  V2 x;
+  std::memcpy(&x, a + n + 1, sizeof x);  // nodes n + 1, n + 2
+  x = right(right(x, 0), 1);
+  V2 y = {a[n], x[0]};  // nodes n, n + 1
+  y = left(left(y, 0), 1);
+  std::memcpy(a + n, &y, sizeof y);
+  a[n + 2] = x[1];
+}
 // Four particles advance by dt (wx, wy) and their rows are tracked, as the scalar passes do.
 inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, RowSpan& rows) {
   const double x0 = g.x0, y0 = g.y0, ih = g.inv_h, x1 = g.x1();
@@ -368,6 +387,44 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
         simd::add_row(fld[kFx], nu, tx(2), tx(3));
         simd::add_row(fld[kFx + 1], n, ty(1), ty(0));
         simd::add_row(fld[kFx + 1], nu, ty(2), ty(3));
+      }
+      continue;
+    }
+    if (simd::in_pairs(n0)) {  // two cells' nodes at once, each node's terms in particle order
+      flush();
+      const long n = n0[0], nu = n + nnx;
+      using simd::V2;
+      using simd::pair_of;
+      if constexpr (kM) {
+        const V4 mk = simd::load(M + k), mvx = mk * simd::load(VX + k), mvy = mk * simd::load(VY + k);
+        auto term = [&](V4 w, int a) {
+          return [&, a, w](V2 t, int j) { return t + pair_of(w, j) * pair_of(N[a], j); };
+        };
+        for (int c = 0; c < 3; ++c) {
+          const V4 w = c == 0 ? mk : c == 1 ? mvx : mvy;
+          simd::add_pairs(fld[c], n, term(w, 1), term(w, 0));
+          simd::add_pairs(fld[c], nu, term(w, 2), term(w, 3));
+        }
+      }
+      if constexpr (kFo) {
+        const V4 v = simd::load(V + k), sxx = simd::load(SXX + k), syy = simd::load(SYY + k),
+                 sxy = simd::load(SXY + k), mk = simd::load(M + k);
+        for (int l = 0; l < 4; ++l) {
+          negative |= std::signbit(v[l]);
+          stretched |= v[l] > stretch_limit * mk[l];
+        }
+        V4 Tx[4], Ty[4];
+        for (int a = 0; a < 4; ++a) {
+          Tx[a] = sxx * dNx[a] + sxy * dNy[a];
+          Ty[a] = sxy * dNx[a] + syy * dNy[a];
+        }
+        auto term = [&](const V4* T, int a) {
+          return [&, T, a](V2 t, int j) { return t - pair_of(v, j) * pair_of(T[a], j); };
+        };
+        simd::add_pairs(fld[kFx], n, term(Tx, 1), term(Tx, 0));
+        simd::add_pairs(fld[kFx], nu, term(Tx, 2), term(Tx, 3));
+        simd::add_pairs(fld[kFx + 1], n, term(Ty, 1), term(Ty, 0));
+        simd::add_pairs(fld[kFx + 1], nu, term(Ty, 2), term(Ty, 3));
       }
       continue;
     }
