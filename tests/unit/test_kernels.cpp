@@ -210,17 +210,19 @@ class Kernels : public ::testing::TestWithParam<int> {};
 TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   const int n = 103;  // 25 groups of four and a tail of three
   const KernelState start(n, 11, GetParam());
-  {  // the groups of four whose cells follow each other in a row: the row form's share
-    int in_row = 0;
+  {  // the groups of four in the row form (1 per cell) and two by two (2 per cell)
+    int in_row = 0, in_pairs = 0;
     for (int k = 0; k + 4 <= n; k += 4) {
       long n0[4];
       for (int l = 0; l < 4; ++l)
         n0[l] = static_cast<long>(std::floor(start.p.y[k + l] / start.g.h)) * start.g.nnx +
                 static_cast<long>(std::floor(start.p.x[k + l] / start.g.h));
       in_row += kernels::simd::in_a_row(n0);
+      in_pairs += kernels::simd::in_pairs(n0);
     }
     if (GetParam() == 1) EXPECT_GE(in_row, 10) << "groups in a row";
     else EXPECT_EQ(in_row, 0) << "groups in a row";
+    if (GetParam() == 2) EXPECT_GE(in_pairs, 10) << "groups two by two";
   }
   const double dt = 1e-8, inv_rho = 1.0 / tungsten().rho;
   auto p2g = [&](auto shape_c) {  // p2g: mass, momenta, forces
