@@ -222,7 +222,9 @@ TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
     }
     if (GetParam() == 1) EXPECT_GE(in_row, 10) << "groups in a row";
     else EXPECT_EQ(in_row, 0) << "groups in a row";
-    if (GetParam() == 2) EXPECT_GE(in_pairs, 10) << "groups two by two";
+    if (GetParam() == 2) {
+      EXPECT_GE(in_pairs, 10) << "groups two by two";
+    }
   }
   const double dt = 1e-8, inv_rho = 1.0 / tungsten().rho;
   auto p2g = [&](auto shape_c) {  // p2g: mass, momenta, forces

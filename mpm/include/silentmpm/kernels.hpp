@@ -362,48 +362,33 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
     if constexpr (kFo) simd::prefetch_ahead(k, V, SXX, SYY, SXY);
     simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
                           dNy);
-    if (simd::in_a_row(n0)) {  // a node row's sums at once, each node's terms in particle order
+    if (const bool row = simd::in_a_row(n0); row || simd::in_pairs(n0)) {
+      // A node row's sums at once (four consecutive cells: add_row), or two cells' (two by two:
+      // add_pairs); each node's terms in particle order.
       flush();
       const long n = n0[0], nu = n + nnx;
-      if constexpr (kM) {
-        const V4 mk = simd::load(M + k), mvx = mk * simd::load(VX + k), mvy = mk * simd::load(VY + k);
-        auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
-        for (int c = 0; c < 3; ++c) {
-          const V4 w = c == 0 ? mk : c == 1 ? mvx : mvy;
-          simd::add_row(fld[c], n, term(w, 1), term(w, 0));
-          simd::add_row(fld[c], nu, term(w, 2), term(w, 3));
-        }
-      }
-      if constexpr (kFo) {
-        const V4 v = simd::load(V + k), sxx = simd::load(SXX + k), syy = simd::load(SYY + k),
-                 sxy = simd::load(SXY + k), mk = simd::load(M + k);
-        for (int l = 0; l < 4; ++l) {
-          negative |= std::signbit(v[l]);
-          stretched |= v[l] > stretch_limit * mk[l];
-        }
-        auto tx = [&](int a) { return [&, a](V4 t) { return t - v * (sxx * dNx[a] + sxy * dNy[a]); }; };
-        auto ty = [&](int a) { return [&, a](V4 t) { return t - v * (sxy * dNx[a] + syy * dNy[a]); }; };
-        simd::add_row(fld[kFx], n, tx(1), tx(0));
-        simd::add_row(fld[kFx], nu, tx(2), tx(3));
-        simd::add_row(fld[kFx + 1], n, ty(1), ty(0));
-        simd::add_row(fld[kFx + 1], nu, ty(2), ty(3));
-      }
-      continue;
-    }
-    if (simd::in_pairs(n0)) {  // two cells' nodes at once, each node's terms in particle order
-      flush();
-      const long n = n0[0], nu = n + nnx;
-      using simd::V2;
-      using simd::pair_of;
-      if constexpr (kM) {
-        const V4 mk = simd::load(M + k), mvx = mk * simd::load(VX + k), mvy = mk * simd::load(VY + k);
-        auto term = [&](V4 w, int a) {
-          return [&, a, w](V2 t, int j) { return t + pair_of(w, j) * pair_of(N[a], j); };
+      // F S added (SUB: subtracted) at each particle's right (Sr) and left (Sl) node of a row.
+      auto into = [&](double* a, long at, V4 F, V4 Sr, V4 Sl, auto sub) {
+        auto term = [](auto t, auto f, auto s) {
+          if constexpr (decltype(sub)::value) return t - f * s;
+          else return t + f * s;
         };
+        using simd::pair_of;
+        if (row)
+          simd::add_row(a, at, [&](V4 t) { return term(t, F, Sr); }, [&](V4 t) { return term(t, F, Sl); });
+        else
+          simd::add_pairs(
+              a, at, [&](simd::V2 t, int j) { return term(t, pair_of(F, j), pair_of(Sr, j)); },
+              [&](simd::V2 t, int j) { return term(t, pair_of(F, j), pair_of(Sl, j)); });
+      };
+      const std::false_type add;
+      const std::true_type sub;
+      if constexpr (kM) {
+        const V4 mk = simd::load(M + k), mvx = mk * simd::load(VX + k), mvy = mk * simd::load(VY + k);
         for (int c = 0; c < 3; ++c) {
           const V4 w = c == 0 ? mk : c == 1 ? mvx : mvy;
-          simd::add_pairs(fld[c], n, term(w, 1), term(w, 0));
-          simd::add_pairs(fld[c], nu, term(w, 2), term(w, 3));
+          into(fld[c], n, w, N[1], N[0], add);
+          into(fld[c], nu, w, N[2], N[3], add);
         }
       }
       if constexpr (kFo) {
@@ -418,13 +403,10 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
           Tx[a] = sxx * dNx[a] + sxy * dNy[a];
           Ty[a] = sxy * dNx[a] + syy * dNy[a];
         }
-        auto term = [&](const V4* T, int a) {
-          return [&, T, a](V2 t, int j) { return t - pair_of(v, j) * pair_of(T[a], j); };
-        };
-        simd::add_pairs(fld[kFx], n, term(Tx, 1), term(Tx, 0));
-        simd::add_pairs(fld[kFx], nu, term(Tx, 2), term(Tx, 3));
-        simd::add_pairs(fld[kFx + 1], n, term(Ty, 1), term(Ty, 0));
-        simd::add_pairs(fld[kFx + 1], nu, term(Ty, 2), term(Ty, 3));
+        into(fld[kFx], n, v, Tx[1], Tx[0], sub);
+        into(fld[kFx], nu, v, Tx[2], Tx[3], sub);
+        into(fld[kFx + 1], n, v, Ty[1], Ty[0], sub);
+        into(fld[kFx + 1], nu, v, Ty[2], Ty[3], sub);
       }
       continue;
     }
