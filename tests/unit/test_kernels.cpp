@@ -210,8 +210,8 @@ class Kernels : public ::testing::TestWithParam<int> {};
 TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
   const int n = 103;  // 25 groups of four and a tail of three
   const KernelState start(n, 11, GetParam());
-  {  // the groups of four in the row form (1 per cell) and two by two (2 per cell)
-    int in_row = 0, in_pairs = 0;
+  {  // the groups of four in the row form (1 per cell), two by two (2) and in two cells (3)
+    int in_row = 0, in_pairs = 0, in_two = 0;
     for (int k = 0; k + 4 <= n; k += 4) {
       long n0[4];
       for (int l = 0; l < 4; ++l)
@@ -219,11 +219,15 @@ TEST_P(Kernels, FourAtATimeEqualsTheScalarLoopBitForBit) {
                 static_cast<long>(std::floor(start.p.x[k + l] / start.g.h));
       in_row += kernels::simd::in_a_row(n0);
       in_pairs += kernels::simd::in_pairs(n0);
+      in_two += kernels::simd::layout(n0).kind == kernels::simd::kInTwo;
     }
     if (GetParam() == 1) EXPECT_GE(in_row, 10) << "groups in a row";
     else EXPECT_EQ(in_row, 0) << "groups in a row";
     if (GetParam() == 2) {
       EXPECT_GE(in_pairs, 10) << "groups two by two";
+    }
+    if (GetParam() == 3) {  // three and one, one and three: kInTwo
+      EXPECT_GE(in_two, 5) << "groups in two cells";
     }
   }
   const double dt = 1e-8, inv_rho = 1.0 / tungsten().rho;

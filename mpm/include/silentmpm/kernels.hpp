@@ -136,19 +136,42 @@ inline bool in_a_row(const long n0[4]) {
 inline bool in_pairs(const long n0[4]) {
   return n0[1] == n0[0] && n0[2] == n0[0] + 1 && n0[3] == n0[2];
 }
-// How four points' nodes lie: kInRow (in_a_row), kInPairs (in_pairs), else kScattered.
-constexpr int kScattered = 0, kInRow = 1, kInPairs = 2;
-inline int layout(const long n0[4]) {
-  return in_a_row(n0) ? kInRow : in_pairs(n0) ? kInPairs : kScattered;
+// How four points' first nodes lie, for the passes' reads: kInRow (in_a_row); kInPairs
+// (in_pairs); kInCell, all the same; kInTwo, each the first one's or the next (a row of particles
+// seeded at 9 per cell spans two cells unevenly), `upper` marking the lanes of the next; else
+// kScattered.
+constexpr int kScattered = 0, kInRow = 1, kInPairs = 2, kInCell = 3, kInTwo = 4;
+struct Layout {
+  int kind;
+  M4 upper;
+};
+inline Layout layout(const long n0[4]) {
+  if (in_a_row(n0)) return {kInRow, M4{}};
+  if (in_pairs(n0)) return {kInPairs, M4{}};
+  M4 up;
+  bool two = true, any = false;
+  for (int l = 0; l < 4; ++l) {
+    const long d = n0[l] - n0[0];
+    two = two && (d == 0 || d == 1);
+    any = any || d == 1;
+    up[l] = d == 1 ? -1 : 0;
+  }
+  return {!two ? kScattered : any ? kInTwo : kInCell, up};
 }
-// gather(a, n0, off), read as one load where layout(n0) (`lay`) allows: the same values.
-inline V4 gather(const double* a, const long n0[4], long off, int lay) {
-  if (lay == kInRow) return load(a + n0[0] + off);
-  if (lay == kInPairs) {
+// gather(a, n0, off), read as one load or two values where the layout allows: the same values.
+inline V4 gather(const double* a, const long n0[4], long off, const Layout& lay) {
+  if (lay.kind == kInRow) return load(a + n0[0] + off);
+  if (lay.kind == kInPairs) {
     using V2 = double __attribute__((vector_size(16)));
     V2 two;
     std::memcpy(&two, a + n0[0] + off, sizeof two);
     return __builtin_shufflevector(two, two, 0, 0, 1, 1);
+  }
+  if (lay.kind == kInCell || lay.kind == kInTwo) {
+    const double lo = a[n0[0] + off];
+    if (lay.kind == kInCell) return V4{lo, lo, lo, lo};
+    const double hi = a[n0[0] + 1 + off];
+    return lay.upper ? V4{hi, hi, hi, hi} : V4{lo, lo, lo, lo};
   }
   return gather(a, n0, off);
 }
@@ -631,8 +654,8 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     simd::prefetch_ahead(k, X, Y, M);
     simd::prefetch_ahead<1>(k, VX, VY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, nullptr, nullptr)) return k;
-    const int lay = simd::layout(n0);
-    const bool row = lay == simd::kInRow;
+    const simd::Layout lay = simd::layout(n0);
+    const bool row = lay.kind == simd::kInRow;
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
 #pragma GCC unroll 9
     for (int c = 0; c < K; ++c) {
@@ -769,7 +792,7 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
     V4 N[K], dNx[K], dNy[K];
     simd::prefetch_ahead<1>(k, X, Y, V, SXX, SYY, SZZ, SXY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
-    const int lay = simd::layout(n0);
+    const simd::Layout lay = simd::layout(n0);
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
 #pragma GCC unroll 9
     for (int c = 0; c < K; ++c) {
