@@ -158,11 +158,11 @@ inline Layout layout(const long n0[4]) {
   }
   return {!two ? kScattered : any ? kInTwo : kInCell, up};
 }
+using V2 = double __attribute__((vector_size(16)));
 // gather(a, n0, off), read as one load or two values where the layout allows: the same values.
 inline V4 gather(const double* a, const long n0[4], long off, const Layout& lay) {
   if (lay.kind == kInRow) return load(a + n0[0] + off);
   if (lay.kind == kInPairs) {
-    using V2 = double __attribute__((vector_size(16)));
     V2 two;
     std::memcpy(&two, a + n0[0] + off, sizeof two);
     return __builtin_shufflevector(two, two, 0, 0, 1, 1);
@@ -206,7 +206,6 @@ inline void add_row3(double* a, long n, const Third& third, const Second& second
 // the particles 1 and 3. right(s, j) adds pair j's terms at their right nodes (n + 1, n + 2),
 // left(s, j) at their left nodes (n, n + 1). At node n + 1 the right terms of particles 0 and 1
 // come before the left terms of 2 and 3: particle order at every node, the scalar loop's sums.
-using V2 = double __attribute__((vector_size(16)));
 inline V2 pair_of(V4 w, int j) {
   return j == 0 ? __builtin_shufflevector(w, w, 0, 2) : __builtin_shufflevector(w, w, 1, 3);
 }
@@ -219,6 +218,13 @@ inline void add_pairs(double* a, long n, const Right& right, const Left& left) {
   y = left(left(y, 0), 1);
   std::memcpy(a + n, &y, sizeof y);
   a[n + 2] = x[1];
+}
+// p2g's health flags for four particles (volumes v, masses m), as the scalar loop sets them.
+inline void check_volumes(V4 v, V4 m, double stretch_limit, bool& negative, bool& stretched) {
+  for (int l = 0; l < 4; ++l) {
+    negative |= std::signbit(v[l]);
+    stretched |= v[l] > stretch_limit * m[l];
+  }
 }
 // Four particles advance by dt (wx, wy) and their rows are tracked, as the scalar passes do.
 inline void move(double* X, double* Y, V4 wx, V4 wy, double dt, const Grid& g, RowSpan& rows) {
@@ -416,11 +422,8 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
       }
       if constexpr (kFo) {
         const V4 v = simd::load(V + k), sxx = simd::load(SXX + k), syy = simd::load(SYY + k),
-                 sxy = simd::load(SXY + k), mk = simd::load(M + k);
-        for (int l = 0; l < 4; ++l) {
-          negative |= std::signbit(v[l]);
-          stretched |= v[l] > stretch_limit * mk[l];
-        }
+                 sxy = simd::load(SXY + k);
+        simd::check_volumes(v, simd::load(M + k), stretch_limit, negative, stretched);
         V4 Tx[4], Ty[4];
         for (int a = 0; a < 4; ++a) {
           Tx[a] = sxx * dNx[a] + sxy * dNy[a];
@@ -513,11 +516,8 @@ inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, 
       }
       if constexpr ((WHAT & kForce) != 0) {
         const V4 v = simd::load(V + k), sxx = simd::load(SXX + k), syy = simd::load(SYY + k),
-                 sxy = simd::load(SXY + k), mk = simd::load(M + k);
-        for (int l = 0; l < 4; ++l) {
-          negative |= std::signbit(v[l]);
-          stretched |= v[l] > stretch_limit * mk[l];
-        }
+                 sxy = simd::load(SXY + k);
+        simd::check_volumes(v, simd::load(M + k), stretch_limit, negative, stretched);
         auto tx = [&](int a) { return [&, a](V4 t) { return t - v * (sxx * dNx[a] + sxy * dNy[a]); }; };
         auto ty = [&](int a) { return [&, a](V4 t) { return t - v * (sxy * dNx[a] + syy * dNy[a]); }; };
         for (int jj = 0; jj < 3; ++jj) {
@@ -679,14 +679,14 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     }
     if constexpr (REMAP) {
       const V4 mvx = mk * nvx, mvy = mk * nvy;
+      auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
       if (K == 4 && row) {  // bilinear: node a is 0 lower left, 1 lower right, 2 upper right, 3 upper left
         const long n = n0[0], nu = n + g.nnx;
-        simd::add_row(f.qx, n, [&](V4 t) { return t + mvx * N[1]; }, [&](V4 t) { return t + mvx * N[0]; });
-        simd::add_row(f.qx, nu, [&](V4 t) { return t + mvx * N[2]; }, [&](V4 t) { return t + mvx * N[3]; });
-        simd::add_row(f.qy, n, [&](V4 t) { return t + mvy * N[1]; }, [&](V4 t) { return t + mvy * N[0]; });
-        simd::add_row(f.qy, nu, [&](V4 t) { return t + mvy * N[2]; }, [&](V4 t) { return t + mvy * N[3]; });
+        simd::add_row(f.qx, n, term(mvx, 1), term(mvx, 0));
+        simd::add_row(f.qx, nu, term(mvx, 2), term(mvx, 3));
+        simd::add_row(f.qy, n, term(mvy, 1), term(mvy, 0));
+        simd::add_row(f.qy, nu, term(mvy, 2), term(mvy, 3));
       } else if (K == 9 && row) {  // the 3 x 3 shapes: node a = 3 jj + ii at n0 + jj nnx + ii
-        auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
         for (int jj = 0; jj < 3; ++jj) {
           const long n = n0[0] + jj * g.nnx;
           simd::add_row3(f.qx, n, term(mvx, 3 * jj + 2), term(mvx, 3 * jj + 1), term(mvx, 3 * jj));
