@@ -1802,41 +1802,63 @@ void Solver::consistent_dashpots() {
   // The consistent mass between the slots, row by row (the diagonal left out; in each row the
   // entries in the order their first particle met them, each summed in particle order):
   // (Mc)_ij = sum_p m_p N_ip N_jp. A row holds at most the slots a particle's stencil shares
-  // with it, kCmRow of them.
-  cm_cnt_.assign(ns, 0);
-  cm_col_.resize(kCmRow * ns);
-  cm_w_.resize(kCmRow * ns);
-  for (const std::uint32_t q : cm_hits_) {
-    const double* N = cm_pN_.data() + K * q;
-    const int* sls = cm_ps_.data() + K * q;
-    for (int a = 0; a < K; ++a) {
-      const int i = sls[a];
-      if (i < 0) continue;
-      int* col = cm_col_.data() + kCmRow * i;
-      double* w = cm_w_.data() + kCmRow * i;
-      for (int b = 0; b < K; ++b) {
-        const int j = sls[b];
-        if (j < 0 || j == i) continue;
-        int e = 0;
-        while (e < cm_cnt_[i] && col[e] != j) ++e;
-        if (e == cm_cnt_[i]) {
-          if (e == kCmRow) throw std::logic_error("consistent_dashpots: a row of more than 24 slots");
-          col[e] = j;
-          w[e] = 0;
-          ++cm_cnt_[i];
+  // with it, kCmRow of them. The rows' pattern (each entry's slot and place) follows from the
+  // hits' slots alone: when those are the last step's, so is the pattern, and the list of each
+  // product's place (cm_pair_, in the order the products are summed) is used again.
+  const std::size_t nh = cm_hits_.size();
+  cm_key_next_.resize(K * nh);
+  for (std::size_t t = 0; t < nh; ++t)
+    std::copy_n(cm_ps_.data() + K * cm_hits_[t], K, cm_key_next_.data() + K * t);
+  if (cm_key_next_ != cm_key_ || cm_cnt_.size() != ns) {
+    cm_key_.swap(cm_key_next_);
+    cm_pair_.clear();
+    cm_cnt_.assign(ns, 0);
+    cm_col_.resize(kCmRow * ns);
+    cm_w_.resize(kCmRow * ns);
+    for (std::size_t t = 0; t < nh; ++t) {
+      const int* sls = cm_key_.data() + K * t;
+      for (int a = 0; a < K; ++a) {
+        const int i = sls[a];
+        if (i < 0) continue;
+        int* ci = cm_col_.data() + kCmRow * i;
+        for (int b = 0; b < K; ++b) {
+          const int j = sls[b];
+          if (j < 0 || j == i) continue;
+          int e = 0;
+          while (e < cm_cnt_[i] && ci[e] != j) ++e;
+          if (e == cm_cnt_[i]) {
+            if (e == kCmRow) throw std::logic_error("consistent_dashpots: a row of more than 24 slots");
+            ci[e] = j;
+            ++cm_cnt_[i];
+          }
+          cm_pair_.push_back({kCmRow * i + e, static_cast<int>(t), a, b});
         }
-        w[e] += cm_pm_[q] * N[a] * N[b];
       }
     }
+  }
+  for (std::size_t i = 0; i < ns; ++i) std::fill_n(cm_w_.data() + kCmRow * i, cm_cnt_[i], 0.0);
+  for (const CmPair& c : cm_pair_) {
+    const std::uint32_t q = cm_hits_[c.hit];
+    const double* N = cm_pN_.data() + K * q;
+    cm_w_[c.place] += cm_pm_[q] * N[c.a] * N[c.b];
   }
   // Each slot's equation as an affine map, vbar = b - Q o (Q = P / (2 m), P the inverse of
   // I + kappa C on the free components, b = P (v + 1/2 Mc dv0 / m)), and its g = G vbar
   // (G = dt C / m on the free components); the start is the trapezoidal mean.
-  cm_node_.resize(kCmNode * ns);
-  std::vector<double> g(2 * ns), vb(2 * ns);
+  // By columns (kCmNode of nsp values: ns rounded up to whole blocks of four slots, the rest
+  // zero), vbar's x and y too; g as (x, y) pairs.
+  const std::size_t nsp = (ns + 3) / 4 * 4;
+  cm_node_.assign(kCmNode * nsp, 0.0);
+  cm_vb_.assign(2 * nsp, 0.0);
+  cm_o_.assign(2 * nsp, 0.0);
+  cm_g0_.assign(2 * nsp, 0.0);
+  double* vbx = cm_vb_.data();
+  double* vby = vbx + nsp;
+  double* ox = cm_o_.data();
+  double* oy = ox + nsp;
   for (std::size_t k = 0; k < ns; ++k) {
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
-    double* n = cm_node_.data() + kCmNode * k;
+    double* n = cm_node_.data() + k;  // n[nsp * c]: column c
     const double* c = cm_.data() + kCm * k;
     const int fi = static_cast<int>(r[kDnFlags]);  // a held component: fixed, or the closure's
     const double mi = r[kDnM], free_x = (fi & (1 | kDnHeldX)) ? 0.0 : 1.0,
@@ -1859,72 +1881,104 @@ void Solver::consistent_dashpots() {
     // A component the delayed closure holds keeps the mean of its start and its closure's
     // velocity (its Q row is zero: pxx = pxy = 0 there).
     n[0] = (fi & kDnHeldX) ? 0.5 * (r[kDnVx] + r[kDnUx]) : pxx * rx + pxy * ry;
-    n[1] = (fi & kDnHeldY) ? 0.5 * (r[kDnVy] + r[kDnUy]) : pxy * rx + pyy * ry;
+    n[nsp] = (fi & kDnHeldY) ? 0.5 * (r[kDnVy] + r[kDnUy]) : pxy * rx + pyy * ry;
     const double q = 0.5 / mi;
-    n[2] = q * pxx;
-    n[3] = q * pxy;
-    n[4] = q * pyy;
+    n[2 * nsp] = q * pxx;
+    n[3 * nsp] = q * pxy;
+    n[4 * nsp] = q * pyy;
     const double gs = DT / mi;
-    n[5] = free_x * gs;
-    n[6] = free_y * gs;
-    n[7] = cxx;
-    n[8] = cxy;
-    n[9] = cyy;
-    vb[2 * k] = 0.5 * (r[kDnVx] + r[kDnUx]);
-    vb[2 * k + 1] = 0.5 * (r[kDnVy] + r[kDnUy]);
-    g[2 * k] = n[5] * (cxx * vb[2 * k] + cxy * vb[2 * k + 1]);
-    g[2 * k + 1] = n[6] * (cxy * vb[2 * k] + cyy * vb[2 * k + 1]);
+    const double n5 = free_x * gs, n6 = free_y * gs;
+    n[5 * nsp] = n5;
+    n[6 * nsp] = n6;
+    n[7 * nsp] = cxx;
+    n[8 * nsp] = cxy;
+    n[9 * nsp] = cyy;
+    vbx[k] = 0.5 * (r[kDnVx] + r[kDnUx]);
+    vby[k] = 0.5 * (r[kDnVy] + r[kDnUy]);
+    cm_g0_[2 * k] = n5 * (cxx * vbx[k] + cxy * vby[k]);
+    cm_g0_[2 * k + 1] = n6 * (cxy * vbx[k] + cyy * vby[k]);
   }
-  // An iteration: each slot's o from g, then its vbar and its new g. Several ranks sum o over
-  // the halo between the two; on one process they are one pass, the new g written apart from
-  // the old (the same values in the same order). o's x and y go as a pair (one SIMD register,
-  // each lane the scalar multiply-adds).
+  // An iteration: each slot's o from g (o's x and y as a pair: one SIMD register, each lane the
+  // scalar multiply-adds), then (several ranks: o summed over the halo) every slot's vbar and its
+  // new g, four slots at a time, each lane the scalar arithmetic; the new g is written apart
+  // from the old. The largest change and vbar are the same whatever the order they are met in.
   using V2 = double __attribute__((vector_size(16)));
-  auto row_sum = [&](std::size_t k, const double* gg) {
-    const int* col = cm_col_.data() + kCmRow * k;
-    const double* w = cm_w_.data() + kCmRow * k;
-    V2 o = {0.0, 0.0};
-    for (int e = 0; e < cm_cnt_[k]; ++e) {
-      V2 gj;
-      std::memcpy(&gj, gg + 2 * col[e], sizeof(V2));
-      o += w[e] * gj;
+  using V4 = double __attribute__((vector_size(32)));
+  using M4 = long long __attribute__((vector_size(32)));
+  auto row_sums = [&](const double* gg) {
+    for (std::size_t k = 0; k < ns; ++k) {
+      const int* col = cm_col_.data() + kCmRow * k;
+      const double* w = cm_w_.data() + kCmRow * k;
+      V2 o = {0.0, 0.0};
+      for (int e = 0; e < cm_cnt_[k]; ++e) {
+        V2 gj;
+        std::memcpy(&gj, gg + 2 * col[e], sizeof(V2));
+        o += w[e] * gj;
+      }
+      ox[k] = o[0];
+      oy[k] = o[1];
     }
-    return o;
   };
-  auto update = [&](std::size_t k, double ox, double oy, double* gn, double& change, double& scale) {
-    const double* n = cm_node_.data() + kCmNode * k;
-    const double bx = n[0] - (n[2] * ox + n[3] * oy);
-    const double by = n[1] - (n[3] * ox + n[4] * oy);
-    change = std::max(change, std::max(std::abs(bx - vb[2 * k]), std::abs(by - vb[2 * k + 1])));
-    scale = std::max(scale, std::max(std::abs(bx), std::abs(by)));
-    vb[2 * k] = bx;
-    vb[2 * k + 1] = by;
-    gn[2 * k] = n[5] * (n[7] * bx + n[8] * by);
-    gn[2 * k + 1] = n[6] * (n[8] * bx + n[9] * by);
+  auto load = [](const double* a) {
+    V4 v;
+    std::memcpy(&v, a, sizeof v);
+    return v;
   };
-  if (!dist_) cm_g_.resize(2 * ns);
+  auto store = [](double* a, V4 v) { std::memcpy(a, &v, sizeof v); };
+  // std::max(a, b) and std::abs lane by lane: b where a < b, else a; the sign bit cleared.
+  auto vmax = [](V4 a, V4 b) {
+    const M4 lt = a < b;
+    return reinterpret_cast<V4>((reinterpret_cast<M4>(b) & lt) | (reinterpret_cast<M4>(a) & ~lt));
+  };
+  auto vabs = [](V4 a) {
+    const M4 mask = {~(1LL << 63), ~(1LL << 63), ~(1LL << 63), ~(1LL << 63)};
+    return reinterpret_cast<V4>(reinterpret_cast<M4>(a) & mask);
+  };
+  auto update = [&](double* gn, double& change, double& scale) {
+    const double* n = cm_node_.data();
+    V4 ch = {0, 0, 0, 0}, sc = {0, 0, 0, 0};
+    for (std::size_t k = 0; k < nsp; k += 4) {
+      const V4 o_x = load(ox + k), o_y = load(oy + k);
+      const V4 bx = load(n + k) - (load(n + 2 * nsp + k) * o_x + load(n + 3 * nsp + k) * o_y);
+      const V4 by = load(n + nsp + k) - (load(n + 3 * nsp + k) * o_x + load(n + 4 * nsp + k) * o_y);
+      ch = vmax(ch, vmax(vabs(bx - load(vbx + k)), vabs(by - load(vby + k))));
+      sc = vmax(sc, vmax(vabs(bx), vabs(by)));
+      store(vbx + k, bx);
+      store(vby + k, by);
+      const V4 n8 = load(n + 8 * nsp + k);
+      const V4 gx = load(n + 5 * nsp + k) * (load(n + 7 * nsp + k) * bx + n8 * by);
+      const V4 gy = load(n + 6 * nsp + k) * (n8 * bx + load(n + 9 * nsp + k) * by);
+      store(gn + 2 * k, __builtin_shufflevector(gx, gy, 0, 4, 1, 5));
+      store(gn + 2 * k + 4, __builtin_shufflevector(gx, gy, 2, 6, 3, 7));
+    }
+    for (int l = 0; l < 4; ++l) {
+      change = std::max(change, ch[l]);
+      scale = std::max(scale, sc[l]);
+    }
+  };
+  cm_g_.assign(2 * nsp, 0.0);
   int it = 0;
   for (;; ++it) {
     double change = 0, scale = 0;
+    row_sums(cm_g0_.data());
     if (dist_) {
       for (std::size_t k = 0; k < ns; ++k) {
-        const V2 o = row_sum(k, g.data());
-        cm_[kCm * k + 6] = o[0];
-        cm_[kCm * k + 7] = o[1];
+        cm_[kCm * k + 6] = ox[k];
+        cm_[kCm * k + 7] = oy[k];
       }
       cm_sum(6, 2);
-      for (std::size_t k = 0; k < ns; ++k)
-        update(k, cm_[kCm * k + 6], cm_[kCm * k + 7], g.data(), change, scale);
+      for (std::size_t k = 0; k < ns; ++k) {
+        ox[k] = cm_[kCm * k + 6];
+        oy[k] = cm_[kCm * k + 7];
+      }
+      update(cm_g0_.data(), change, scale);
       double v[2] = {change, scale};
       dist_->max(v, 2);
       change = v[0];
       scale = v[1];
     } else {
-      for (std::size_t k = 0; k < ns; ++k) {
-        const V2 o = row_sum(k, g.data());
-        update(k, o[0], o[1], cm_g_.data(), change, scale);
-      }
-      g.swap(cm_g_);
+      update(cm_g_.data(), change, scale);
+      cm_g0_.swap(cm_g_);
     }
     if (change <= 1e-13 * scale) break;
     if (it + 1 == kCmMaxIterations) {  // the last iterate stands; the run's summary counts it
@@ -1943,8 +1997,8 @@ void Solver::consistent_dashpots() {
   for (long k = 0; k < nsl; ++k) {
     const long i = cm_nodes_[k];
     double* c = cm_.data() + kCm * k;
-    c[4] = vb[2 * k];
-    c[5] = vb[2 * k + 1];
+    c[4] = vbx[k];
+    c[5] = vby[k];
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
     const int fi = static_cast<int>(r[kDnFlags]);
     const double fx = r[kDnFx] - r[kDnCxx] * c[4] - r[kDnCxy] * c[5];

@@ -302,8 +302,15 @@ class Solver {
   static constexpr int kCmRow = 24;     // the slots a row of the consistent mass can hold
   std::vector<int> cm_cnt_, cm_col_;    // the consistent mass between slots, kCmRow per row
   std::vector<double> cm_w_;
+  struct CmPair {
+    int place, hit, a, b;  // the entry kCmRow * row + its place; hit t's product N_a N_b
+  };
+  std::vector<CmPair> cm_pair_;         // the products in the order they are summed
+  std::vector<int> cm_key_, cm_key_next_;  // the hits' slots (K each) the pattern was made for
   static constexpr int kCmNode = 10;    // per slot: its equation (see consistent_dashpots)
-  std::vector<double> cm_node_;
+  std::vector<double> cm_node_;         // by columns
+  std::vector<double> cm_vb_, cm_o_;    // per slot: vbar and o, x's then y's (scratch)
+  std::vector<double> cm_g0_;           // 2 per slot: an iteration's g (scratch)
   static constexpr int kCm = 8;
   std::vector<double> cm_;              // per slot: kCm values (see consistent_dashpots)
   std::vector<double> cm_halo_;         // several ranks: grid-sized arrays for the halo sums
