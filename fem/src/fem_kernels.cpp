@@ -61,6 +61,9 @@ std::size_t Solver::nodes() const {
 std::size_t Solver::matrix_blocks() const { return impl_->col.size(); }
 std::size_t Solver::stored_blocks() const { return impl_->val.size() / 4; }
 bool Solver::rows_shared() const { return !impl_->row_val.empty(); }
+std::size_t Solver::row_groups() const {
+  return static_cast<std::size_t>(std::count(impl_->row4.begin(), impl_->row4.end(), 1));
+}
 std::size_t Solver::pml_cells() const {
   return impl_->part ? impl_->part->pml_cells.size() : impl_->pml.cell.size();
 }
@@ -117,6 +120,7 @@ std::vector<std::uint32_t> Solver::boundary_nodes(const std::vector<int>& curves
 
 namespace {
 using V2 = double __attribute__((vector_size(16)));  // two doubles, one SIMD register
+using V8 = double __attribute__((vector_size(64)));  // four nodes' (x, y)
 
 // The stiffness's rows (Impl's node-block CSR), read one at a time.
 struct Rows {
@@ -139,6 +143,25 @@ struct Rows {
       V2 c0, c1;
       std::memcpy(&c0, b, sizeof c0);
       std::memcpy(&c1, b + 2, sizeof c1);
+      acc += c0 * ux + c1 * uy;
+    }
+    return acc;
+  }
+  // Rows i .. i+3 of a group Impl::row4 marks (shared values): the four rows' (x, y) in one
+  // register, each lane the sums of times() (a block's u of the four rows is one run of u).
+  inline V8 times4(std::int64_t i, const double* __restrict u) const {
+    const double* __restrict row = kv + 4 * std::uint64_t{rv[i]};
+    const std::uint32_t* __restrict c = cl + rp[i];
+    const std::uint64_t n = rp[i + 1] - rp[i];
+    V8 acc = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    for (std::uint64_t k = 0; k < n; ++k) {
+      V8 w;
+      std::memcpy(&w, u + 2 * std::uint64_t{c[k]}, sizeof w);
+      const V8 ux = __builtin_shufflevector(w, w, 0, 0, 2, 2, 4, 4, 6, 6);
+      const V8 uy = __builtin_shufflevector(w, w, 1, 1, 3, 3, 5, 5, 7, 7);
+      const double* b = row + 4 * k;
+      const V8 c0 = {b[0], b[1], b[0], b[1], b[0], b[1], b[0], b[1]};
+      const V8 c1 = {b[2], b[3], b[2], b[3], b[2], b[3], b[2], b[3]};
       acc += c0 * ux + c1 * uy;
     }
     return acc;
@@ -486,14 +509,49 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
   double* __restrict un = m.u_next.data();
   double* __restrict f = m.ku.data();
   double work = 0, absorbed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
-    if (parallel)
-  for (std::int64_t r = 0; r < n; ++r) {
-    const std::int64_t i = LIST ? list[r] : r;
-    const V2 acc = K.times<SHARED>(i, u);
-    f[2 * i] = -acc[0];
-    f[2 * i + 1] = -acc[1];
-    node(i, -acc[0], -acc[1], f_ext, u, un, work, absorbed);
+  // Each thread the rows a static schedule would give it, in order (the same sums of work and
+  // absorbed energy per thread).
+#pragma omp parallel reduction(+ : work, absorbed) num_threads(m.threads) if (parallel)
+  {
+    const std::int64_t nt = omp_get_num_threads(), t = omp_get_thread_num();
+    const std::int64_t q = n / nt, rest = n % nt;
+    const std::int64_t r0 = t * q + std::min(t, rest), r1 = r0 + q + (t < rest ? 1 : 0);
+    auto one = [&](std::int64_t i, V2 acc) {
+      f[2 * i] = -acc[0];
+      f[2 * i + 1] = -acc[1];
+      node(i, -acc[0], -acc[1], f_ext, u, un, work, absorbed);
+    };
+    // Rows one at a time; where Impl::row4 marks a group of four (4g .. 4g+3; not with a list
+    // of rows), the group at once, its arrays fetched kAhead rows ahead (the many streams of
+    // the pass leave the hardware's prefetchers behind).
+    constexpr std::int64_t kAhead = 32;
+    const std::uint8_t* row4 = !LIST && SHARED && !m.row4.empty() ? m.row4.data() : nullptr;
+    for (std::int64_t r = r0; r < r1;) {
+      if (row4 && r % 4 == 0 && r + 4 <= r1 && row4[r / 4]) {
+        if (r + kAhead < r1) {
+          const std::int64_t a = r + kAhead;
+          __builtin_prefetch(u + 2 * a);
+          __builtin_prefetch(un + 2 * a, 1);
+          __builtin_prefetch(f + 2 * a, 1);
+          __builtin_prefetch(node.v + 2 * a, 1);
+          __builtin_prefetch(f_ext + 2 * a);
+          __builtin_prefetch(K.cl + K.rp[a]);
+          __builtin_prefetch(K.cl + K.rp[a] + 16);
+          if (a % 8 == 0) {
+            __builtin_prefetch(node.im + a);
+            __builtin_prefetch(node.ms + a);
+            __builtin_prefetch(node.dn + a);
+          }
+        }
+        const V8 acc = K.times4(r, u);
+        for (int j = 0; j < 4; ++j) one(r + j, V2{acc[2 * j], acc[2 * j + 1]});
+        r += 4;
+        continue;
+      }
+      const std::int64_t i = LIST ? list[r] : r;
+      one(i, K.times<SHARED>(i, u));
+      ++r;
+    }
   }
   m.u.swap(m.u_next);
   work_out += work;

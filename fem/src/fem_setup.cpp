@@ -344,6 +344,18 @@ void share_equal_rows(Solver::Impl& m) {
   }
   m.row_val = std::move(row_val);
   m.val = std::move(kinds);
+  m.row4.assign(nn / 4, 0);
+  for (std::size_t g = 0; g < nn / 4; ++g) {
+    const std::size_t i = 4 * g;
+    const std::uint64_t n = m.rowptr[i + 1] - m.rowptr[i];
+    bool same = true;
+    for (std::size_t j = 1; j < 4 && same; ++j) {
+      same = m.rowptr[i + j + 1] - m.rowptr[i + j] == n && m.row_val[i + j] == m.row_val[i];
+      for (std::uint64_t k = 0; k < n && same; ++k)
+        same = m.col[m.rowptr[i + j] + k] == m.col[m.rowptr[i] + k] + j;
+    }
+    m.row4[g] = same ? 1 : 0;
+  }
 }
 
 }  // namespace

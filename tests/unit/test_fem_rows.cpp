@@ -8,7 +8,8 @@
 //     patch test: within 1e-10 of the largest force it gives on the boundary, the traction of
 //     that uniform strain).
 // On a mesh whose rows are nearly all different nothing is shared.
-// fem::Solver::step makes one pass over the rows (-K u and the nodal update together); it equals,
+// fem::Solver::step makes one pass over the rows (-K u and the nodal update together; Q1's rows
+// of consecutive nodes mostly four at a time, reaching half the nodes so at least); it equals,
 // bit for bit, the two passes the hybrid makes (internal_force, then advance_free_nodes): u, v
 // and the booked work and absorbed energy (on two threads within 1e-14: the sums' order), with a traction, LK dashpots, Kelvin-Voigt springs, a
 // PML, a damping band with a stiffness part and gravity, Q1 and Q2, on one and two threads.
@@ -111,6 +112,12 @@ TEST(FemRows, OnePassStepEqualsForceThenUpdate) {
         return s;
       };
       fem::Solver one(spec()), two(spec());
+      // Q1: most rows go four at a time (step's groups; internal_force takes rows one by one).
+      const std::size_t groups = one.row_groups();
+      std::printf("  Q%d: %zu groups of four rows of %zu nodes\n", degree, groups, one.nodes());
+      if (degree == 1) {
+        EXPECT_GE(4 * groups, one.nodes() / 2);
+      }
       const double dt = 0.4 * one.critical_dt();
       one.set_dt(dt);
       two.set_dt(dt);

@@ -160,6 +160,10 @@ class Solver {
   // offset to its kind's values, rows_shared() true).
   std::size_t stored_blocks() const;
   bool rows_shared() const;
+  // With shared rows: the groups of four consecutive rows (4g .. 4g+3) that share one row of
+  // values and whose columns are the first's shifted by their place (consecutive nodes of a
+  // structured mesh); step() takes each such group at once.
+  std::size_t row_groups() const;
   // The perfectly matched layers' cells (this rank's), and those whose forces take the
   // tensor-product form (Spec::pml_tensor; known once the solver has stepped, 0 before).
   std::size_t pml_cells() const;
