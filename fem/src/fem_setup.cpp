@@ -356,6 +356,7 @@ void share_equal_rows(Solver::Impl& m) {
     }
     m.row4[g] = same ? 1 : 0;
   }
+  if (std::count(m.row4.begin(), m.row4.end(), 1) == 0) m.row4.clear();
 }
 
 }  // namespace
