@@ -462,12 +462,44 @@ struct NodeUpdate {
       absorbed += dt * (bx * (c.cxx * bx + c.cxy * by) + by * (c.cxy * bx + c.cyy * by) -
                         px * bx - py * by);
     }
-    work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
-    if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
+    book(i, f_ext, vx0, vy0, vx, vy, work);
     v[2 * i] = vx;
     v[2 * i + 1] = vy;
     u_out[2 * i] = u_in[2 * i] + dt * vx;
     u_out[2 * i + 1] = u_in[2 * i + 1] + dt * vy;
+  }
+  // The work of node i's loads and gravity over the step, the velocity going from v0 to v.
+  inline void book(std::int64_t i, const double* __restrict f_ext, double vx0, double vy0,
+                   double vx, double vy, double& work) const {
+    work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
+    if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
+  }
+  // Whether nodes i .. i+3 are all free and without a dashpot (four() applies).
+  inline bool plain4(std::int64_t i) const {
+    std::uint32_t fixed;
+    std::memcpy(&fixed, mask + i, sizeof fixed);
+    return fixed == 0 && (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0;
+  }
+  // operator() on nodes i .. i+3 at once (plain4), their (x, y) in one register, each lane the
+  // single node's arithmetic; K u's part of their forces is -ku.
+  inline void four(std::int64_t i, V8 f_int, const double* __restrict f_ext, const double* u_in,
+                   double* u_out, double& work) const {
+    V8 fe, v0, ui;
+    std::memcpy(&fe, f_ext + 2 * i, sizeof fe);
+    std::memcpy(&v0, v + 2 * i, sizeof v0);
+    std::memcpy(&ui, u_in + 2 * i, sizeof ui);
+    V8 f = f_int + fe;
+    if (gravity) {
+      const V8 m = {ms[i], ms[i], ms[i + 1], ms[i + 1], ms[i + 2], ms[i + 2], ms[i + 3], ms[i + 3]};
+      const V8 g = {gx, gy, gx, gy, gx, gy, gx, gy};
+      f += m * g;
+    }
+    const V8 w = {im[i], im[i], im[i + 1], im[i + 1], im[i + 2], im[i + 2], im[i + 3], im[i + 3]};
+    const V8 vn = v0 + dt * f * w;
+    for (int j = 0; j < 4; ++j) book(i + j, f_ext, v0[2 * j], v0[2 * j + 1], vn[2 * j], vn[2 * j + 1], work);
+    const V8 un = ui + dt * vn;
+    std::memcpy(v + 2 * i, &vn, sizeof vn);
+    std::memcpy(u_out + 2 * i, &un, sizeof un);
   }
 };
 
@@ -544,7 +576,13 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
           }
         }
         const V8 acc = K.times4(r, u);
-        for (int j = 0; j < 4; ++j) one(r + j, V2{acc[2 * j], acc[2 * j + 1]});
+        if (node.plain4(r)) {
+          const V8 fi = -acc;
+          std::memcpy(f + 2 * r, &fi, sizeof fi);
+          node.four(r, fi, f_ext, u, un, work);
+        } else {
+          for (int j = 0; j < 4; ++j) one(r + j, V2{acc[2 * j], acc[2 * j + 1]});
+        }
         r += 4;
         continue;
       }
