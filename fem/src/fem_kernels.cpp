@@ -603,10 +603,10 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
       one(i, K.times<SHARED>(i, u));
       ++r;
     }
-  }
 #ifdef __SSE2__
-  _mm_sfence();  // the streamed stores before anything reads them
+    _mm_sfence();  // this thread's streamed stores before the others (or the next pass) read them
 #endif
+  }
   m.u.swap(m.u_next);
   work_out += work;
   absorbed_out += absorbed;
