@@ -554,58 +554,69 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
   double* __restrict un = m.u_next.data();
   double* __restrict f = m.ku.data();
   double work = 0, absorbed = 0;
-  // Each thread the rows a static schedule would give it, in order (the same sums of work and
-  // absorbed energy per thread).
-#pragma omp parallel reduction(+ : work, absorbed) num_threads(m.threads) if (parallel)
-  {
-    const std::int64_t nt = omp_get_num_threads(), t = omp_get_thread_num();
-    const std::int64_t q = n / nt, rest = n % nt;
-    const std::int64_t r0 = t * q + std::min(t, rest), r1 = r0 + q + (t < rest ? 1 : 0);
-    auto one = [&](std::int64_t i, V2 acc) {
+  const std::uint8_t* row4 = !LIST && SHARED && !m.row4.empty() ? m.row4.data() : nullptr;
+  if (!row4) {  // row by row
+#pragma omp parallel for schedule(static) reduction(+ : work, absorbed) num_threads(m.threads) \
+    if (parallel)
+    for (std::int64_t r = 0; r < n; ++r) {
+      const std::int64_t i = LIST ? list[r] : r;
+      const V2 acc = K.times<SHARED>(i, u);
       f[2 * i] = -acc[0];
       f[2 * i + 1] = -acc[1];
       node(i, -acc[0], -acc[1], f_ext, u, un, work, absorbed);
-    };
-    // Rows one at a time; where Impl::row4 marks a group of four (4g .. 4g+3; not with a list
-    // of rows), the group at once, its arrays fetched kAhead rows ahead (the many streams of
-    // the pass leave the hardware's prefetchers behind).
-    constexpr std::int64_t kAhead = 32;
-    const std::uint8_t* row4 = !LIST && SHARED && !m.row4.empty() ? m.row4.data() : nullptr;
-    for (std::int64_t r = r0; r < r1;) {
-      if (row4 && r % 4 == 0 && r + 4 <= r1 && row4[r / 4]) {
-        if (r + kAhead < r1) {
-          const std::int64_t a = r + kAhead;
-          __builtin_prefetch(u + 2 * a);
-          __builtin_prefetch(un + 2 * a, 1);
-          __builtin_prefetch(f + 2 * a, 1);
-          __builtin_prefetch(node.v + 2 * a, 1);
-          __builtin_prefetch(f_ext + 2 * a);
-          __builtin_prefetch(K.cl + K.rp[a]);
-          __builtin_prefetch(K.cl + K.rp[a] + 16);
-          if (a % 8 == 0) {
-            __builtin_prefetch(node.im + a);
-            __builtin_prefetch(node.ms + a);
-            __builtin_prefetch(node.dn + a);
-          }
-        }
-        const V8 acc = K.times4(r, u);
-        if (node.plain4(r)) {
-          const V8 fi = -acc;
-          stream(f + 2 * r, fi);
-          node.four(r, fi, f_ext, u, un, work);
-        } else {
-          for (int j = 0; j < 4; ++j) one(r + j, V2{acc[2 * j], acc[2 * j + 1]});
-        }
-        r += 4;
-        continue;
-      }
-      const std::int64_t i = LIST ? list[r] : r;
-      one(i, K.times<SHARED>(i, u));
-      ++r;
     }
+  } else {
+    // Each thread the rows a static schedule would give it, in order (the same sums of work and
+    // absorbed energy per thread).
+#pragma omp parallel reduction(+ : work, absorbed) num_threads(m.threads) if (parallel)
+    {
+      const std::int64_t nt = omp_get_num_threads(), t = omp_get_thread_num();
+      const std::int64_t q = n / nt, rest = n % nt;
+      const std::int64_t r0 = t * q + std::min(t, rest), r1 = r0 + q + (t < rest ? 1 : 0);
+      auto one = [&](std::int64_t i, V2 acc) {
+        f[2 * i] = -acc[0];
+        f[2 * i + 1] = -acc[1];
+        node(i, -acc[0], -acc[1], f_ext, u, un, work, absorbed);
+      };
+      // Rows one at a time; where Impl::row4 marks a group of four (4g .. 4g+3), the group at
+      // once, its arrays fetched kAhead rows ahead (the many streams of the pass leave the
+      // hardware's prefetchers behind).
+      constexpr std::int64_t kAhead = 32;
+      for (std::int64_t r = r0; r < r1;) {
+        if (r % 4 == 0 && r + 4 <= r1 && row4[r / 4]) {
+          if (r + kAhead < r1) {
+            const std::int64_t a = r + kAhead;
+            __builtin_prefetch(u + 2 * a);
+            __builtin_prefetch(un + 2 * a, 1);
+            __builtin_prefetch(f + 2 * a, 1);
+            __builtin_prefetch(node.v + 2 * a, 1);
+            __builtin_prefetch(f_ext + 2 * a);
+            __builtin_prefetch(K.cl + K.rp[a]);
+            __builtin_prefetch(K.cl + K.rp[a] + 16);
+            if (a % 8 == 0) {
+              __builtin_prefetch(node.im + a);
+              __builtin_prefetch(node.ms + a);
+              __builtin_prefetch(node.dn + a);
+            }
+          }
+          const V8 acc = K.times4(r, u);
+          if (node.plain4(r)) {
+            const V8 fi = -acc;
+            stream(f + 2 * r, fi);
+            node.four(r, fi, f_ext, u, un, work);
+          } else {
+            for (int j = 0; j < 4; ++j) one(r + j, V2{acc[2 * j], acc[2 * j + 1]});
+          }
+          r += 4;
+          continue;
+        }
+        one(r, K.times<SHARED>(r, u));
+        ++r;
+      }
 #ifdef __SSE2__
-    _mm_sfence();  // this thread's streamed stores before the others (or the next pass) read them
+      _mm_sfence();  // this thread's streamed stores before anything else reads them
 #endif
+    }
   }
   m.u.swap(m.u_next);
   work_out += work;
