@@ -130,6 +130,13 @@ struct Solver::Impl {
 
   double crit_dt = 0;
   bool ku_valid = false;  // ku holds K u for the current u
+  // The step's groups of four rows (row4) store the new displacement and -K u streaming (not
+  // reading the lines first) or plainly: -1 while the first steps time both ways (a pass of at
+  // least kStreamTrialBytes; a smaller one, whose arrays the cache may hold, stores plainly),
+  // then 0 plain, 1 streaming (fem_kernels.cpp, Solver::step).
+  int stream_mode = -1;
+  int stream_trial = 0;
+  double stream_time[2][4] = {};
 
   // Probes: shape values and gradients of the dofs of every cell containing the point (a point on
   // a cell edge or node belongs to 2 or 4 cells; their stresses are averaged).

@@ -16,6 +16,9 @@ namespace {
 // Loops over fewer items than this run on one thread: below it the fork/join of a parallel region
 // costs more than it saves (and far more on an oversubscribed machine).
 constexpr std::int64_t kParallelMinimum = 40000;
+// The least bytes a step's pass over the rows moves for its stores to be timed both ways (see
+// Solver::step): a pass that the cache may hold keeps plain stores.
+constexpr double kStreamTrialBytes = 32e6;
 
 std::string fmt(double v) {
   char b[40];
@@ -427,11 +430,11 @@ void pml_forces(Solver::Impl& m, double dt) {
 // One node's explicit update: v+ = v + dt f / m, the trapezoidal solve at a node with a dashpot
 // block (dashpot.hpp), constraints; then u_out = u_in + dt v+ (u_out may be u_in). Adds the
 // work of f_ext (with the mid-step velocity) and the energy the dashpots absorb.
-// Stores a node group's 64 bytes without reading their cache lines first (the stores of the
-// next group complete a line the group's last store began).
-inline void stream(double* a, V8 x) {
+// Stores a node group's 64 bytes; with `streaming`, without reading their cache lines first (the
+// stores of the next group complete a line the group's last store began).
+inline void stream(double* a, V8 x, bool streaming) {
 #ifdef __SSE2__
-  if ((reinterpret_cast<std::uintptr_t>(a) & 15) == 0) {
+  if (streaming && (reinterpret_cast<std::uintptr_t>(a) & 15) == 0) {
     for (int k = 0; k < 4; ++k) _mm_stream_pd(a + 2 * k, __m128d{x[2 * k], x[2 * k + 1]});
     return;
   }
@@ -487,16 +490,12 @@ struct NodeUpdate {
     work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
     if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
   }
-  // Whether nodes i .. i+3 are all free and without a dashpot (four() applies).
-  inline bool plain4(std::int64_t i) const {
-    std::uint32_t fixed;
-    std::memcpy(&fixed, mask + i, sizeof fixed);
-    return fixed == 0 && (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0;
-  }
-  // operator() on nodes i .. i+3 at once (plain4), their (x, y) in one register, each lane the
-  // single node's arithmetic; K u's part of their forces is -ku.
+  // operator() on nodes i .. i+3 (f_int their internal forces, u_out not u_in): their (x, y)
+  // in one register, each lane the single node's arithmetic for a free node without a dashpot;
+  // a node with either takes operator() itself, in its place among the four (the work and the
+  // absorbed energy booked in the nodes' order), and its lanes then hold what it wrote.
   inline void four(std::int64_t i, V8 f_int, const double* __restrict f_ext, const double* u_in,
-                   double* u_out, double& work) const {
+                   double* u_out, double& work, double& absorbed, bool streaming) const {
     V8 fe, v0, ui;
     std::memcpy(&fe, f_ext + 2 * i, sizeof fe);
     std::memcpy(&v0, v + 2 * i, sizeof v0);
@@ -508,11 +507,22 @@ struct NodeUpdate {
       f += m * g;
     }
     const V8 w = {im[i], im[i], im[i + 1], im[i + 1], im[i + 2], im[i + 2], im[i + 3], im[i + 3]};
-    const V8 vn = v0 + dt * f * w;
-    for (int j = 0; j < 4; ++j) book(i + j, f_ext, v0[2 * j], v0[2 * j + 1], vn[2 * j], vn[2 * j + 1], work);
-    const V8 un = ui + dt * vn;
+    V8 vn = v0 + dt * f * w;
+    V8 un = ui + dt * vn;
+    for (int j = 0; j < 4; ++j) {
+      const std::int64_t k = i + j;
+      if (mask[k] == 0 && dn[k] < 0) {
+        book(k, f_ext, v0[2 * j], v0[2 * j + 1], vn[2 * j], vn[2 * j + 1], work);
+        continue;
+      }
+      (*this)(k, f_int[2 * j], f_int[2 * j + 1], f_ext, u_in, u_out, work, absorbed);
+      vn[2 * j] = v[2 * k];
+      vn[2 * j + 1] = v[2 * k + 1];
+      un[2 * j] = u_out[2 * k];
+      un[2 * j + 1] = u_out[2 * k + 1];
+    }
     std::memcpy(v + 2 * i, &vn, sizeof vn);
-    stream(u_out + 2 * i, un);
+    stream(u_out + 2 * i, un, streaming);
   }
 };
 
@@ -546,7 +556,7 @@ void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n
 template <bool LIST, bool SHARED>
 void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
                    const double* __restrict f_ext, double dt, bool parallel, double& work_out,
-                   double& absorbed_out) {
+                   double& absorbed_out, bool streaming) {
   const Rows K(m);
   const NodeUpdate node(m, dt);
   if (m.u_next.size() != m.u.size()) m.u_next.assign(m.u.size(), 0.0);
@@ -599,14 +609,9 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
               __builtin_prefetch(node.dn + a);
             }
           }
-          const V8 acc = K.times4(r, u);
-          if (node.plain4(r)) {
-            const V8 fi = -acc;
-            stream(f + 2 * r, fi);
-            node.four(r, fi, f_ext, u, un, work);
-          } else {
-            for (int j = 0; j < 4; ++j) one(r + j, V2{acc[2 * j], acc[2 * j + 1]});
-          }
+          const V8 fi = -K.times4(r, u);
+          stream(f + 2 * r, fi, streaming);
+          node.four(r, fi, f_ext, u, un, work, absorbed, streaming);
           r += 4;
           continue;
         }
@@ -614,7 +619,7 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
         ++r;
       }
 #ifdef __SSE2__
-      _mm_sfence();  // this thread's streamed stores before anything else reads them
+      if (streaming) _mm_sfence();  // this thread's streamed stores before anything reads them
 #endif
     }
   }
@@ -688,10 +693,27 @@ void Solver::step() {
   const bool parallel = rows >= kParallelMinimum;
   double& work = m.part ? m.part->work : energy.external_work;
   double& absorbed = m.part ? m.part->absorbed : energy.absorbed;
-  if (own && shared) fused_step_on<true, true>(m, own, rows, m.fext.data(), dt, parallel, work, absorbed);
-  else if (own) fused_step_on<true, false>(m, own, rows, m.fext.data(), dt, parallel, work, absorbed);
-  else if (shared) fused_step_on<false, true>(m, nullptr, rows, m.fext.data(), dt, parallel, work, absorbed);
-  else fused_step_on<false, false>(m, nullptr, rows, m.fext.data(), dt, parallel, work, absorbed);
+  // Streaming stores or plain ones: the first twelve steps of a large pass (by the bench's count
+  // of its bytes, about 156 a node) take each way three steps at a time, twice, and keep the
+  // faster by its fastest step (the first of each three, which follows the other way's, not
+  // counted).
+  if (m.stream_mode < 0 && (m.row4.empty() || 156.0 * rows < kStreamTrialBytes)) m.stream_mode = 0;
+  const bool streaming = m.stream_mode == 1 || (m.stream_mode < 0 && (m.stream_trial / 3) % 2 == 1);
+  const double start = m.stream_mode < 0 ? omp_get_wtime() : 0.0;
+  const double* fe = m.fext.data();
+  if (own && shared) fused_step_on<true, true>(m, own, rows, fe, dt, parallel, work, absorbed, streaming);
+  else if (own) fused_step_on<true, false>(m, own, rows, fe, dt, parallel, work, absorbed, streaming);
+  else if (shared) fused_step_on<false, true>(m, nullptr, rows, fe, dt, parallel, work, absorbed, streaming);
+  else fused_step_on<false, false>(m, nullptr, rows, fe, dt, parallel, work, absorbed, streaming);
+  if (m.stream_mode < 0) {
+    const int k = m.stream_trial;
+    if (k % 3 != 0) m.stream_time[(k / 3) % 2][2 * (k / 6) + k % 3 - 1] = omp_get_wtime() - start;
+    if (++m.stream_trial == 12) {
+      const double plain = *std::min_element(m.stream_time[0], m.stream_time[0] + 4);
+      const double streamed = *std::min_element(m.stream_time[1], m.stream_time[1] + 4);
+      m.stream_mode = streamed < 0.98 * plain ? 1 : 0;
+    }
+  }
   if (m.part) exchange_ghosts(m);
   t += dt;
   ++steps;
