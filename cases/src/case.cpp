@@ -1350,11 +1350,11 @@ class Builder {
                                     "unshifted layer; put LK behind it), or give the body "
                                     "\"particles_per_cell\": 4, or use scheme.update \"USL\" "
                                     "(docs/physics.md section 9.3)";
-        const double h = s_->grid.h;
+        const double h = grid_.h;
         if (!(band.width >= kPmlOnePpcCells * h * (1 - 1e-9)))
           o.fail("width", why + "width >= " + std::to_string(kPmlOnePpcCells) + " cells (" +
                               fmt(kPmlOnePpcCells * h) + " m), got " + fmt(band.width) + or_else);
-        const double cd = s_->materials[static_cast<std::size_t>(b.material)].cd;
+        const double cd = materials_[static_cast<std::size_t>(b.material)].cd;
         const double need = pml_one_ppc_alpha(cd, band.r0, band.power, band.width, h);
         if (auto_alpha) band.alpha = need;
         if (!(band.alpha >= need))

@@ -102,3 +102,41 @@ TEST(FilmCase, KeysAreReadAndValidated) {
             std::string::npos)
       << error_of(d);
 }
+
+// A particle PML under MUSL at 1 ppc in the film (a body seeded from a gmsh surface, whose
+// boundaries are read before the grid and the materials reach the solver): the 10-cell layer
+// (1 um of 0.1 um cells) passes the width check and is asked for its frequency shift, with the
+// shift the substrate's own c_d and the case's cell give (it had been checked against cells of
+// 1 m and read the solver's still empty materials); "auto" builds.
+TEST(FilmCase, PmlUnderMuslAtOnePpcChecksWithTheCasesCell) {
+  std::ifstream f(case_path("pml"));
+  nlohmann::json d = nlohmann::json::parse(f);
+  d["geometry"]["file"] =
+      (case_path("pml").parent_path() / d["geometry"]["file"].get<std::string>()).string();
+  d["scheme"]["update"] = "MUSL";
+  nlohmann::json* pml = nullptr;
+  for (auto& b : d["boundaries"])
+    if (b["type"] == "pml") pml = &b;
+  ASSERT_NE(pml, nullptr);
+  ASSERT_DOUBLE_EQ((*pml)["width"].get<double>(), 10 * d["grid"]["cell"].get<double>());
+  const std::string e = error_of(d);
+  EXPECT_NE(e.find(".alpha: a pml on particles under scheme.update \"MUSL\" at 1 particle per "
+                   "cell (body \"substrate\") needs alpha >= 0.04 sqrt(d0 c_d / h) = "),
+            std::string::npos)
+      << e;
+  // "auto" takes 0.04 sqrt(d0 c_d / h), d0 = 3 c_d ln(1 / r0) / (2 width), with the
+  // substrate's c_d and the case's cell (1e-7 m): 3.07e9 1/s here.
+  (*pml)["alpha"] = "auto";
+  Case c = build_case(d, "film.json");
+  ASSERT_TRUE(c.solver);
+  const Solver& s = *c.solver;
+  double cd = 0;
+  for (const Material& m : s.materials)
+    if (m.name == "silicon") cd = m.cd;
+  ASSERT_GT(cd, 0.0);
+  const double want = pml_one_ppc_alpha(cd, (*pml)["r0"].get<double>(), 2.0,
+                                        (*pml)["width"].get<double>(), s.grid.h);
+  EXPECT_DOUBLE_EQ(s.grid.h, 1e-7);
+  EXPECT_NEAR(s.pml.alpha, want, 1e-12 * want);
+  EXPECT_GT(want, 1e9);
+}
