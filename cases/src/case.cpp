@@ -1483,7 +1483,7 @@ class Builder {
         const double off = std::abs(e - std::round(e));
         need(off <= 1e-6, "needs the edge on a grid line (the edge at " + at + " lies " + fmt(off) +
                               " of a cell off one)");
-        need(s_->materials[P.group[k]].cs > 0, "needs a material with a shear wave speed (" + at +
+        need(materials_[P.group[k]].cs > 0, "needs a material with a shear wave speed (" + at +
                                                    " has none)");
         // The blocks exactly on the axes (the closure runs where C_xy is 0).
         sb.layer.nx[q] = along_x ? std::copysign(1.0, nx) : 0.0;
