@@ -1810,13 +1810,13 @@ void Solver::consistent_dashpots() {
   for (std::size_t t = 0; t < nh; ++t)
     std::copy_n(cm_ps_.data() + K * cm_hits_[t], K, cm_key_next_.data() + K * t);
   if (cm_key_next_ != cm_key_ || cm_cnt_.size() != ns) {
-    cm_key_.swap(cm_key_next_);
+    cm_key_.clear();  // (no pattern, should the build below throw)
     cm_pair_.clear();
     cm_cnt_.assign(ns, 0);
     cm_col_.resize(kCmRow * ns);
     cm_w_.resize(kCmRow * ns);
     for (std::size_t t = 0; t < nh; ++t) {
-      const int* sls = cm_key_.data() + K * t;
+      const int* sls = cm_key_next_.data() + K * t;
       for (int a = 0; a < K; ++a) {
         const int i = sls[a];
         if (i < 0) continue;
@@ -1835,6 +1835,7 @@ void Solver::consistent_dashpots() {
         }
       }
     }
+    cm_key_.swap(cm_key_next_);
   }
   for (std::size_t i = 0; i < ns; ++i) std::fill_n(cm_w_.data() + kCmRow * i, cm_cnt_[i], 0.0);
   for (const CmPair& c : cm_pair_) {

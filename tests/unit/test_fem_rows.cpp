@@ -12,7 +12,9 @@
 // of consecutive nodes mostly four at a time, reaching half the nodes so at least); it equals,
 // bit for bit, the two passes the hybrid makes (internal_force, then advance_free_nodes): u, v
 // and the booked work and absorbed energy (on two threads within 1e-14: the sums' order), with a traction, LK dashpots, Kelvin-Voigt springs, a
-// PML, a damping band with a stiffness part and gravity, Q1 and Q2, on one and two threads.
+// PML, a damping band with a stiffness part and gravity, Q1 and Q2, on one and two threads;
+// and above the size from which it runs on several threads, with the groups of four rows, the
+// work and absorbed energy too (the threads take the rows of a static schedule).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -145,6 +147,47 @@ TEST(FemRows, OnePassStepEqualsForceThenUpdate) {
       EXPECT_GT(umax, 0.0);  // the pulse is in
       EXPECT_GT(absorbed, 0.0);
     }
+}
+
+// Above the size from which the step runs on several threads (40 000 rows), step()'s threads
+// take the rows a static schedule gives them, as advance_free_nodes does: on two threads the
+// work and the absorbed energy are the same sums, to the bit, with the groups of four rows (and
+// LK dashpots among them) on.
+TEST(FemRows, GroupsOnTwoThreadsBookAsTheRowLoop) {
+  auto spec = [] {
+    fem::Spec s = steel_rectangle("two_thread_rect", 210, 200, 1);
+    s.threads = 2;
+    s.gravity_y = -9.81;
+    fem::Boundary load = bc(fem::Boundary::Kind::Traction, 14, "load");
+    load.normal = -1e8;
+    load.fn = sin2_bell(2e-6);
+    s.boundaries = {load, bc(fem::Boundary::Kind::Dashpot, 11, "lk"),
+                    bc(fem::Boundary::Kind::Dashpot, 12, "lk_side")};
+    return s;
+  };
+  fem::Solver one(spec()), two(spec());
+  ASSERT_GE(one.nodes(), 40000u);
+  EXPECT_GE(4 * one.row_groups(), one.nodes() / 2);
+  const double dt = 0.4 * one.critical_dt();
+  one.set_dt(dt);
+  two.set_dt(dt);
+  const std::vector<std::int64_t> skip(two.nodes(), -1);
+  std::vector<double> f_int(two.dofs()), f_ext(two.dofs(), 0.0);
+  double work = 0, absorbed = 0;
+  for (int k = 0; k < 40; ++k) {
+    one.step();
+    two.internal_force(two.displacement().data(), f_int.data());
+    two.refresh_external_force(two.t, f_ext.data());
+    two.advance_free_nodes(skip.data(), f_int.data(), f_ext.data(), dt, work, absorbed);
+    two.t += dt;
+  }
+  EXPECT_TRUE(one.displacement() == two.displacement());
+  EXPECT_TRUE(one.velocity() == two.velocity());
+  EXPECT_EQ(one.energy.external_work, work);
+  EXPECT_EQ(one.energy.absorbed, absorbed);
+  EXPECT_GT(work, 0.0);
+  std::printf("  %zu nodes, %zu groups: work %.17g J/m, absorbed %.17g J/m\n", one.nodes(),
+              one.row_groups(), work, absorbed);
 }
 
 TEST(FemRows, UnstructuredMeshKeepsEveryRow) {
