@@ -48,6 +48,24 @@ std::vector<double> field(const fem::Solver& s, bool linear) {
   return u;
 }
 
+// `steps` steps of two solvers of one model at 0.4 of the critical step: one by step(), the
+// other by the hybrid's two passes (internal_force, then advance_free_nodes), which book their
+// work and absorbed energy into `work` and `absorbed`.
+void step_both(fem::Solver& one, fem::Solver& two, int steps, double& work, double& absorbed) {
+  const double dt = 0.4 * one.critical_dt();
+  one.set_dt(dt);
+  two.set_dt(dt);
+  const std::vector<std::int64_t> skip(two.nodes(), -1);
+  std::vector<double> f_int(two.dofs()), f_ext(two.dofs(), 0.0);
+  for (int k = 0; k < steps; ++k) {
+    one.step();
+    two.internal_force(two.displacement().data(), f_int.data());
+    two.refresh_external_force(two.t, f_ext.data());
+    two.advance_free_nodes(skip.data(), f_int.data(), f_ext.data(), dt, work, absorbed);
+    two.t += dt;
+  }
+}
+
 TEST(FemRows, SharedRowsGiveTheSameInternalForce) {
   for (const int degree : {1, 2})
     for (const bool springs : {false, true}) {
@@ -120,19 +138,8 @@ TEST(FemRows, OnePassStepEqualsForceThenUpdate) {
       if (degree == 1) {
         EXPECT_GE(4 * groups, one.nodes() / 2);
       }
-      const double dt = 0.4 * one.critical_dt();
-      one.set_dt(dt);
-      two.set_dt(dt);
-      const std::vector<std::int64_t> skip(two.nodes(), -1);
-      std::vector<double> f_int(two.dofs()), f_ext(two.dofs(), 0.0);
       double work = 0, absorbed = 0;
-      for (int k = 0; k < 300; ++k) {
-        one.step();
-        two.internal_force(two.displacement().data(), f_int.data());
-        two.refresh_external_force(two.t, f_ext.data());
-        two.advance_free_nodes(skip.data(), f_int.data(), f_ext.data(), dt, work, absorbed);
-        two.t += dt;
-      }
+      step_both(one, two, 300, work, absorbed);
       EXPECT_TRUE(one.displacement() == two.displacement()) << "Q" << degree << ", " << threads;
       EXPECT_TRUE(one.velocity() == two.velocity()) << "Q" << degree << ", " << threads;
       // advance_free_nodes sums over the threads whatever the size, step() on one thread below
@@ -168,19 +175,8 @@ TEST(FemRows, GroupsOnTwoThreadsBookAsTheRowLoop) {
   fem::Solver one(spec()), two(spec());
   ASSERT_GE(one.nodes(), 40000u);
   EXPECT_GE(4 * one.row_groups(), one.nodes() / 2);
-  const double dt = 0.4 * one.critical_dt();
-  one.set_dt(dt);
-  two.set_dt(dt);
-  const std::vector<std::int64_t> skip(two.nodes(), -1);
-  std::vector<double> f_int(two.dofs()), f_ext(two.dofs(), 0.0);
   double work = 0, absorbed = 0;
-  for (int k = 0; k < 40; ++k) {
-    one.step();
-    two.internal_force(two.displacement().data(), f_int.data());
-    two.refresh_external_force(two.t, f_ext.data());
-    two.advance_free_nodes(skip.data(), f_int.data(), f_ext.data(), dt, work, absorbed);
-    two.t += dt;
-  }
+  step_both(one, two, 40, work, absorbed);
   EXPECT_TRUE(one.displacement() == two.displacement());
   EXPECT_TRUE(one.velocity() == two.velocity());
   EXPECT_EQ(one.energy.external_work, work);
