@@ -67,6 +67,7 @@ std::size_t Solver::nodes() const {
 std::size_t Solver::matrix_blocks() const { return impl_->col.size(); }
 std::size_t Solver::stored_blocks() const { return impl_->val.size() / 4; }
 bool Solver::rows_shared() const { return !impl_->row_val.empty(); }
+int Solver::store_mode() const { return impl_->stream_mode; }
 std::size_t Solver::row_groups() const {
   return static_cast<std::size_t>(std::count(impl_->row4.begin(), impl_->row4.end(), 1));
 }

@@ -164,6 +164,9 @@ class Solver {
   // values and whose columns are the first's shifted by their place (consecutive nodes of a
   // structured mesh); step() takes each such group at once.
   std::size_t row_groups() const;
+  // How step() stores the groups' new displacement and -K u: -1 while its first steps time
+  // both ways, 0 plainly, 1 streaming (not reading the lines first; a pass of 32 MB or more).
+  int store_mode() const;
   // The perfectly matched layers' cells (this rank's), and those whose forces take the
   // tensor-product form (Spec::pml_tensor; known once the solver has stepped, 0 before).
   std::size_t pml_cells() const;
