@@ -1903,9 +1903,11 @@ void Solver::consistent_dashpots() {
   // scalar multiply-adds), then (several ranks: o summed over the halo) every slot's vbar and its
   // new g, four slots at a time, each lane the scalar arithmetic; the new g is written apart
   // from the old. The largest change and vbar are the same whatever the order they are met in.
-  using V2 = double __attribute__((vector_size(16)));
-  using V4 = double __attribute__((vector_size(32)));
-  using M4 = long long __attribute__((vector_size(32)));
+  using kernels::simd::M4;
+  using kernels::simd::V2;
+  using kernels::simd::V4;
+  using kernels::simd::load;
+  using kernels::simd::store;
   auto row_sums = [&](const double* gg) {
     for (std::size_t k = 0; k < ns; ++k) {
       const int* col = cm_col_.data() + kCmRow * k;
@@ -1920,19 +1922,13 @@ void Solver::consistent_dashpots() {
       oy[k] = o[1];
     }
   };
-  auto load = [](const double* a) {
-    V4 v;
-    std::memcpy(&v, a, sizeof v);
-    return v;
-  };
-  auto store = [](double* a, V4 v) { std::memcpy(a, &v, sizeof v); };
   // std::max(a, b) and std::abs lane by lane: b where a < b, else a; the sign bit cleared.
   auto vmax = [](V4 a, V4 b) {
     const M4 lt = a < b;
     return reinterpret_cast<V4>((reinterpret_cast<M4>(b) & lt) | (reinterpret_cast<M4>(a) & ~lt));
   };
   auto vabs = [](V4 a) {
-    const M4 mask = {~(1LL << 63), ~(1LL << 63), ~(1LL << 63), ~(1LL << 63)};
+    const M4 mask = {~(1L << 63), ~(1L << 63), ~(1L << 63), ~(1L << 63)};
     return reinterpret_cast<V4>(reinterpret_cast<M4>(a) & mask);
   };
   auto update = [&](double* gn, double& change, double& scale) {

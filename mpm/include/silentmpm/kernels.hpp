@@ -201,6 +201,17 @@ inline void add_row3(double* a, long n, const Third& third, const Second& second
   a[n + 4] = u[3];
   a[n + 5] = t[3];
 }
+// The three node rows of four particles' 3 x 3 supports (in_a_row, first node n), add_row3 each:
+// term(a) the terms at node a = 3 jj + ii of the support.
+template <class Term>
+inline void add_rows3(double* a, long n, long nnx, const Term& term) {
+  for (int jj = 0; jj < 3; ++jj)
+    add_row3(a, n + jj * nnx, term(3 * jj + 2), term(3 * jj + 1), term(3 * jj));
+}
+// t + w s for the row forms' adders.
+inline auto plus(V4 w, V4 s) {
+  return [w, s](V4 t) { return t + w * s; };
+}
 // Four particles two by two in cells n and n + 1 of a row (in_pairs) summed into nodes n .. n + 2
 // of `a`, as two pairs of lanes, one particle of each cell: pair 0 the particles 0 and 2, pair 1
 // the particles 1 and 3. right(s, j) adds pair j's terms at their right nodes (n + 1, n + 2),
@@ -505,13 +516,10 @@ inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, 
       const long nnx = g.nnx;
       if constexpr ((WHAT & kMomentum) != 0) {
         const V4 mk = simd::load(M + k), mvx = mk * simd::load(VX + k), mvy = mk * simd::load(VY + k);
-        auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
         double* fm[3] = {f.m, f.px, f.py};
         for (int c = 0; c < 3; ++c) {
           const V4 w = c == 0 ? mk : c == 1 ? mvx : mvy;
-          for (int jj = 0; jj < 3; ++jj)
-            simd::add_row3(fm[c], n0[0] + jj * nnx, term(w, 3 * jj + 2), term(w, 3 * jj + 1),
-                           term(w, 3 * jj));
+          simd::add_rows3(fm[c], n0[0], nnx, [&](int a) { return simd::plus(w, N[a]); });
         }
       }
       if constexpr ((WHAT & kForce) != 0) {
@@ -520,11 +528,8 @@ inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, 
         simd::check_volumes(v, simd::load(M + k), stretch_limit, negative, stretched);
         auto tx = [&](int a) { return [&, a](V4 t) { return t - v * (sxx * dNx[a] + sxy * dNy[a]); }; };
         auto ty = [&](int a) { return [&, a](V4 t) { return t - v * (sxy * dNx[a] + syy * dNy[a]); }; };
-        for (int jj = 0; jj < 3; ++jj) {
-          const long n = n0[0] + jj * nnx;
-          simd::add_row3(f.fx, n, tx(3 * jj + 2), tx(3 * jj + 1), tx(3 * jj));
-          simd::add_row3(f.fy, n, ty(3 * jj + 2), ty(3 * jj + 1), ty(3 * jj));
-        }
+        simd::add_rows3(f.fx, n0[0], nnx, tx);
+        simd::add_rows3(f.fy, n0[0], nnx, ty);
       }
       continue;
     }
@@ -679,7 +684,7 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     }
     if constexpr (REMAP) {
       const V4 mvx = mk * nvx, mvy = mk * nvy;
-      auto term = [&](V4 w, int a) { return [&, a, w](V4 t) { return t + w * N[a]; }; };
+      auto term = [&](V4 w, int a) { return simd::plus(w, N[a]); };
       if (K == 4 && row) {  // bilinear: node a is 0 lower left, 1 lower right, 2 upper right, 3 upper left
         const long n = n0[0], nu = n + g.nnx;
         simd::add_row(f.qx, n, term(mvx, 1), term(mvx, 0));
@@ -687,11 +692,8 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
         simd::add_row(f.qy, n, term(mvy, 1), term(mvy, 0));
         simd::add_row(f.qy, nu, term(mvy, 2), term(mvy, 3));
       } else if (K == 9 && row) {  // the 3 x 3 shapes: node a = 3 jj + ii at n0 + jj nnx + ii
-        for (int jj = 0; jj < 3; ++jj) {
-          const long n = n0[0] + jj * g.nnx;
-          simd::add_row3(f.qx, n, term(mvx, 3 * jj + 2), term(mvx, 3 * jj + 1), term(mvx, 3 * jj));
-          simd::add_row3(f.qy, n, term(mvy, 3 * jj + 2), term(mvy, 3 * jj + 1), term(mvy, 3 * jj));
-        }
+        simd::add_rows3(f.qx, n0[0], g.nnx, [&](int a) { return term(mvx, a); });
+        simd::add_rows3(f.qy, n0[0], g.nnx, [&](int a) { return term(mvy, a); });
       } else
       for (int l = 0; l < 4; ++l)
         for (int c = 0; c < K; ++c) {
