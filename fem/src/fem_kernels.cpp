@@ -493,6 +493,17 @@ struct NodeUpdate {
     work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
     if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
   }
+  // Whether nodes i .. i+3 are free, without a dashpot block and unloaded (fe their f_ext):
+  // then their lanes of four() are their whole update and their work terms are zeros, whose
+  // sum changes no total (for finite velocities; a non-finite velocity stops the run anyway).
+  inline bool plain(std::int64_t i, V8 fe) const {
+    std::uint32_t m4;
+    std::memcpy(&m4, mask + i, sizeof m4);
+    using L8 = long long __attribute__((vector_size(64)));
+    const L8 nz = fe != V8{};
+    const long long any = (nz[0] | nz[1]) | (nz[2] | nz[3]) | (nz[4] | nz[5]) | (nz[6] | nz[7]);
+    return m4 == 0 && (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0 && any == 0;
+  }
   // operator() on nodes i .. i+3 (f_int their internal forces, u_out not u_in): their (x, y)
   // in one register, each lane the single node's arithmetic for a free node without a dashpot;
   // a node with either takes operator() itself, in its place among the four (the work and the
@@ -512,6 +523,11 @@ struct NodeUpdate {
     const V8 w = {im[i], im[i], im[i + 1], im[i + 1], im[i + 2], im[i + 2], im[i + 3], im[i + 3]};
     V8 vn = v0 + dt * f * w;
     V8 un = ui + dt * vn;
+    if (!gravity && plain(i, fe)) {  // no lane books anything (see plain)
+      std::memcpy(v + 2 * i, &vn, sizeof vn);
+      stream(u_out + 2 * i, un, streaming);
+      return;
+    }
     for (int j = 0; j < 4; ++j) {
       const std::int64_t k = i + j;
       if (mask[k] == 0 && dn[k] < 0) {

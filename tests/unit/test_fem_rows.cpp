@@ -11,8 +11,10 @@
 // fem::Solver::step makes one pass over the rows (-K u and the nodal update together; Q1's rows
 // of consecutive nodes mostly four at a time, reaching half the nodes so at least); it equals,
 // bit for bit, the two passes the hybrid makes (internal_force, then advance_free_nodes): u, v
-// and the booked work and absorbed energy (on two threads within 1e-14: the sums' order), with a traction, LK dashpots, Kelvin-Voigt springs, a
-// PML, a damping band with a stiffness part and gravity, Q1 and Q2, on one and two threads;
+// and the booked work and absorbed energy (on two threads within 1e-14: the sums' order), with a
+// traction and rollers on one side, LK dashpots, Kelvin-Voigt springs, a PML, a damping band
+// with a stiffness part, with and without gravity (without it, a group of four free, unloaded
+// nodes without dashpots books no work), Q1 and Q2, on one and two threads;
 // and above the size from which it runs on several threads, with the groups of four rows, the
 // work and absorbed energy too (the threads take the rows of a static schedule).
 #include <gtest/gtest.h>
@@ -110,84 +112,94 @@ TEST(FemRows, PatchTestThroughSharedRows) {
 
 TEST(FemRows, OnePassStepEqualsForceThenUpdate) {
   for (const int degree : {1, 2})
-    for (const int threads : {1, 2}) {
-      auto spec = [&] {
-        fem::Spec s = steel_rectangle("one_pass_rect", 40, 30, degree);
-        s.threads = threads;
-        s.gravity_y = -9.81;
-        fem::Boundary load = bc(fem::Boundary::Kind::Traction, 14, "load");
-        load.normal = -1e8;
-        load.fn = sin2_bell(2e-6);
-        fem::Boundary lk = bc(fem::Boundary::Kind::Dashpot, 11, "lk");
-        fem::Boundary kv = bc(fem::Boundary::Kind::Dashpot, 13, "kv");
-        kv.delta = 10e-3;
-        fem::Boundary pml = bc(fem::Boundary::Kind::Pml, 12, "pml");
-        pml.width = 5e-3;
-        pml.r0 = 1e-2;
-        fem::Boundary band = bc(fem::Boundary::Kind::Damping, 13, "band");
-        band.width = 4e-3;
-        band.r0 = 0.9;
-        band.beta = 1e-8;
-        s.boundaries = {load, lk, kv, pml, bc(fem::Boundary::Kind::Dashpot, 12, "pml_lk"), band};
-        return s;
-      };
-      fem::Solver one(spec()), two(spec());
-      // Q1: most rows go four at a time (step's groups; internal_force takes rows one by one).
-      const std::size_t groups = one.row_groups();
-      std::printf("  Q%d: %zu groups of four rows of %zu nodes\n", degree, groups, one.nodes());
-      if (degree == 1) {
-        EXPECT_GE(4 * groups, one.nodes() / 2);
+    for (const int threads : {1, 2})
+      for (const bool gravity : {true, false}) {
+        auto spec = [&] {
+          fem::Spec s = steel_rectangle("one_pass_rect", 40, 30, degree);
+          s.threads = threads;
+          s.gravity_y = gravity ? -9.81 : 0.0;
+          fem::Boundary load = bc(fem::Boundary::Kind::Traction, 14, "load");
+          load.normal = -1e8;
+          load.fn = sin2_bell(2e-6);
+          fem::Boundary lk = bc(fem::Boundary::Kind::Dashpot, 11, "lk");
+          fem::Boundary kv = bc(fem::Boundary::Kind::Dashpot, 13, "kv");
+          kv.delta = 10e-3;
+          fem::Boundary pml = bc(fem::Boundary::Kind::Pml, 12, "pml");
+          pml.width = 5e-3;
+          pml.r0 = 1e-2;
+          fem::Boundary band = bc(fem::Boundary::Kind::Damping, 13, "band");
+          band.width = 4e-3;
+          band.r0 = 0.9;
+          band.beta = 1e-8;
+          fem::Boundary roller = bc(fem::Boundary::Kind::Roller, 14, "roller");  // the load's side
+          roller.component = 0;
+          s.boundaries = {load, roller, lk, kv, pml, bc(fem::Boundary::Kind::Dashpot, 12, "pml_lk"),
+                          band};
+          return s;
+        };
+        fem::Solver one(spec()), two(spec());
+        // Q1: most rows go four at a time (step's groups; internal_force takes rows one by one).
+        const std::size_t groups = one.row_groups();
+        std::printf("  Q%d: %zu groups of four rows of %zu nodes\n", degree, groups, one.nodes());
+        if (degree == 1) {
+          EXPECT_GE(4 * groups, one.nodes() / 2);
+        }
+        double work = 0, absorbed = 0;
+        step_both(one, two, 300, work, absorbed);
+        EXPECT_TRUE(one.displacement() == two.displacement())
+            << "Q" << degree << ", " << threads << ", gravity " << gravity;
+        EXPECT_TRUE(one.velocity() == two.velocity())
+            << "Q" << degree << ", " << threads << ", gravity " << gravity;
+        // advance_free_nodes sums over the threads whatever the size, step() on one thread below
+        // a size (the sums' order then differs on two threads).
+        const double tol = threads == 1 ? 0.0 : 1e-14;
+        EXPECT_LE(std::fabs(one.energy.external_work - work), tol * std::fabs(work));
+        EXPECT_LE(std::fabs(one.energy.absorbed - absorbed), tol * std::fabs(absorbed));
+        double umax = 0;
+        for (const double u : one.displacement()) umax = std::max(umax, std::fabs(u));
+        std::printf("  Q%d, %d thread(s): max |u| %.3e, work %.6e J/m, absorbed %.6e J/m\n", degree,
+                    threads, umax, work, absorbed);
+        EXPECT_GT(umax, 0.0);  // the pulse is in
+        EXPECT_GT(absorbed, 0.0);
       }
-      double work = 0, absorbed = 0;
-      step_both(one, two, 300, work, absorbed);
-      EXPECT_TRUE(one.displacement() == two.displacement()) << "Q" << degree << ", " << threads;
-      EXPECT_TRUE(one.velocity() == two.velocity()) << "Q" << degree << ", " << threads;
-      // advance_free_nodes sums over the threads whatever the size, step() on one thread below
-      // a size (the sums' order then differs on two threads).
-      const double tol = threads == 1 ? 0.0 : 1e-14;
-      EXPECT_LE(std::fabs(one.energy.external_work - work), tol * std::fabs(work));
-      EXPECT_LE(std::fabs(one.energy.absorbed - absorbed), tol * std::fabs(absorbed));
-      double umax = 0;
-      for (const double u : one.displacement()) umax = std::max(umax, std::fabs(u));
-      std::printf("  Q%d, %d thread(s): max |u| %.3e, work %.6e J/m, absorbed %.6e J/m\n", degree,
-                  threads, umax, work, absorbed);
-      EXPECT_GT(umax, 0.0);  // the pulse is in
-      EXPECT_GT(absorbed, 0.0);
-    }
 }
 
 // Above the size from which the step runs on several threads (40 000 rows), step()'s threads
 // take the rows a static schedule gives them, as advance_free_nodes does: on two threads the
 // work and the absorbed energy are the same sums, to the bit, with the groups of four rows (and
-// LK dashpots among them) on. The square is large enough (207 000 nodes) for the step to time
-// its groups' stores both ways over its first twelve steps, then keep one: the same bits.
+// LK dashpots among them) on, with gravity and without (then the groups of free, unloaded nodes
+// book nothing). The square is large enough (207 000 nodes) for the step to time its groups'
+// stores both ways over its first twelve steps, then keep one: the same bits.
 TEST(FemRows, GroupsOnTwoThreadsBookAsTheRowLoop) {
-  auto spec = [] {
-    fem::Spec s = steel_rectangle("two_thread_rect", 460, 450, 1);
-    s.threads = 2;
-    s.gravity_y = -9.81;
-    fem::Boundary load = bc(fem::Boundary::Kind::Traction, 14, "load");
-    load.normal = -1e8;
-    load.fn = sin2_bell(2e-6);
-    s.boundaries = {load, bc(fem::Boundary::Kind::Dashpot, 11, "lk"),
-                    bc(fem::Boundary::Kind::Dashpot, 12, "lk_side")};
-    return s;
-  };
-  fem::Solver one(spec()), two(spec());
-  ASSERT_GE(one.nodes(), 40000u);
-  EXPECT_GE(4 * one.row_groups(), one.nodes() / 2);
-  EXPECT_EQ(one.store_mode(), -1);
-  double work = 0, absorbed = 0;
-  step_both(one, two, 16, work, absorbed);
-  EXPECT_GE(one.store_mode(), 0);
-  EXPECT_TRUE(one.displacement() == two.displacement());
-  EXPECT_TRUE(one.velocity() == two.velocity());
-  EXPECT_EQ(one.energy.external_work, work);
-  EXPECT_EQ(one.energy.absorbed, absorbed);
-  EXPECT_GT(work, 0.0);
-  std::printf("  %zu nodes, %zu groups, stores %s: work %.17g J/m, absorbed %.17g J/m\n",
-              one.nodes(), one.row_groups(), one.store_mode() ? "streaming" : "plain", work,
-              absorbed);
+  for (const bool gravity : {true, false}) {
+    auto spec = [&] {
+      fem::Spec s = steel_rectangle("two_thread_rect", 460, 450, 1);
+      s.threads = 2;
+      s.gravity_y = gravity ? -9.81 : 0.0;
+      fem::Boundary load = bc(fem::Boundary::Kind::Traction, 14, "load");
+      load.normal = -1e8;
+      load.fn = sin2_bell(2e-6);
+      s.boundaries = {load, bc(fem::Boundary::Kind::Dashpot, 11, "lk"),
+                      bc(fem::Boundary::Kind::Dashpot, 12, "lk_side")};
+      return s;
+    };
+    fem::Solver one(spec()), two(spec());
+    ASSERT_GE(one.nodes(), 40000u);
+    EXPECT_GE(4 * one.row_groups(), one.nodes() / 2);
+    EXPECT_EQ(one.store_mode(), -1);
+    double work = 0, absorbed = 0;
+    step_both(one, two, 16, work, absorbed);
+    EXPECT_GE(one.store_mode(), 0);
+    EXPECT_TRUE(one.displacement() == two.displacement()) << "gravity " << gravity;
+    EXPECT_TRUE(one.velocity() == two.velocity()) << "gravity " << gravity;
+    EXPECT_EQ(one.energy.external_work, work) << "gravity " << gravity;
+    EXPECT_EQ(one.energy.absorbed, absorbed) << "gravity " << gravity;
+    EXPECT_GT(work, 0.0);
+    std::printf("  gravity %d: %zu nodes, %zu groups, stores %s: work %.17g J/m, absorbed %.17g "
+                "J/m\n",
+                gravity, one.nodes(), one.row_groups(), one.store_mode() ? "streaming" : "plain",
+                work, absorbed);
+  }
 }
 
 TEST(FemRows, UnstructuredMeshKeepsEveryRow) {
