@@ -129,6 +129,25 @@ namespace {
 using V2 = double __attribute__((vector_size(16)));  // two doubles, one SIMD register
 using V8 = double __attribute__((vector_size(64)));  // four nodes' (x, y)
 
+#ifdef __AVX512DQ__
+// (p[0], p[1]) in each of four lanes' pairs, by one load (the masked form: GCC's unmasked
+// intrinsic reads an undefined register and warns).
+inline V8 bcast2(const double* p) {
+  return reinterpret_cast<V8>(_mm512_mask_broadcast_f64x2(_mm512_setzero_pd(), 0xff, _mm_loadu_pd(p)));
+}
+#endif
+
+// (p[0], p[0], p[1], p[1], p[2], p[2], p[3], p[3]): four nodes' value for their (x, y) lanes.
+inline V8 dup4(const double* p) {
+#ifdef __AVX512F__
+  const __m512i idx = _mm512_set_epi64(3, 3, 2, 2, 1, 1, 0, 0);
+  // (The zero-masked forms: GCC's plain ones read an undefined register and warn.)
+  return reinterpret_cast<V8>(_mm512_maskz_permutexvar_pd(0xff, idx, _mm512_maskz_loadu_pd(0x0f, p)));
+#else
+  return V8{p[0], p[0], p[1], p[1], p[2], p[2], p[3], p[3]};
+#endif
+}
+
 // The stiffness's rows (Impl's node-block CSR), read one at a time.
 struct Rows {
   const std::uint64_t* __restrict rp;
@@ -166,9 +185,15 @@ struct Rows {
       std::memcpy(&w, u + 2 * std::uint64_t{c[k]}, sizeof w);
       const V8 ux = __builtin_shufflevector(w, w, 0, 0, 2, 2, 4, 4, 6, 6);
       const V8 uy = __builtin_shufflevector(w, w, 1, 1, 3, 3, 5, 5, 7, 7);
+      // The block's two columns, each repeated in the four rows' lanes (one load each).
+#ifdef __AVX512DQ__
+      const V8 c0 = bcast2(row + 4 * k);
+      const V8 c1 = bcast2(row + 4 * k + 2);
+#else
       const double* b = row + 4 * k;
       const V8 c0 = {b[0], b[1], b[0], b[1], b[0], b[1], b[0], b[1]};
       const V8 c1 = {b[2], b[3], b[2], b[3], b[2], b[3], b[2], b[3]};
+#endif
       acc += c0 * ux + c1 * uy;
     }
     return acc;
@@ -499,10 +524,33 @@ struct NodeUpdate {
   inline bool plain(std::int64_t i, V8 fe) const {
     std::uint32_t m4;
     std::memcpy(&m4, mask + i, sizeof m4);
+#ifdef __AVX512F__
+    const bool any = _mm512_cmpneq_pd_mask(reinterpret_cast<__m512d>(fe), _mm512_setzero_pd()) != 0;
+#else
     using L8 = long long __attribute__((vector_size(64)));
     const L8 nz = fe != V8{};
-    const long long any = (nz[0] | nz[1]) | (nz[2] | nz[3]) | (nz[4] | nz[5]) | (nz[6] | nz[7]);
-    return m4 == 0 && (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0 && any == 0;
+    const bool any = ((nz[0] | nz[1]) | (nz[2] | nz[3]) | (nz[4] | nz[5]) | (nz[6] | nz[7])) != 0;
+#endif
+    return m4 == 0 && (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0 && !any;
+  }
+  // four()'s nodes one by one where they are not all plain: the work of each free node without
+  // a dashpot, operator() for the others (vn and un then take what it wrote). Apart, so that the
+  // plain groups keep their registers.
+  [[gnu::noinline]] void mixed(std::int64_t i, const V8& f_int, const double* __restrict f_ext,
+                               const double* u_in, double* u_out, double& work, double& absorbed,
+                               const V8& v0, V8& vn, V8& un) const {
+    for (int j = 0; j < 4; ++j) {
+      const std::int64_t k = i + j;
+      if (mask[k] == 0 && dn[k] < 0) {
+        book(k, f_ext, v0[2 * j], v0[2 * j + 1], vn[2 * j], vn[2 * j + 1], work);
+        continue;
+      }
+      (*this)(k, f_int[2 * j], f_int[2 * j + 1], f_ext, u_in, u_out, work, absorbed);
+      vn[2 * j] = v[2 * k];
+      vn[2 * j + 1] = v[2 * k + 1];
+      un[2 * j] = u_out[2 * k];
+      un[2 * j + 1] = u_out[2 * k + 1];
+    }
   }
   // operator() on nodes i .. i+3 (f_int their internal forces, u_out not u_in): their (x, y)
   // in one register, each lane the single node's arithmetic for a free node without a dashpot;
@@ -516,29 +564,17 @@ struct NodeUpdate {
     std::memcpy(&ui, u_in + 2 * i, sizeof ui);
     V8 f = f_int + fe;
     if (gravity) {
-      const V8 m = {ms[i], ms[i], ms[i + 1], ms[i + 1], ms[i + 2], ms[i + 2], ms[i + 3], ms[i + 3]};
       const V8 g = {gx, gy, gx, gy, gx, gy, gx, gy};
-      f += m * g;
+      f += dup4(ms + i) * g;
     }
-    const V8 w = {im[i], im[i], im[i + 1], im[i + 1], im[i + 2], im[i + 2], im[i + 3], im[i + 3]};
+    const V8 w = dup4(im + i);
     V8 vn = v0 + dt * f * w;
     V8 un = ui + dt * vn;
-    if (!gravity && plain(i, fe)) {  // no lane books anything (see plain)
-      std::memcpy(v + 2 * i, &vn, sizeof vn);
-      stream(u_out + 2 * i, un, streaming);
-      return;
-    }
-    for (int j = 0; j < 4; ++j) {
-      const std::int64_t k = i + j;
-      if (mask[k] == 0 && dn[k] < 0) {
-        book(k, f_ext, v0[2 * j], v0[2 * j + 1], vn[2 * j], vn[2 * j + 1], work);
-        continue;
-      }
-      (*this)(k, f_int[2 * j], f_int[2 * j + 1], f_ext, u_in, u_out, work, absorbed);
-      vn[2 * j] = v[2 * k];
-      vn[2 * j + 1] = v[2 * k + 1];
-      un[2 * j] = u_out[2 * k];
-      un[2 * j + 1] = u_out[2 * k + 1];
+    if (gravity || !plain(i, fe)) {  // copies: the plain path's values stay in registers
+      V8 fi = f_int, v_old = v0, v_new = vn, u_new = un;
+      mixed(i, fi, f_ext, u_in, u_out, work, absorbed, v_old, v_new, u_new);
+      vn = v_new;
+      un = u_new;
     }
     std::memcpy(v + 2 * i, &vn, sizeof vn);
     stream(u_out + 2 * i, un, streaming);
@@ -607,12 +643,12 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
         f[2 * i + 1] = -acc[1];
         node(i, -acc[0], -acc[1], f_ext, u, un, work, absorbed);
       };
-      // Rows one at a time; where Impl::row4 marks a group of four (4g .. 4g+3), the group at
+      // Rows one at a time; where Impl::row4 marks a group of four (r .. r+3), the group at
       // once, its arrays fetched kAhead rows ahead (the many streams of the pass leave the
       // hardware's prefetchers behind).
       constexpr std::int64_t kAhead = 32;
       for (std::int64_t r = r0; r < r1;) {
-        if (r % 4 == 0 && r + 4 <= r1 && row4[r / 4]) {
+        if (r + 4 <= r1 && row4[r]) {
           if (r + kAhead < r1) {
             const std::int64_t a = r + kAhead;
             __builtin_prefetch(u + 2 * a);
@@ -622,7 +658,7 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
             __builtin_prefetch(f_ext + 2 * a);
             __builtin_prefetch(K.cl + K.rp[a]);
             __builtin_prefetch(K.cl + std::min(K.rp[a] + 16, K.rp[n]));
-            if (a % 8 == 0) {
+            if (a % 8 < 4) {  // a new line of these arrays
               __builtin_prefetch(node.im + a);
               __builtin_prefetch(node.ms + a);
               __builtin_prefetch(node.dn + a);
