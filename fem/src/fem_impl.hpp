@@ -51,10 +51,9 @@ struct Solver::Impl {
   std::vector<std::uint32_t> col;
   std::vector<double> val;
   std::vector<std::uint32_t> row_val;
-  // With shared values: per row i, 1 where rows i .. i+3 form a group: they share one row of
-  // values and each row's columns are the first's plus its place in the group (consecutive nodes
-  // of a structured mesh); no row is in two groups. K u then reads the four rows' u of a block
-  // as one run (fem_kernels.cpp).
+  // With shared values: per group of four rows 4g .. 4g+3, 1 when they share one row of values
+  // and each row's columns are the first's plus its place in the group (consecutive nodes of a
+  // structured mesh): K u then reads the four rows' u of a block as one run (fem_kernels.cpp).
   std::vector<std::uint8_t> row4;
 
   // Dashpot blocks C per dashpot node (their trapezoidal update: dashpot.hpp).

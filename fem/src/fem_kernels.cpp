@@ -139,13 +139,10 @@ inline V8 bcast2(const double* p) {
 
 // (p[0], p[0], p[1], p[1], p[2], p[2], p[3], p[3]): four nodes' value for their (x, y) lanes.
 inline V8 dup4(const double* p) {
-#ifdef __AVX512F__
-  const __m512i idx = _mm512_set_epi64(3, 3, 2, 2, 1, 1, 0, 0);
-  // (The zero-masked forms: GCC's plain ones read an undefined register and warn.)
-  return reinterpret_cast<V8>(_mm512_maskz_permutexvar_pd(0xff, idx, _mm512_maskz_loadu_pd(0x0f, p)));
-#else
-  return V8{p[0], p[0], p[1], p[1], p[2], p[2], p[3], p[3]};
-#endif
+  using V4 = double __attribute__((vector_size(32)));
+  V4 x;
+  std::memcpy(&x, p, sizeof x);
+  return __builtin_shufflevector(x, x, 0, 0, 1, 1, 2, 2, 3, 3);
 }
 
 // The stiffness's rows (Impl's node-block CSR), read one at a time.
@@ -643,22 +640,25 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
         f[2 * i + 1] = -acc[1];
         node(i, -acc[0], -acc[1], f_ext, u, un, work, absorbed);
       };
-      // Rows one at a time; where Impl::row4 marks a group of four (r .. r+3), the group at
+      // Rows one at a time; where Impl::row4 marks a group of four (4g .. 4g+3), the group at
       // once, its arrays fetched kAhead rows ahead (the many streams of the pass leave the
       // hardware's prefetchers behind).
       constexpr std::int64_t kAhead = 32;
       for (std::int64_t r = r0; r < r1;) {
-        if (r + 4 <= r1 && row4[r]) {
+        if (r % 4 == 0 && r + 4 <= r1 && row4[r / 4]) {
           if (r + kAhead < r1) {
             const std::int64_t a = r + kAhead;
-            __builtin_prefetch(u + 2 * a);
+            // u^n where the group's furthest column (the mesh row above) will be: the pass reaches
+            // new lines of u there first (its own row's and the row below's it read before).
+            const std::uint64_t far = std::uint64_t{K.cl[K.rp[r + 1] - 1]} + kAhead;
+            __builtin_prefetch(u + 2 * std::min(far, static_cast<std::uint64_t>(n - 1)));
             __builtin_prefetch(un + 2 * a, 1);
             __builtin_prefetch(f + 2 * a, 1);
             __builtin_prefetch(node.v + 2 * a, 1);
             __builtin_prefetch(f_ext + 2 * a);
             __builtin_prefetch(K.cl + K.rp[a]);
             __builtin_prefetch(K.cl + std::min(K.rp[a] + 16, K.rp[n]));
-            if (a % 8 < 4) {  // a new line of these arrays
+            if (a % 8 == 0) {
               __builtin_prefetch(node.im + a);
               __builtin_prefetch(node.ms + a);
               __builtin_prefetch(node.dn + a);

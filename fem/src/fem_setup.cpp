@@ -344,10 +344,9 @@ void share_equal_rows(Solver::Impl& m) {
   }
   m.row_val = std::move(row_val);
   m.val = std::move(kinds);
-  // Groups of four taken greedily in row order: a run of consecutive nodes leaves at most three
-  // rows of its own to go one by one, wherever it starts.
-  m.row4.assign(nn, 0);
-  for (std::size_t i = 0; i + 4 <= nn;) {
+  m.row4.assign(nn / 4, 0);
+  for (std::size_t g = 0; g < nn / 4; ++g) {
+    const std::size_t i = 4 * g;
     const std::uint64_t n = m.rowptr[i + 1] - m.rowptr[i];
     bool same = true;
     for (std::size_t j = 1; j < 4 && same; ++j) {
@@ -355,8 +354,7 @@ void share_equal_rows(Solver::Impl& m) {
       for (std::uint64_t k = 0; k < n && same; ++k)
         same = m.col[m.rowptr[i + j] + k] == m.col[m.rowptr[i] + k] + j;
     }
-    m.row4[i] = same ? 1 : 0;
-    i += same ? 4 : 1;
+    m.row4[g] = same ? 1 : 0;
   }
   if (std::count(m.row4.begin(), m.row4.end(), 1) == 0) m.row4.clear();
 }
