@@ -94,6 +94,14 @@ template <int W = 0, class... A>
 inline void prefetch_ahead(uint32_t k, const A*... a) {
   (__builtin_prefetch(a + k + kAhead, W), ...);
 }
+// The grid's node rows ahead of the pass: a pass over particles ordered by cell meets new lines
+// of the nodal arrays first at the top node row of its cells (the rows below it met a cell row
+// earlier). at: the last of four particles' top row's node; kGridAhead nodes beyond it.
+constexpr long kGridAhead = 64;
+template <int W = 0, class... A>
+inline void prefetch_grid(long at, const A*... a) {
+  (__builtin_prefetch(a + at + kGridAhead, W), ...);
+}
 // Bilinear::eval of four points: each one's first node n0 (its cell's lower left) and the values
 // N (and gradients dNx, dNy) in Bilinear's node order.
 inline void bilinear_values(V4 x, V4 y, double x0, double y0, double ih, long nnx, long n0[4],
@@ -402,6 +410,9 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
     if constexpr (kFo) simd::prefetch_ahead(k, V, SXX, SYY, SXY);
     simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
                           dNy);
+    if constexpr (kF == 5) simd::prefetch_grid<1>(n0[3] + nnx, fld[0], fld[1], fld[2], fld[3], fld[4]);
+    else if constexpr (kF == 3) simd::prefetch_grid<1>(n0[3] + nnx, fld[0], fld[1], fld[2]);
+    else simd::prefetch_grid<1>(n0[3] + nnx, fld[0], fld[1]);
     if (const bool row = simd::in_a_row(n0); row || simd::in_pairs(n0)) {
       // A node row's sums at once (four consecutive cells: add_row), or two cells' (two by two:
       // add_pairs); each node's terms in particle order.
@@ -512,6 +523,8 @@ inline uint32_t p2g4(const Grid& g, const Particles& p, uint32_t b, uint32_t e, 
     if constexpr ((WHAT & kMomentum) != 0) simd::prefetch_ahead(k, VX, VY);
     if constexpr ((WHAT & kForce) != 0) simd::prefetch_ahead(k, V, SXX, SYY, SXY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
+    if constexpr ((WHAT & kMomentum) != 0) simd::prefetch_grid<1>(n0[3] + off[K - 1], f.m, f.px, f.py);
+    if constexpr ((WHAT & kForce) != 0) simd::prefetch_grid<1>(n0[3] + off[K - 1], f.fx, f.fy);
     if (K == 9 && simd::in_a_row(n0)) {  // each node row's sums at once, in particle order
       const long nnx = g.nnx;
       if constexpr ((WHAT & kMomentum) != 0) {
@@ -659,6 +672,7 @@ inline uint32_t g2p4(const Grid& g, Particles& p, uint32_t b, uint32_t e, const 
     simd::prefetch_ahead(k, X, Y, M);
     simd::prefetch_ahead<1>(k, VX, VY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, nullptr, nullptr)) return k;
+    simd::prefetch_grid(n0[3] + off[K - 1], ux, uy, vx, vy);
     const simd::Layout lay = simd::layout(n0);
     const bool row = lay.kind == simd::kInRow;
     V4 dvx = {0, 0, 0, 0}, dvy = dvx, wx = dvx, wy = dvx;
@@ -794,6 +808,8 @@ inline uint32_t update_stress4(const Grid& g, Particles& p, uint32_t b, uint32_t
     V4 N[K], dNx[K], dNy[K];
     simd::prefetch_ahead<1>(k, X, Y, V, SXX, SYY, SZZ, SXY);
     if (!shape.eval(simd::load(X + k), simd::load(Y + k), M + k, g, n0, N, dNx, dNy)) return k;
+    simd::prefetch_grid(n0[3] + off[K - 1], gx, gy);
+    if constexpr (MOVE) simd::prefetch_grid(n0[3] + off[K - 1], ux, uy);
     const simd::Layout lay = simd::layout(n0);
     V4 lxx = {0, 0, 0, 0}, lxy = lxx, lyx = lxx, lyy = lxx, wx = lxx, wy = lxx;
 #pragma GCC unroll 9
