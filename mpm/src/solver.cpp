@@ -1422,9 +1422,8 @@ void Solver::grid_update() {
   if (delayed) delay_prepare();
   const double gx = opt.gravity_x, gy = opt.gravity_y;
   double* rec_all = dn_rec_.data();
-  auto dashpot = [&](long i) {
-    const int closure = update_dashpot_node(i, delayed, gx, gy);
-    if (!track) return;
+  // Node i's record from its velocities (v, v+).
+  auto record = [&](long i, double vxi, double vyi, double uxi, double uyi, int closure) {
     double* r = rec_all + kDn * dashpot_index_[i];
     const double* c = grid.dash.data() + Grid::kDash * i;
     r[kDnWeight] = c[3];
@@ -1432,16 +1431,20 @@ void Solver::grid_update() {
     r[kDnM] = m[i];
     r[kDnFx] = fx[i];
     r[kDnFy] = fy[i];
-    r[kDnVx] = vx[i];
-    r[kDnVy] = vy[i];
-    r[kDnUx] = ux[i];
-    r[kDnUy] = uy[i];
+    r[kDnVx] = vxi;
+    r[kDnVy] = vyi;
+    r[kDnUx] = uxi;
+    r[kDnUy] = uyi;
     r[kDnCxx] = c[0];
     r[kDnCxy] = c[1];
     r[kDnCyy] = c[2];
     // Strained with v+: not in the solve.
     const int skip = !updated_weight_.empty() && updated_weight_[i] > 0 ? kDnSkip : 0;
     r[kDnFlags] = static_cast<double>((fix[i] & 3) | skip | closure);
+  };
+  auto dashpot = [&](long i) {
+    const int closure = update_dashpot_node(i, delayed, gx, gy);
+    if (track) record(i, vx[i], vy[i], ux[i], uy[i], closure);
   };
   // Node by node in order; each line's worth of nodes (eight, where the four velocity arrays
   // start their cache lines) that holds a dashpot node takes plain stores and then its dashpot
@@ -1465,7 +1468,32 @@ void Solver::grid_update() {
       } else {
         for (long j = g; j < ge; ++j) any = any || (u.fix[j] & Grid::kDashpotNode);
       }
-      if (any) {
+      if (any && u.stream && !delayed && ge - g == 8) {
+        // A whole line, streamed as the runs around it: its eight nodes' velocities into a
+        // buffer, its dashpot nodes' update there (update_dashpot_node without a delayed
+        // closure: the trapezoidal update of a node heavier than the floor), then out. The
+        // line's plain stores would each first read it from memory.
+        bad |= u.run(from, g);
+        alignas(64) double b[4][8];
+        NodeUpdate t = plain;
+        t.m = m + g; t.px += g; t.py += g; t.fx = fx + g; t.fy = fy + g; t.fix += g;
+        t.vx = b[0]; t.vy = b[1]; t.ux = b[2]; t.uy = b[3];
+        bad |= t.run(0, 8);
+        for (long j = g; j < ge; ++j) {
+          if (!(u.fix[j] & Grid::kDashpotNode)) continue;
+          const long l = j - g;
+          if (m[j] > mass_floor_)
+            dashpot_velocity(m[j], grid.cxx(j), grid.cxy(j), grid.cyy(j), b[0][l], b[1][l], fx[j],
+                             fy[j], dt, fix[j], b[2][l], b[3][l]);
+          if (track) record(j, b[0][l], b[1][l], b[2][l], b[3][l], 0);
+        }
+        for (int a = 0; a < 4; ++a) {
+          double* to = a == 0 ? u.vx : a == 1 ? u.vy : a == 2 ? u.ux : u.uy;
+          NodeUpdate::put<true>(to + g, kernels::simd::load(b[a]));
+          NodeUpdate::put<true>(to + g + 4, kernels::simd::load(b[a] + 4));
+        }
+        from = ge;
+      } else if (any) {
         bad |= u.run(from, g) | plain.run(g, ge);
         for (long j = g; j < ge; ++j)
           if (u.fix[j] & Grid::kDashpotNode) dashpot(j);

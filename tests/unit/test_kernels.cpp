@@ -334,7 +334,7 @@ INSTANTIATE_TEST_SUITE_P(Layouts, Kernels, ::testing::Values(0, 1, 2, 3), [](con
 // and the choice by timing, which a small grid skips.
 TEST(Step, StreamingStoresGiveTheSameBits) {
   for (Scheme scheme : {Scheme::MUSL, Scheme::USL, Scheme::USF})
-  for (End end : {End::Free, End::Silent})  // (the dashpot nodes' lines store plainly)
+  for (End end : {End::Free, End::Silent})  // (the dashpot nodes' whole lines: by a buffer)
   for (int threads : {1, 2}) {
     std::unique_ptr<Solver> run[2];
     for (int mode : {0, 1}) {
