@@ -24,7 +24,8 @@
 //     After each size and thread count a line gives the silent edge's cost over the free one:
 //     from the best rates of the rounds, and the range of the rounds' own pairs; another, the
 //     stores of the grid's write-only passes (Solver::streaming: a large grid times both kinds
-//     on its first steps, which the warm-up takes).
+//     on its first steps, which the warm-up takes; each round's silent run takes the stores its
+//     free run chose).
 #include <omp.h>
 
 #include <algorithm>
@@ -117,11 +118,16 @@ double solve_iterations = 0;
 // The grid's stores the timed runs used (Solver::store_mode): bit 0 plain, bit 1 streaming.
 int stores_seen = 0;
 
-double rate(double h, bool silent, int threads, int steps, ShapeKind shape) {
+// stores: the grid's stores to take (Solver::streaming; -1: the solver times both ways on its
+// first steps and keeps the faster); `used` gets the mode the timed steps ran with.
+double rate(double h, bool silent, int threads, int steps, ShapeKind shape, int stores,
+            int& used) {
   auto s = pulse_plate(h, silent, threads, shape, steps);
+  s->streaming = stores;
   // Warm-up, and the steps on which the solver times its grid's stores both ways.
   for (int i = 0; i < 3 || s->store_mode() < 0; ++i) s->step();
-  stores_seen |= s->store_mode() > 0 ? 2 : 1;
+  used = s->store_mode();
+  stores_seen |= used > 0 ? 2 : 1;
   const long it0 = s->dashpot_solve.iterations, st0 = s->dashpot_solve.steps;
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < steps; ++i) s->step();
@@ -224,12 +230,17 @@ int main(int argc, char** argv) {
       // Each round's rates, free and silent, per shape: the silent edge's cost over the free one.
       const std::size_t ns = shapes.size();
       std::vector<double> free_rate(ns * rounds), silent_rate(ns * rounds);
+      // The silent run of a round takes the stores its free run chose, so that the two differ
+      // by the edge alone.
+      std::vector<int> free_stores(ns, -1);
       stores_seen = 0;
       for (int round = 0; round < rounds; ++round)
         for (bool silent : {false, true})
           for (std::size_t si = 0; si < ns; ++si) {
             const ShapeKind shape = shapes[si];
-            const double r = rate(h, silent, th, steps, shape);
+            int used = -1;
+            const double r = rate(h, silent, th, steps, shape, silent ? free_stores[si] : -1, used);
+            if (!silent) free_stores[si] = used;
             (silent ? silent_rate : free_rate)[round * ns + si] = r;
             const double gbs = r * per_update / 1e9;
             std::printf("%10zu %9s %8d %8d %14.3e %9s %8.0f %8.1f %8.0f%%\n", n,
@@ -254,7 +265,7 @@ int main(int argc, char** argv) {
                     100 * hi, solve_iterations);
       }
       std::printf("# %zu particles, %d thread%s: the grid's write-only passes with %s stores "
-                  "(each run times both on its first steps)\n",
+                  "(each free run times both on its first steps, its silent run takes the same)\n",
                   n, th, th == 1 ? "" : "s",
                   stores_seen == 2 ? "streaming" : stores_seen == 1 ? "plain" : "plain or streaming");
     }
