@@ -1448,8 +1448,10 @@ void Solver::grid_update() {
   };
   // Node by node in order; each line's worth of nodes (eight, where the four velocity arrays
   // start their cache lines) that holds a dashpot node takes plain stores and then its dashpot
-  // nodes' update, which reads those values back while they are in cache. The runs between go
-  // whole, streamed where the step streams: whole lines, never a line shared with plain stores.
+  // nodes' update, which reads those values back while they are in cache (where the step streams
+  // and no closure is delayed, a whole line goes through a buffer instead, below). The runs
+  // between go whole, streamed where the step streams: whole lines, never a line shared with
+  // plain stores.
 #pragma omp parallel num_threads(nthreads_) reduction(| : bad)
   {
     const NodeUpdate u = nodes;
@@ -1482,13 +1484,12 @@ void Solver::grid_update() {
         for (long j = g; j < ge; ++j) {
           if (!(u.fix[j] & Grid::kDashpotNode)) continue;
           const long l = j - g;
-          if (m[j] > mass_floor_)
-            dashpot_velocity(m[j], grid.cxx(j), grid.cxy(j), grid.cyy(j), b[0][l], b[1][l], fx[j],
-                             fy[j], dt, fix[j], b[2][l], b[3][l]);
+          trapezoidal_dashpot(j, b[0][l], b[1][l], b[2][l], b[3][l]);
           if (track) record(j, b[0][l], b[1][l], b[2][l], b[3][l], 0);
         }
+        double* const out[4] = {u.vx, u.vy, u.ux, u.uy};
         for (int a = 0; a < 4; ++a) {
-          double* to = a == 0 ? u.vx : a == 1 ? u.vy : a == 2 ? u.ux : u.uy;
+          double* to = out[a];
           NodeUpdate::put<true>(to + g, kernels::simd::load(b[a]));
           NodeUpdate::put<true>(to + g + 4, kernels::simd::load(b[a] + 4));
         }
@@ -1572,10 +1573,14 @@ int Solver::update_dashpot_node(long i, bool delayed, double gx, double gy) {
     }
   }
   const int closure = delayed && delay_rho_[i] > 0 ? kDnSkip : 0;
-  if (m[i] <= floor) return closure;
-  dashpot_velocity(m[i], grid.cxx(i), grid.cxy(i), grid.cyy(i), vx[i], vy[i], fx[i], fy[i], DT,
-                   fix[i], ux[i], uy[i]);
+  trapezoidal_dashpot(i, vx[i], vy[i], ux[i], uy[i]);
   return closure;
+}
+
+void Solver::trapezoidal_dashpot(long i, double vx, double vy, double& ux, double& uy) const {
+  if (grid.m[i] <= mass_floor_) return;
+  dashpot_velocity(grid.m[i], grid.cxx(i), grid.cxy(i), grid.cyy(i), vx, vy, grid.fx[i],
+                   grid.fy[i], dt, grid.fix[i], ux, uy);
 }
 
 // MUSL and USF, in particle terms (positions held, one field, FLIP): the nodal velocity is

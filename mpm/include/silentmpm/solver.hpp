@@ -466,6 +466,9 @@ class Solver {
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
   int update_dashpot_node(long i, bool delayed, double gx, double gy);
+  // Its trapezoidal update (no delayed closure) from node i's velocity (vx, vy) into (ux, uy);
+  // a node not heavier than the mass floor keeps them.
+  void trapezoidal_dashpot(long i, double vx, double vy, double& ux, double& uy) const;
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
