@@ -22,7 +22,9 @@
 //     1e8); --rounds: how many times each free and silent pair runs, alternating (default 1).
 //     Steps per rate: 200, 30 or 10 by size, times half the thread count from 4 threads on.
 //     After each size and thread count a line gives the silent edge's cost over the free one:
-//     from the best rates of the rounds, and the range of the rounds' own pairs; another, the
+//     from a free and a silent plate stepped in turns, the median over their paired steps (four
+//     times the rate's steps; paired_cost), then from the rates (the best of the rounds, and
+//     the range of the rounds' own pairs); another, the
 //     stores of the grid's write-only passes (Solver::streaming: a large grid times both kinds
 //     on its first steps, which the warm-up takes; each round's silent run takes the stores its
 //     free run chose).
@@ -138,6 +140,42 @@ double rate(double h, bool silent, int threads, int steps, ShapeKind shape, int 
   return static_cast<double>(s->p.size()) * steps / sec;
 }
 
+// The silent edge's cost measured in pairs: a free and a silent plate held at once and stepped
+// in turns, `block` steps each (the first of each turn not counted: its cache holds the other
+// plate's arrays), every counted step timed; the pulse reaches the edge halfway through the
+// `blocks` turns. A step of one plate is paired with the same step of the other (the wave at the
+// same place), and the cost is the median over the pairs of t_silent / t_free - 1, which this
+// host's drifts of 10-30 % between whole runs leave within a few tenths of a percent. `lo10`
+// gets the ratio of the plates' 10th-percentile step times, less one.
+double paired_cost(double h, int threads, int blocks, int block, ShapeKind shape, double& lo10) {
+  const int counted = blocks * (block - 1);
+  auto f = pulse_plate(h, false, threads, shape, blocks * block);
+  for (int i = 0; i < 3 || f->store_mode() < 0; ++i) f->step();
+  auto s = pulse_plate(h, true, threads, shape, blocks * block);
+  s->streaming = f->store_mode();
+  for (int i = 0; i < 3; ++i) s->step();
+  std::vector<double> tf, ts;
+  tf.reserve(counted);
+  ts.reserve(counted);
+  for (int b = 0; b < blocks; ++b)
+    for (Solver* x : {f.get(), s.get()})
+      for (int i = 0; i < block; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        x->step();
+        const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (i > 0) (x == f.get() ? tf : ts).push_back(t);
+      }
+  std::vector<double> ratio(counted);
+  for (int k = 0; k < counted; ++k) ratio[k] = ts[k] / tf[k];
+  auto quantile = [](std::vector<double> v, double q) {
+    const auto at = v.begin() + static_cast<std::ptrdiff_t>(q * (v.size() - 1));
+    std::nth_element(v.begin(), at, v.end());
+    return *at;
+  };
+  lo10 = quantile(ts, 0.1) / quantile(tf, 0.1) - 1;
+  return quantile(ratio, 0.5) - 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -249,6 +287,12 @@ int main(int argc, char** argv) {
             std::fflush(stdout);
           }
       for (std::size_t si = 0; si < ns; ++si) {
+        // Paired steps: four times the rate's steps in turns of 10 (5 above 5e5 particles, 2 above
+        // 2e6), each turn's first step not counted.
+        const int block = n > 2000000 ? 2 : n > 500000 ? 5 : 10;
+        const int blocks = std::max(4, 4 * steps / block);
+        double lo10 = 0;
+        const double paired = paired_cost(h, th, blocks, block, shapes[si], lo10);
         double best_free = 0, best_silent = 0, lo = 1e300, hi = -1e300;
         for (int round = 0; round < rounds; ++round) {
           const double f = free_rate[round * ns + si], sr = silent_rate[round * ns + si];
@@ -258,11 +302,12 @@ int main(int argc, char** argv) {
           hi = std::max(hi, f / sr - 1);
         }
         std::printf("# %zu particles, %d thread%s, %s: the silent edge costs %.1f %% over the free "
-                    "one (best rates of %d round%s; %.1f to %.1f %% round by round; its solve "
-                    "%.1f iterations a step)\n",
-                    n, th, th == 1 ? "" : "s", shape_name(shapes[si]),
-                    100 * (best_free / best_silent - 1), rounds, rounds == 1 ? "" : "s", 100 * lo,
-                    100 * hi, solve_iterations);
+                    "one (median of %d paired steps; %.1f %% between the steps' 10th "
+                    "percentiles; the rates above: %.1f %% between the best of %d round%s, %.1f to "
+                    "%.1f %% round by round; its solve %.1f iterations a step)\n",
+                    n, th, th == 1 ? "" : "s", shape_name(shapes[si]), 100 * paired,
+                    blocks * (block - 1), 100 * lo10, 100 * (best_free / best_silent - 1), rounds,
+                    rounds == 1 ? "" : "s", 100 * lo, 100 * hi, solve_iterations);
       }
       std::printf("# %zu particles, %d thread%s: the grid's write-only passes with %s stores "
                   "(each free run times both on its first steps, its silent run takes the same)\n",
