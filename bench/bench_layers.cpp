@@ -4,13 +4,14 @@
 // its left, right and bottom sides and a free top: free edges, LK dashpots (`silent` /
 // `dashpot`), Kelvin-Voigt springs, a graded damping band of L cells in front of the dashpots,
 // a perfectly matched layer of L cells in front of them. Each variant runs a short sin^2 pulse
-// from the top for a few steps to warm up, then is timed over S steps; the variants alternate,
-// R rounds (one thread by default, timed by the process's CPU clock; with more threads by the
-// wall clock, since idle OpenMP threads spin and count as CPU). The time per step is the best
-// round's; the ratio to the free square is the median over the rounds of the ratio within each
-// round, which cancels the host's slow drifts (the edge-only boundaries amplify the ratio's
-// noise by N / N_layer, about 70 at 200 cells: measure them on a smaller square, e.g.
-// `--cells 50 --steps 3200 --kind lk`, where it is about 17).
+// from the top for a few steps to warm up, then the variants take turns of 10 steps, R rounds of
+// S steps each, every step timed but each turn's first (one thread by default, timed by the
+// process's CPU clock; with more threads by the wall clock, since idle OpenMP threads spin and
+// count as CPU). The time per step is the median step's; the ratio to the free square is the
+// median over the timed steps of each step's time over the free square's step of the same turn
+// and place, which cancels the host's drifts (10-30 % between whole runs on a shared host; the
+// edge-only boundaries amplify the ratio's noise by N / N_layer, about 70 at 200 cells: measure
+// them on a smaller square too, e.g. `--cells 50 --steps 3200 --kind lk`, where it is about 17).
 //
 // Per variant it prints the time per step, the ratio to the free square's, and the cost of one
 // cell of the layer against a free cell:
@@ -125,8 +126,7 @@ struct Variant {
   std::string method, kind, scheme;  // scheme: MPM only
   Case c;
   int layer_cells = 0;               // thickness of the layer in cells (0: none)
-  double best = 1e300;               // seconds per step
-  std::vector<double> rounds;        // seconds per step, each round
+  std::vector<double> steps;         // seconds of each timed step, in order
 };
 
 double median(std::vector<double> v) {
@@ -191,19 +191,19 @@ int main(int argc, char** argv) {
     if (o.only != "fem") {
       for (const char* k : {"free", "lk", "kv", "damping", "pml"}) {
         if (std::string(k) == "pml" && o.ppc < 4) continue;  // MUSL's layer needs 4 or 9 ppc
-        Variant v{"MPM", k, "MUSL", {}, 0, 1e300, {}};
+        Variant v{"MPM", k, "MUSL", {}, 0, {}};
         v.c = load_case_text(mpm_case(o, k, "MUSL"), (dir / "mpm.json").string());
         vs.push_back(std::move(v));
       }
       for (const char* k : {"free", "pml"}) {
-        Variant v{"MPM", k, "USL", {}, 0, 1e300, {}};
+        Variant v{"MPM", k, "USL", {}, 0, {}};
         v.c = load_case_text(mpm_case(o, k, "USL"), (dir / "mpm.json").string());
         vs.push_back(std::move(v));
       }
     }
     if (o.only != "mpm")
       for (const char* k : {"free", "lk", "kv", "damping", "pml"}) {
-        Variant v{"FEM", k, "", {}, 0, 1e300, {}};
+        Variant v{"FEM", k, "", {}, 0, {}};
         v.c = load_case_text(fem_case(o, k, geo), (dir / "fem.json").string());
         vs.push_back(std::move(v));
       }
@@ -226,17 +226,22 @@ int main(int argc, char** argv) {
     v.layer_cells = (v.kind == "damping" || v.kind == "pml") ? o.layer : v.kind == "free" ? 0 : 1;
 
   std::printf("bench_layers: %d x %d cells (h = 1 mm, steel), layers on left, right and bottom, "
-              "band and PML %d cells; %d steps x best of %d rounds, %d thread(s)\n",
+              "band and PML %d cells; %d steps x %d rounds in turns of 10, %d thread(s)\n",
               o.cells, o.cells, o.layer, o.steps, o.rounds, o.threads);
   for (Variant& v : vs)
     for (int s = 0; s < 20; ++s) step(v);
+  // In turns of kTurn steps, the variants one after another, every step timed but each turn's
+  // first (its caches hold the variant before's arrays).
+  constexpr int kTurn = 10;
+  const int turns = std::max(1, o.steps / kTurn);
   for (int r = 0; r < o.rounds; ++r)
-    for (Variant& v : vs) {
-      const double t0 = seconds(o.threads);
-      for (int s = 0; s < o.steps; ++s) step(v);
-      v.rounds.push_back((seconds(o.threads) - t0) / o.steps);
-      v.best = std::min(v.best, v.rounds.back());
-    }
+    for (int b = 0; b < turns; ++b)
+      for (Variant& v : vs)
+        for (int s = 0; s < kTurn; ++s) {
+          const double t0 = seconds(o.threads);
+          step(v);
+          if (s > 0) v.steps.push_back(seconds(o.threads) - t0);
+        }
   std::printf("%-6s %-8s %-6s %12s %10s %14s\n", "method", "boundary", "scheme", "us/step",
               "vs free", "cost/cell");
   const double N = double(o.cells) * o.cells;
@@ -244,11 +249,13 @@ int main(int argc, char** argv) {
     const Variant* f = nullptr;
     for (const Variant& w : vs)
       if (w.method == v.method && w.kind == "free" && w.scheme == v.scheme) f = &w;
-    std::vector<double> r(v.rounds.size());
-    for (std::size_t k = 0; k < r.size(); ++k) r[k] = v.rounds[k] / f->rounds[k];
+    // Each step against the free square's step of the same turn and place (the wave where it
+    // is in both): the median of those ratios.
+    std::vector<double> r(v.steps.size());
+    for (std::size_t k = 0; k < r.size(); ++k) r[k] = v.steps[k] / f->steps[k];
     const double ratio = median(r);
     std::printf("%-6s %-8s %-6s %12.1f %10.3f", v.method.c_str(), v.kind.c_str(),
-                v.scheme.empty() ? "-" : v.scheme.c_str(), 1e6 * v.best, ratio);
+                v.scheme.empty() ? "-" : v.scheme.c_str(), 1e6 * median(v.steps), ratio);
     if (v.layer_cells > 0)
       std::printf(" %14.2f\n", 1 + (ratio - 1) * N / layer_cells(o.cells, v.layer_cells));
     else
