@@ -3,9 +3,10 @@
 //
 // The loader's contract, checked on every input: it returns a built case or throws CaseError whose
 // message is one line naming the source ("fuzz.json: ..."). Anything else — another exception, a
-// message without the source, a crash, a sanitizer report, a hang (libFuzzer's -timeout) or an
-// allocation beyond -rss_limit_mb — is a finding. The pre-flight limits are lowered so that a
-// valid case stays small: 256 MB for an MPM grid and its particles, 20 000 cells for a gmsh mesh.
+// message without the source, a crash, a sanitizer report, a hang (libFuzzer's -timeout), an
+// allocation of -malloc_limit_mb or more or a process beyond -rss_limit_mb (scripts/fuzz.sh says
+// why the two differ) — is a finding. The pre-flight limits are lowered so that a valid case
+// stays small: 256 MB for an MPM grid and its particles, 20 000 cells for a gmsh mesh.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
