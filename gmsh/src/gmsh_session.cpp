@@ -23,6 +23,13 @@ std::mutex& gmsh_mutex() {
   return m;
 }
 
+// Whether the last session cleared the model and the ONELAB parameters when it ended (under
+// the lock).
+bool& cleared_at_end() {
+  static bool cleared = false;
+  return cleared;
+}
+
 std::string last_error() {
   std::string e;
   try {
@@ -78,11 +85,17 @@ GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threa
   static char name[] = "silentmpm";
   char* argv[] = {name, nullptr};
   try {
-    gmsh::initialize(1, argv, /*readConfigFiles=*/false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::clear();
-    gmsh::onelab::clear();
-    gmsh::finalize();
+    // The last session cleared what outlives gmsh::finalize (the model and the parser's
+    // variables, the ONELAB parameters) before it finalised; nothing else starts gmsh. Where
+    // that failed (or this is the process's first session), a cycle to clear them first.
+    if (!cleared_at_end()) {
+      gmsh::initialize(1, argv, /*readConfigFiles=*/false);
+      gmsh::option::setNumber("General.Terminal", 0);
+      gmsh::clear();
+      gmsh::onelab::clear();
+      gmsh::finalize();
+    }
+    cleared_at_end() = false;
     gmsh::initialize(1, argv, /*readConfigFiles=*/false);
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("Mesh.MeshSizeMax", 1e22);  // gmsh's defaults
@@ -96,7 +109,12 @@ GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threa
 
 GmshSession::~GmshSession() {
   try {
+    gmsh::clear();  // the model, and the parser's variables (h of the last .geo)
     gmsh::onelab::clear();
+    cleared_at_end() = true;
+  } catch (...) {
+  }
+  try {
     gmsh::logger::stop();
     gmsh::finalize();
   } catch (...) {

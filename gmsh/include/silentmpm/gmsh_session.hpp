@@ -5,14 +5,14 @@
 // the session needs nothing of the project, so it is its own target under both of them.
 //
 // A session holds the process-wide gmsh lock for its lifetime (one load at a time, from any
-// thread) and starts from a fresh gmsh: initialise, clear the model and the ONELAB parameters,
-// finalise, initialise again (gmsh 4.8 has no isInitialized), with terminal output off and the
-// log recorded. Without the fresh start an earlier load's options (Mesh.ElementOrder,
-// Mesh.RecombineAll, ...) and ONELAB parameters (DefineConstant[ h = {..., Name
-// "Parameters/h"} ]) would be picked up, and after a syntax error gmsh's parser no longer
-// defines the DefineConstant parameters; a fresh initialisation resets every option to its
-// default. The session clears the ONELAB parameters and finalises gmsh when it ends. This header
-// does not include gmsh.h.
+// thread) and starts from a fresh gmsh, initialised for it, with terminal output off and the
+// log recorded; when it ends it clears the model (and with it the parser's variables) and the
+// ONELAB parameters, which outlive gmsh::finalize, and finalises gmsh. Without the fresh start
+// an earlier load's options (Mesh.ElementOrder, Mesh.RecombineAll, ...) and ONELAB parameters
+// (DefineConstant[ h = {..., Name "Parameters/h"} ]) would be picked up, and after a syntax
+// error gmsh's parser no longer defines the DefineConstant parameters; a fresh initialisation
+// resets every option to its default. One initialise/finalise cycle a session: gmsh keeps
+// memory with each, more as they add up (scripts/fuzz.sh). This header does not include gmsh.h.
 #include <functional>
 #include <mutex>
 #include <string>
