@@ -21,11 +21,11 @@ cd "$root"  # the seeds name their meshes from the repository root
 export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp"  # third-party leaks
 export UBSAN_OPTIONS="print_stacktrace=1"
 # Memory: one allocation of 2 GB or more is a finding (-malloc_limit_mb); the process as a whole
-# may grow to 6 GB (-rss_limit_mb), because gmsh's initialise/finalise cycle (two in every
+# may grow to 6 GB (-rss_limit_mb), because gmsh's initialise/finalise cycle (one in every
 # session that reads a .geo or .msh) keeps memory that grows with the number of cycles, faster
-# as they add up (2 000 bare cycles: 46 -> 98 MB resident): a run reached 2 GB after 7 minutes
-# (480 000 inputs).
-# Split longer campaigns into runs of about 10 minutes; the corpus carries over.
+# as they add up (2 000 bare cycles: 46 -> 98 MB resident): with two cycles a session, as the
+# session had then, a run reached 2 GB after 7 minutes (480 000 inputs) and a 10-minute run
+# peaked at 4.5 GB. Split longer campaigns into runs of about 10 minutes; the corpus carries over.
 echo "fuzz.sh: fuzzing the case loader for $secs s (seed $seed)"
 set +e
 "$b/fuzz_case" -max_total_time="$secs" -seed="$seed" -rss_limit_mb=6144 -malloc_limit_mb=2048 -timeout=30 \
