@@ -150,10 +150,11 @@ double rate(double h, bool silent, int threads, int steps, ShapeKind shape, int 
 double paired_cost(double h, int threads, int blocks, int block, ShapeKind shape, double& lo10) {
   const int counted = blocks * (block - 1);
   auto f = pulse_plate(h, false, threads, shape, blocks * block);
-  for (int i = 0; i < 3 || f->store_mode() < 0; ++i) f->step();
+  int warm = 0;  // the free plate's warm-up (with its stores' trial), which the silent one takes
+  for (; warm < 3 || f->store_mode() < 0; ++warm) f->step();
   auto s = pulse_plate(h, true, threads, shape, blocks * block);
   s->streaming = f->store_mode();
-  for (int i = 0; i < 3; ++i) s->step();
+  for (int i = 0; i < warm; ++i) s->step();
   std::vector<double> tf, ts;
   tf.reserve(counted);
   ts.reserve(counted);

@@ -30,6 +30,13 @@ bool& cleared_at_end() {
   return cleared;
 }
 
+// What outlives gmsh::finalize: the model (and with it the parser's variables, h of the last
+// .geo) and the ONELAB parameters.
+void clear_leftovers() {
+  gmsh::clear();
+  gmsh::onelab::clear();
+}
+
 std::string last_error() {
   std::string e;
   try {
@@ -91,8 +98,7 @@ GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threa
     if (!cleared_at_end()) {
       gmsh::initialize(1, argv, /*readConfigFiles=*/false);
       gmsh::option::setNumber("General.Terminal", 0);
-      gmsh::clear();
-      gmsh::onelab::clear();
+      clear_leftovers();
       gmsh::finalize();
     }
     cleared_at_end() = false;
@@ -109,8 +115,7 @@ GmshSession::GmshSession() : lock_(gmsh_mutex()), omp_threads_(omp_get_max_threa
 
 GmshSession::~GmshSession() {
   try {
-    gmsh::clear();  // the model, and the parser's variables (h of the last .geo)
-    gmsh::onelab::clear();
+    clear_leftovers();
     cleared_at_end() = true;
   } catch (...) {
   }

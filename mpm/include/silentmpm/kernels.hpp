@@ -410,9 +410,7 @@ inline uint32_t p2g_bilinear4(const Grid& g, const Particles& p, uint32_t b, uin
     if constexpr (kFo) simd::prefetch_ahead(k, V, SXX, SYY, SXY);
     simd::bilinear_values(simd::load(X + k), simd::load(Y + k), g.x0, g.y0, ih, nnx, n0, N, dNx,
                           dNy);
-    if constexpr (kF == 5) simd::prefetch_grid<1>(n0[3] + nnx, fld[0], fld[1], fld[2], fld[3], fld[4]);
-    else if constexpr (kF == 3) simd::prefetch_grid<1>(n0[3] + nnx, fld[0], fld[1], fld[2]);
-    else simd::prefetch_grid<1>(n0[3] + nnx, fld[0], fld[1]);
+    for (int c = 0; c < kF; ++c) simd::prefetch_grid<1>(n0[3] + nnx, fld[c]);
     if (const bool row = simd::in_a_row(n0); row || simd::in_pairs(n0)) {
       // A node row's sums at once (four consecutive cells: add_row), or two cells' (two by two:
       // add_pairs); each node's terms in particle order.
