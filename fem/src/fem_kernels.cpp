@@ -127,6 +127,7 @@ std::vector<std::uint32_t> Solver::boundary_nodes(const std::vector<int>& curves
 
 namespace {
 using V2 = double __attribute__((vector_size(16)));  // two doubles, one SIMD register
+using V4 = double __attribute__((vector_size(32)));  // four nodes' x (or y)
 using V8 = double __attribute__((vector_size(64)));  // four nodes' (x, y)
 
 #ifdef __AVX512DQ__
@@ -139,7 +140,6 @@ inline V8 bcast2(const double* p) {
 
 // (p[0], p[0], p[1], p[1], p[2], p[2], p[3], p[3]): four nodes' value for their (x, y) lanes.
 inline V8 dup4(const double* p) {
-  using V4 = double __attribute__((vector_size(32)));
   V4 x;
   std::memcpy(&x, p, sizeof x);
   return __builtin_shufflevector(x, x, 0, 0, 1, 1, 2, 2, 3, 3);
@@ -515,10 +515,10 @@ struct NodeUpdate {
     work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
     if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
   }
-  // Whether nodes i .. i+3 are free, without a dashpot block and unloaded (fe their f_ext):
-  // then their lanes of four() are their whole update and their work terms are zeros, whose
-  // sum changes no total (for finite velocities; a non-finite velocity stops the run anyway).
-  inline bool plain(std::int64_t i, V8 fe) const {
+  // Whether nodes i .. i+3 are free and unloaded (fe their f_ext): then their work terms are
+  // zeros, whose sum changes no total (for finite velocities; a non-finite velocity stops the
+  // run anyway).
+  inline bool quiet(std::int64_t i, V8 fe) const {
     std::uint32_t m4;
     std::memcpy(&m4, mask + i, sizeof m4);
 #ifdef __AVX512F__
@@ -528,7 +528,56 @@ struct NodeUpdate {
     const L8 nz = fe != V8{};
     const bool any = ((nz[0] | nz[1]) | (nz[2] | nz[3]) | (nz[4] | nz[5]) | (nz[6] | nz[7])) != 0;
 #endif
-    return m4 == 0 && (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0 && !any;
+    return m4 == 0 && !any;
+  }
+  // quiet and without a dashpot block: their lanes of four() are their whole update.
+  inline bool plain(std::int64_t i, V8 fe) const {
+    return (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0 && quiet(i, fe);
+  }
+  // Quiet nodes i .. i+3 of which some hold a dashpot block (a damping band's or a PML's
+  // nodes, an edge's): those take operator()'s trapezoidal update four at a time, each lane
+  // dashpot_velocity's arithmetic for a free node (the same bits), and their absorbed energy
+  // is booked in the nodes' order; the others keep their lanes (f = f_int + fe, v0 and ui the
+  // group's, vn and un four()'s). Apart, as mixed().
+  [[gnu::noinline]] void dashpots(std::int64_t i, const V8& f, const V8& v0, const V8& ui,
+                                  V8& vn, V8& un, double& absorbed) const {
+    V4 cxx = {0, 0, 0, 0}, cxy = cxx, cyy = cxx, px = cxx, py = cxx;
+    bool block[4];
+    for (int j = 0; j < 4; ++j) {
+      const std::int32_t d = dn[i + j];
+      block[j] = d >= 0;
+      if (!block[j]) continue;
+      cxx[j] = D[d].cxx;
+      cxy[j] = D[d].cxy;
+      cyy[j] = D[d].cyy;
+      px[j] = pf[2 * d];
+      py[j] = pf[2 * d + 1];
+    }
+    V4 mi;
+    std::memcpy(&mi, ms + i, sizeof mi);
+    const V4 vx0 = __builtin_shufflevector(v0, v0, 0, 2, 4, 6);
+    const V4 vy0 = __builtin_shufflevector(v0, v0, 1, 3, 5, 7);
+    const V4 fx = __builtin_shufflevector(f, f, 0, 2, 4, 6) + px;
+    const V4 fy = __builtin_shufflevector(f, f, 1, 3, 5, 7) + py;
+    // dashpot_velocity, mask 0.
+    const double h = 0.5 * dt;
+    const V4 rx = mi * vx0 - h * (cxx * vx0 + cxy * vy0) + dt * fx;
+    const V4 ry = mi * vy0 - h * (cxy * vx0 + cyy * vy0) + dt * fy;
+    const V4 A = mi + h * cxx, B = h * cxy, Dd = mi + h * cyy;
+    const V4 det = A * Dd - B * B;
+    const V4 vx = (Dd * rx - B * ry) / det;
+    const V4 vy = (A * ry - B * rx) / det;
+    const V4 bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
+    const V4 e = bx * (cxx * bx + cxy * by) + by * (cxy * bx + cyy * by) - px * bx - py * by;
+    double a = absorbed;  // (in a register)
+    for (int j = 0; j < 4; ++j) {
+      if (!block[j]) continue;
+      vn[2 * j] = vx[j];
+      vn[2 * j + 1] = vy[j];
+      a += dt * e[j];
+    }
+    absorbed = a;
+    un = ui + dt * vn;
   }
   // four()'s nodes one by one where they are not all plain: the work of each free node without
   // a dashpot, operator() for the others (vn and un then take what it wrote). Apart, so that the
@@ -569,7 +618,12 @@ struct NodeUpdate {
     V8 un = ui + dt * vn;
     if (gravity || !plain(i, fe)) {  // copies: the plain path's values stay in registers
       V8 fi = f_int, v_old = v0, v_new = vn, u_new = un;
-      mixed(i, fi, f_ext, u_in, u_out, work, absorbed, v_old, v_new, u_new);
+      if (!gravity && quiet(i, fe)) {
+        V8 ff = f, uu = ui;
+        dashpots(i, ff, v_old, uu, v_new, u_new, absorbed);
+      } else {
+        mixed(i, fi, f_ext, u_in, u_out, work, absorbed, v_old, v_new, u_new);
+      }
       vn = v_new;
       un = u_new;
     }
