@@ -543,15 +543,31 @@ struct NodeUpdate {
                                   V8& vn, V8& un, double& absorbed) const {
     V4 cxx = {0, 0, 0, 0}, cxy = cxx, cyy = cxx, px = cxx, py = cxx;
     bool block[4];
-    for (int j = 0; j < 4; ++j) {
-      const std::int32_t d = dn[i + j];
-      block[j] = d >= 0;
-      if (!block[j]) continue;
-      cxx[j] = D[d].cxx;
-      cxy[j] = D[d].cxy;
-      cyy[j] = D[d].cyy;
-      px[j] = pf[2 * d];
-      py[j] = pf[2 * d + 1];
+    const std::int32_t d0 = dn[i];
+    const bool all = d0 >= 0 && dn[i + 3] == d0 + 3;  // (blocks in the nodes' order)
+    if (all) {  // four blocks in a row: their values by columns
+      static_assert(sizeof(Solver::DashpotBlock) == 32, "a block: node, cxx, cxy, cyy");
+      V8 b01, b23, p;
+      std::memcpy(&b01, D + d0, sizeof b01);
+      std::memcpy(&b23, D + d0 + 2, sizeof b23);
+      std::memcpy(&p, pf + 2 * d0, sizeof p);
+      cxx = __builtin_shufflevector(b01, b23, 1, 5, 9, 13);
+      cxy = __builtin_shufflevector(b01, b23, 2, 6, 10, 14);
+      cyy = __builtin_shufflevector(b01, b23, 3, 7, 11, 15);
+      px = __builtin_shufflevector(p, p, 0, 2, 4, 6);
+      py = __builtin_shufflevector(p, p, 1, 3, 5, 7);
+      block[0] = block[1] = block[2] = block[3] = true;
+    } else {
+      for (int j = 0; j < 4; ++j) {
+        const std::int32_t d = dn[i + j];
+        block[j] = d >= 0;
+        if (!block[j]) continue;
+        cxx[j] = D[d].cxx;
+        cxy[j] = D[d].cxy;
+        cyy[j] = D[d].cyy;
+        px[j] = pf[2 * d];
+        py[j] = pf[2 * d + 1];
+      }
     }
     V4 mi;
     std::memcpy(&mi, ms + i, sizeof mi);
@@ -570,11 +586,19 @@ struct NodeUpdate {
     const V4 bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
     const V4 e = bx * (cxx * bx + cxy * by) + by * (cxy * bx + cyy * by) - px * bx - py * by;
     double a = absorbed;  // (in a register)
-    for (int j = 0; j < 4; ++j) {
-      if (!block[j]) continue;
-      vn[2 * j] = vx[j];
-      vn[2 * j + 1] = vy[j];
-      a += dt * e[j];
+    if (all) {
+      vn = __builtin_shufflevector(vx, vy, 0, 4, 1, 5, 2, 6, 3, 7);
+      a += dt * e[0];
+      a += dt * e[1];
+      a += dt * e[2];
+      a += dt * e[3];
+    } else {
+      for (int j = 0; j < 4; ++j) {
+        if (!block[j]) continue;
+        vn[2 * j] = vx[j];
+        vn[2 * j + 1] = vy[j];
+        a += dt * e[j];
+      }
     }
     absorbed = a;
     un = ui + dt * vn;
