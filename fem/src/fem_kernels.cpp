@@ -515,10 +515,10 @@ struct NodeUpdate {
     work += dt * (f_ext[2 * i] * 0.5 * (vx0 + vx) + f_ext[2 * i + 1] * 0.5 * (vy0 + vy));
     if (gravity) work += dt * ms[i] * (gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy));
   }
-  // Whether nodes i .. i+3 are free and unloaded (fe their f_ext): then their work terms are
-  // zeros, whose sum changes no total (for finite velocities; a non-finite velocity stops the
-  // run anyway).
-  inline bool quiet(std::int64_t i, V8 fe) const {
+  // Whether nodes i .. i+3 are free, without a dashpot block and unloaded (fe their f_ext):
+  // then their lanes of four() are their whole update and their work terms are zeros, whose
+  // sum changes no total (for finite velocities; a non-finite velocity stops the run anyway).
+  inline bool plain(std::int64_t i, V8 fe) const {
     std::uint32_t m4;
     std::memcpy(&m4, mask + i, sizeof m4);
 #ifdef __AVX512F__
@@ -528,18 +528,22 @@ struct NodeUpdate {
     const L8 nz = fe != V8{};
     const bool any = ((nz[0] | nz[1]) | (nz[2] | nz[3]) | (nz[4] | nz[5]) | (nz[6] | nz[7])) != 0;
 #endif
-    return m4 == 0 && !any;
+    return m4 == 0 && (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0 && !any;
   }
-  // quiet and without a dashpot block: their lanes of four() are their whole update.
-  inline bool plain(std::int64_t i, V8 fe) const {
-    return (dn[i] & dn[i + 1] & dn[i + 2] & dn[i + 3]) < 0 && quiet(i, fe);
+  // Whether nodes i .. i+3 are free and unloaded (plain, dashpot blocks or not).
+  inline bool quiet(std::int64_t i, V8 fe) const {
+    std::uint32_t m4;
+    std::memcpy(&m4, mask + i, sizeof m4);
+    for (int k = 0; k < 8; ++k)
+      if (fe[k] != 0) return false;
+    return m4 == 0;
   }
   // Quiet nodes i .. i+3 of which some hold a dashpot block (a damping band's or a PML's
   // nodes, an edge's): those take operator()'s trapezoidal update four at a time, each lane
   // dashpot_velocity's arithmetic for a free node (the same bits), and their absorbed energy
   // is booked in the nodes' order; the others keep their lanes (f = f_int + fe, v0 and ui the
-  // group's, vn and un four()'s). Apart, as mixed().
-  [[gnu::noinline]] void dashpots(std::int64_t i, const V8& f, const V8& v0, const V8& ui,
+  // group's, vn and un four()'s).
+  inline void dashpots(std::int64_t i, const V8& f, const V8& v0, const V8& ui,
                                   V8& vn, V8& un, double& absorbed) const {
     V4 cxx = {0, 0, 0, 0}, cxy = cxx, cyy = cxx, px = cxx, py = cxx;
     bool block[4];
@@ -603,12 +607,23 @@ struct NodeUpdate {
     absorbed = a;
     un = ui + dt * vn;
   }
-  // four()'s nodes one by one where they are not all plain: the work of each free node without
-  // a dashpot, operator() for the others (vn and un then take what it wrote). Apart, so that the
-  // plain groups keep their registers.
+  // four()'s nodes where they are not all plain: quiet ones with dashpot blocks among them
+  // through dashpots(), else one by one: the work of each free node without a dashpot,
+  // operator() for the others (vn and un then take what it wrote). Apart, so that the plain
+  // groups keep their registers (and their code: the step's loop is the same with it).
   [[gnu::noinline]] void mixed(std::int64_t i, const V8& f_int, const double* __restrict f_ext,
                                const double* u_in, double* u_out, double& work, double& absorbed,
                                const V8& v0, V8& vn, V8& un) const {
+    if (!gravity) {
+      V8 fe;
+      std::memcpy(&fe, f_ext + 2 * i, sizeof fe);
+      if (quiet(i, fe)) {
+        V8 ui;
+        std::memcpy(&ui, u_in + 2 * i, sizeof ui);
+        dashpots(i, f_int + fe, v0, ui, vn, un, absorbed);  // (four()'s f without gravity)
+        return;
+      }
+    }
     for (int j = 0; j < 4; ++j) {
       const std::int64_t k = i + j;
       if (mask[k] == 0 && dn[k] < 0) {
@@ -642,12 +657,7 @@ struct NodeUpdate {
     V8 un = ui + dt * vn;
     if (gravity || !plain(i, fe)) {  // copies: the plain path's values stay in registers
       V8 fi = f_int, v_old = v0, v_new = vn, u_new = un;
-      if (!gravity && quiet(i, fe)) {
-        V8 ff = f, uu = ui;
-        dashpots(i, ff, v_old, uu, v_new, u_new, absorbed);
-      } else {
-        mixed(i, fi, f_ext, u_in, u_out, work, absorbed, v_old, v_new, u_new);
-      }
+      mixed(i, fi, f_ext, u_in, u_out, work, absorbed, v_old, v_new, u_new);
       vn = v_new;
       un = u_new;
     }
