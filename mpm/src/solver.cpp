@@ -1308,6 +1308,14 @@ void Solver::apply_loads() {
 // The dashpot nodes are updated again in the same pass, so the silent layer costs O(boundary).
 namespace {
 
+// Whether the four nodes of these flags are dashpot nodes and free (trapezoidal_dashpots4's
+// first condition, asked before the call).
+inline bool four_free_dashpots(const uint8_t* fix) {
+  std::uint32_t f4;
+  std::memcpy(&f4, fix, sizeof f4);
+  return f4 == 0x01010101u * Grid::kDashpotNode;
+}
+
 // grid_update's pass over nodes [i0, i1): the start velocity p / m (as kernels::nodal_velocity
 // computes it) and the updated one, without reading the nodes' mass and flags twice. Health
 // check at no extra pass: a NaN or Inf anywhere in the particles' mass, momentum or stress
@@ -1481,11 +1489,20 @@ void Solver::grid_update() {
         t.m = m + g; t.px += g; t.py += g; t.fx = fx + g; t.fy = fy + g; t.fix += g;
         t.vx = b[0]; t.vy = b[1]; t.ux = b[2]; t.uy = b[3];
         bad |= t.run(0, 8);
-        for (long j = g; j < ge; ++j) {
-          if (!(u.fix[j] & Grid::kDashpotNode)) continue;
+        for (long j = g; j < ge;) {
           const long l = j - g;
-          trapezoidal_dashpot(j, b[0][l], b[1][l], b[2][l], b[3][l]);
-          if (track) record(j, b[0][l], b[1][l], b[2][l], b[3][l], 0);
+          if (j + 4 <= ge && four_free_dashpots(u.fix + j) &&
+              trapezoidal_dashpots4(j, b[0] + l, b[1] + l, b[2] + l, b[3] + l)) {
+            if (track)
+              for (long k = l; k < l + 4; ++k) record(g + k, b[0][k], b[1][k], b[2][k], b[3][k], 0);
+            j += 4;
+            continue;
+          }
+          if (u.fix[j] & Grid::kDashpotNode) {
+            trapezoidal_dashpot(j, b[0][l], b[1][l], b[2][l], b[3][l]);
+            if (track) record(j, b[0][l], b[1][l], b[2][l], b[3][l], 0);
+          }
+          ++j;
         }
         double* const out[4] = {u.vx, u.vy, u.ux, u.uy};
         for (int a = 0; a < 4; ++a) {
@@ -1496,8 +1513,18 @@ void Solver::grid_update() {
         from = ge;
       } else if (any) {
         bad |= u.run(from, g) | plain.run(g, ge);
-        for (long j = g; j < ge; ++j)
+        for (long j = g; j < ge;) {
+          // Four in a row without a delayed closure: at once (their records then in order).
+          if (!delayed && j + 4 <= ge && four_free_dashpots(u.fix + j) &&
+              trapezoidal_dashpots4(j, u.vx + j, u.vy + j, u.ux + j, u.uy + j)) {
+            if (track)
+              for (long l = j; l < j + 4; ++l) record(l, vx[l], vy[l], ux[l], uy[l], 0);
+            j += 4;
+            continue;
+          }
           if (u.fix[j] & Grid::kDashpotNode) dashpot(j);
+          ++j;
+        }
         from = ge;
       }
       g = ge;
@@ -1581,6 +1608,39 @@ void Solver::trapezoidal_dashpot(long i, double vx, double vy, double& ux, doubl
   if (grid.m[i] <= mass_floor_) return;
   dashpot_velocity(grid.m[i], grid.cxx(i), grid.cxy(i), grid.cyy(i), vx, vy, grid.fx[i],
                    grid.fy[i], dt, grid.fix[i], ux, uy);
+}
+
+// Each lane dashpot_velocity's arithmetic for a free node (the same bits); the four nodes' blocks
+// lie in a row of grid.dash (kDash values a node).
+bool Solver::trapezoidal_dashpots4(long j, const double* vx, const double* vy, double* ux,
+                                   double* uy) const {
+  using kernels::simd::V4;
+  using kernels::simd::load;
+  static_assert(Grid::kDash == 4, "a node's dash values: cxx, cxy, cyy, weight");
+  if (!four_free_dashpots(grid.fix.data() + j)) return false;  // each a dashpot node, free
+  const V4 m = load(grid.m.data() + j);
+  const double floor = mass_floor_;
+  if (!(m[0] > floor && m[1] > floor && m[2] > floor && m[3] > floor)) return false;
+  const double* c = grid.dash.data() + Grid::kDash * j;
+  const V4 c0 = load(c), c1 = load(c + 4), c2 = load(c + 8), c3 = load(c + 12);
+  const V4 lo01 = __builtin_shufflevector(c0, c1, 0, 4, 1, 5);  // cxx0 cxx1 cxy0 cxy1
+  const V4 lo23 = __builtin_shufflevector(c2, c3, 0, 4, 1, 5);
+  const V4 hi01 = __builtin_shufflevector(c0, c1, 2, 6, 3, 7);  // cyy0 cyy1 w0 w1
+  const V4 hi23 = __builtin_shufflevector(c2, c3, 2, 6, 3, 7);
+  const V4 cxx = __builtin_shufflevector(lo01, lo23, 0, 1, 4, 5);
+  const V4 cxy = __builtin_shufflevector(lo01, lo23, 2, 3, 6, 7);
+  const V4 cyy = __builtin_shufflevector(hi01, hi23, 0, 1, 4, 5);
+  const V4 v_x = load(vx), v_y = load(vy);
+  const V4 fx = load(grid.fx.data() + j), fy = load(grid.fy.data() + j);
+  // dashpot_velocity, mask 0.
+  const double DT = dt, h = 0.5 * DT;
+  const V4 rx = m * v_x - h * (cxx * v_x + cxy * v_y) + DT * fx;
+  const V4 ry = m * v_y - h * (cxy * v_x + cyy * v_y) + DT * fy;
+  const V4 A = m + h * cxx, B = h * cxy, D = m + h * cyy;
+  const V4 det = A * D - B * B;
+  kernels::simd::store(ux, (D * rx - B * ry) / det);
+  kernels::simd::store(uy, (A * ry - B * rx) / det);
+  return true;
 }
 
 // MUSL and USF, in particle terms (positions held, one field, FLIP): the nodal velocity is

@@ -1,5 +1,6 @@
 // Bilinear shape functions (exact identities, to round-off), the grid check of moving particles,
-// and the passes that take four particles at a time against the scalar loop (bit for bit).
+// and the passes that take four particles (or the grid update four dashpot nodes) at a time
+// against the scalar loop (bit for bit).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "silentmpm/dashpot.hpp"
 #include "silentmpm/kernels.hpp"
 
 #include "common.hpp"
@@ -369,4 +371,65 @@ TEST(Step, StreamingStoresGiveTheSameBits) {
   EXPECT_EQ(s->store_mode(), -1);
   s->step();
   EXPECT_EQ(s->store_mode(), 0) << "a grid far below the trial's size keeps plain stores";
+}
+
+// The grid update's dashpot nodes (a damping band's, a perfectly matched layer's, an LK end's),
+// four at a time where four in a row are free and heavier than the mass floor: each node's
+// updated velocity equals dashpot_velocity's from its own mass, block, start velocity and force,
+// bit for bit, with plain and with streaming stores, on one and two threads. USL (no dashpot
+// solve follows), and MUSL with the band's nodes that carry no silent weight (the solve replaces
+// the others'). Checked after the update of every step while the pulse crosses the layer.
+TEST(Step, DashpotNodesFourAtATimeAsOneByOne) {
+  struct Check : StepHooks {
+    bool all_nodes = true;  // false: only the nodes without a silent layer's weight
+    long compared = 0, moving = 0, fours = 0, wrong = 0;
+    void after_grid_update(Solver& s) override {
+      const Grid& g = s.grid;
+      const long n = static_cast<long>(g.nodes());
+      auto eligible = [&](long i) {
+        return g.fix[i] == Grid::kDashpotNode && g.m[i] > s.mass_floor();
+      };
+      for (long i = 0; i < n; ++i) {
+        if (!(g.fix[i] & Grid::kDashpotNode) || !(g.m[i] > s.mass_floor())) continue;
+        if (!all_nodes && g.dash_weight(i) > 0) continue;
+        double ux = 0, uy = 0;
+        dashpot_velocity(g.m[i], g.cxx(i), g.cxy(i), g.cyy(i), g.vx[i], g.vy[i], g.fx[i], g.fy[i],
+                         s.dt, g.fix[i], ux, uy);
+        ++compared;
+        moving += ux != 0;
+        wrong += std::memcmp(&ux, &g.vnx[i], sizeof ux) != 0 || std::memcmp(&uy, &g.vny[i], sizeof uy) != 0;
+        if (i + 3 < n && i % 4 == 0 && eligible(i) && eligible(i + 1) && eligible(i + 2) && eligible(i + 3))
+          ++fours;
+      }
+    }
+  };
+  for (const Scheme scheme : {Scheme::USL, Scheme::MUSL})
+  for (const bool pml : {false, true})
+  for (const int mode : {0, 1})
+  for (const int threads : {1, 2}) {
+    if (pml && scheme != Scheme::USL) continue;  // (MUSL damps the layer's particles instead)
+    ColumnSpec spec;
+    spec.scheme = scheme;
+    spec.cells = 40;
+    spec.height = 6;
+    spec.threads = threads;
+    spec.fn = sin2_pulse(2e-6, 1e-6);
+    (pml ? spec.pml_cells : spec.damp_cells) = 12;
+    auto s = make_column(spec);
+    s->streaming = mode;
+    Check check;
+    check.all_nodes = scheme == Scheme::USL;
+    s->attach(&check);
+    for (int k = 0; k < 500; ++k) s->step();
+    s->detach(&check);
+    const std::string c = std::string(scheme_name(scheme)) + (pml ? ", PML" : ", band") +
+                          (mode ? ", streaming" : ", plain") + ", " + std::to_string(threads) +
+                          " thread(s)";
+    EXPECT_EQ(check.wrong, 0) << c;
+    EXPECT_GT(check.moving, check.compared / 4) << c;  // the pulse crossed the layer
+    EXPECT_GT(check.fours, 500L) << c;                // rows of four free dashpot nodes
+    if (mode == 0 && threads == 1)
+      std::printf("  %s: %ld node updates compared (%ld moving), %ld rows of four\n", c.c_str(),
+                  check.compared, check.moving, check.fours);
+  }
 }

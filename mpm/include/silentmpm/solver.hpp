@@ -469,6 +469,10 @@ class Solver {
   // Its trapezoidal update (no delayed closure) from node i's velocity (vx, vy) into (ux, uy);
   // a node not heavier than the mass floor keeps them.
   void trapezoidal_dashpot(long i, double vx, double vy, double& ux, double& uy) const;
+  // The same for nodes j .. j+3 at once, where each is a dashpot node, free and heavier than the
+  // floor (false, and nothing written, otherwise): velocities from vx, vy into ux, uy (four each).
+  bool trapezoidal_dashpots4(long j, const double* vx, const double* vy, double* ux,
+                             double* uy) const;
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
