@@ -538,13 +538,31 @@ struct NodeUpdate {
       if (fe[k] != 0) return false;
     return m4 == 0;
   }
+  // Gravity's work over the step on four nodes, each lane book()'s term, booked in the nodes'
+  // order (v0: their start velocities, vn: their new ones).
+  inline void gravity_work(std::int64_t i, const V8& v0, const V8& vn, double& work) const {
+    V4 mi;
+    std::memcpy(&mi, ms + i, sizeof mi);
+    const V4 vx0 = __builtin_shufflevector(v0, v0, 0, 2, 4, 6);
+    const V4 vy0 = __builtin_shufflevector(v0, v0, 1, 3, 5, 7);
+    const V4 vx = __builtin_shufflevector(vn, vn, 0, 2, 4, 6);
+    const V4 vy = __builtin_shufflevector(vn, vn, 1, 3, 5, 7);
+    const V4 dm = dt * mi;
+    const V4 G = gx * 0.5 * (vx0 + vx) + gy * 0.5 * (vy0 + vy);
+    double w = work;
+    w += dm[0] * G[0];
+    w += dm[1] * G[1];
+    w += dm[2] * G[2];
+    w += dm[3] * G[3];
+    work = w;
+  }
   // Quiet nodes i .. i+3 of which some hold a dashpot block (a damping band's or a PML's
   // nodes, an edge's): those take operator()'s trapezoidal update four at a time, each lane
   // dashpot_velocity's arithmetic for a free node (the same bits), and their absorbed energy
-  // is booked in the nodes' order; the others keep their lanes (f = f_int + fe, v0 and ui the
-  // group's, vn and un four()'s).
-  inline void dashpots(std::int64_t i, const V8& f, const V8& v0, const V8& ui,
-                                  V8& vn, V8& un, double& absorbed) const {
+  // is booked in the nodes' order; the others keep their lanes (f: four()'s, f_int + fe and
+  // gravity; v0 and ui the group's, vn and un four()'s).
+  inline void dashpots(std::int64_t i, const V8& f, const V8& v0, const V8& ui, V8& vn, V8& un,
+                       double& absorbed) const {
     V4 cxx = {0, 0, 0, 0}, cxy = cxx, cyy = cxx, px = cxx, py = cxx;
     bool block[4];
     const std::int32_t d0 = dn[i];
@@ -607,22 +625,29 @@ struct NodeUpdate {
     absorbed = a;
     un = ui + dt * vn;
   }
-  // four()'s nodes where they are not all plain: quiet ones with dashpot blocks among them
-  // through dashpots(), else one by one: the work of each free node without a dashpot,
-  // operator() for the others (vn and un then take what it wrote). Apart, so that the plain
-  // groups keep their registers (and their code: the step's loop is the same with it).
+  // four()'s nodes where they are not all plain (or gravity acts): quiet ones four at a time
+  // (dashpots() where blocks are among them, then gravity's work), else one by one: the work of
+  // each free node without a dashpot, operator() for the others (vn and un then take what it
+  // wrote). Apart, so that the plain groups keep their registers (and their code: the step's
+  // loop is the same with it).
   [[gnu::noinline]] void mixed(std::int64_t i, const V8& f_int, const double* __restrict f_ext,
                                const double* u_in, double* u_out, double& work, double& absorbed,
                                const V8& v0, V8& vn, V8& un) const {
-    if (!gravity) {
-      V8 fe;
-      std::memcpy(&fe, f_ext + 2 * i, sizeof fe);
-      if (quiet(i, fe)) {
+    V8 fe;
+    std::memcpy(&fe, f_ext + 2 * i, sizeof fe);
+    if (quiet(i, fe)) {  // (their f_ext's work terms are zeros)
+      if (std::max(std::max(dn[i], dn[i + 1]), std::max(dn[i + 2], dn[i + 3])) >= 0) {
+        V8 f = f_int + fe;  // four()'s
+        if (gravity) {
+          const V8 g = {gx, gy, gx, gy, gx, gy, gx, gy};
+          f += dup4(ms + i) * g;
+        }
         V8 ui;
         std::memcpy(&ui, u_in + 2 * i, sizeof ui);
-        dashpots(i, f_int + fe, v0, ui, vn, un, absorbed);  // (four()'s f without gravity)
-        return;
+        dashpots(i, f, v0, ui, vn, un, absorbed);
       }
+      if (gravity) gravity_work(i, v0, vn, work);
+      return;
     }
     for (int j = 0; j < 4; ++j) {
       const std::int64_t k = i + j;
