@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <type_traits>
 
 #include "fem_impl.hpp"
 #include "silentmpm/dashpot.hpp"
@@ -666,6 +667,8 @@ struct NodeUpdate {
   // in one register, each lane the single node's arithmetic for a free node without a dashpot;
   // a node with either takes operator() itself, in its place among the four (the work and the
   // absorbed energy booked in the nodes' order), and its lanes then hold what it wrote.
+  // G: gravity acts (the step's loop made for each; a plain group then books its work here).
+  template <bool G>
   inline void four(std::int64_t i, V8 f_int, const double* __restrict f_ext, const double* u_in,
                    double* u_out, double& work, double& absorbed, bool streaming) const {
     V8 fe, v0, ui;
@@ -673,18 +676,20 @@ struct NodeUpdate {
     std::memcpy(&v0, v + 2 * i, sizeof v0);
     std::memcpy(&ui, u_in + 2 * i, sizeof ui);
     V8 f = f_int + fe;
-    if (gravity) {
+    if (G) {
       const V8 g = {gx, gy, gx, gy, gx, gy, gx, gy};
       f += dup4(ms + i) * g;
     }
     const V8 w = dup4(im + i);
     V8 vn = v0 + dt * f * w;
     V8 un = ui + dt * vn;
-    if (gravity || !plain(i, fe)) {  // copies: the plain path's values stay in registers
+    if (!plain(i, fe)) {  // copies: the plain path's values stay in registers
       V8 fi = f_int, v_old = v0, v_new = vn, u_new = un;
       mixed(i, fi, f_ext, u_in, u_out, work, absorbed, v_old, v_new, u_new);
       vn = v_new;
       un = u_new;
+    } else if (G) {
+      gravity_work(i, v0, vn, work);
     }
     std::memcpy(v + 2 * i, &vn, sizeof vn);
     stream(u_out + 2 * i, un, streaming);
@@ -718,7 +723,7 @@ void advance_nodes_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n
 // read from the buffer that no row writes, so the rows' order does not matter. The same sums
 // and products as minus_ku and then advance_nodes_on, so the same bits; the nodal pass then
 // moves neither -K u nor u a second time. Several ranks: this rank's own rows.
-template <bool LIST, bool SHARED>
+template <bool LIST, bool SHARED, bool GRAVITY>
 void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
                    const double* __restrict f_ext, double dt, bool parallel, double& work_out,
                    double& absorbed_out, bool streaming) {
@@ -779,7 +784,7 @@ void fused_step_on(Solver::Impl& m, const std::uint32_t* list, std::int64_t n,
           }
           const V8 fi = -K.times4(r, u);
           stream(f + 2 * r, fi, streaming);
-          node.four(r, fi, f_ext, u, un, work, absorbed, streaming);
+          node.template four<GRAVITY>(r, fi, f_ext, u, un, work, absorbed, streaming);
           r += 4;
           continue;
         }
@@ -869,10 +874,16 @@ void Solver::step() {
   const bool streaming = m.stream_mode == 1 || (m.stream_mode < 0 && (m.stream_trial / 3) % 2 == 1);
   const double start = m.stream_mode < 0 ? omp_get_wtime() : 0.0;
   const double* fe = m.fext.data();
-  if (own && shared) fused_step_on<true, true>(m, own, rows, fe, dt, parallel, work, absorbed, streaming);
-  else if (own) fused_step_on<true, false>(m, own, rows, fe, dt, parallel, work, absorbed, streaming);
-  else if (shared) fused_step_on<false, true>(m, nullptr, rows, fe, dt, parallel, work, absorbed, streaming);
-  else fused_step_on<false, false>(m, nullptr, rows, fe, dt, parallel, work, absorbed, streaming);
+  // (Gravity: the groups' loop made for it, the other one left as it is without.)
+  const auto fused = [&](auto gravity) {
+    constexpr bool G = decltype(gravity)::value;
+    if (own && shared) fused_step_on<true, true, G>(m, own, rows, fe, dt, parallel, work, absorbed, streaming);
+    else if (own) fused_step_on<true, false, G>(m, own, rows, fe, dt, parallel, work, absorbed, streaming);
+    else if (shared) fused_step_on<false, true, G>(m, nullptr, rows, fe, dt, parallel, work, absorbed, streaming);
+    else fused_step_on<false, false, G>(m, nullptr, rows, fe, dt, parallel, work, absorbed, streaming);
+  };
+  if (m.spec.gravity_x != 0 || m.spec.gravity_y != 0) fused(std::true_type{});
+  else fused(std::false_type{});
   if (m.stream_mode < 0) {
     const int k = m.stream_trial;
     if (k % 3 != 0) m.stream_time[(k / 3) % 2][2 * (k / 6) + k % 3 - 1] = omp_get_wtime() - start;
