@@ -298,7 +298,7 @@ Case build_fem_case(const Ctx& ctx, const ojson& doc, bool scatter, bool skeleto
           bc.kind = type == "pml" ? fem::Boundary::Kind::Pml : fem::Boundary::Kind::Damping;
           bc.width = o.num("width");
           o.gt("width", bc.width, 0);
-          bc.r0 = o.num("r0", 1e-3);
+          bc.r0 = o.num("r0", type == "pml" ? kPmlDefaultR0 : 1e-3);
           if (!(bc.r0 > 0 && bc.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(bc.r0));
           bc.power = o.num("power", 2.0);
           o.ge("power", bc.power, 0);

@@ -1325,7 +1325,7 @@ class Builder {
       if (!(band.width <= extent * (1 + 1e-12)))
         o.fail("width", "must be <= the size of body \"" + b.name + "\" normal to its " + side +
                             " (" + fmt(extent) + "), got " + fmt(band.width));
-      band.r0 = o.num("r0", 1e-3);
+      band.r0 = o.num("r0", kPmlDefaultR0);
       if (!(band.r0 > 0 && band.r0 < 1)) o.fail("r0", "must be in (0, 1), got " + fmt(band.r0));
       band.power = o.num("power", 2.0);
       o.ge("power", band.power, 0);

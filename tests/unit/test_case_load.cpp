@@ -170,6 +170,25 @@ TEST(CaseLoad, PmlAlphaAuto) {
   }
 }
 
+// A pml without "r0" takes the case files' default, 5e-3 (kPmlDefaultR0: the r0 at which a 10-cell
+// layer meets both methods' goals at every angle, studies/absorbing), and its "auto" shift follows
+// from it: at 1 particle per cell under MUSL 0.04 sqrt(d0 c_d / h), d0 = 3 c_d ln(200) / (2 width).
+TEST(CaseLoad, PmlDefaultR0) {
+  const fs::path file = write_file("valid_pml_r0.json", kValid);
+  const std::string pml = "boundaries.2={\"type\": \"pml\", \"body\": \"plate\", \"side\": "
+                          "\"left\", \"width\": 0.01, \"alpha\": \"auto\"}";
+  const smpm::Case c = smpm::load_case(
+      file.string(), {"bodies.0.particles_per_cell=1", "boundaries.1.width=0.001", pml});
+  const smpm::Solver& s = *c.solver;
+  ASSERT_EQ(s.pml_bands.size(), 1u);
+  EXPECT_EQ(s.pml_bands[0].r0, 5e-3);
+  EXPECT_EQ(smpm::kPmlDefaultR0, 5e-3);
+  const smpm::Material& m = s.materials[0];
+  const double d0 = 3 * m.cd * std::log(200.0) / (2 * 0.01);
+  const double want = 0.04 * std::sqrt(d0 * m.cd / 0.001);
+  EXPECT_NEAR(s.pml_bands[0].alpha, want, 1e-12 * want);
+}
+
 // A traction on part of a side ("interval"): the layer's particles are those whose centres lie
 // in the interval, and their boundary weights sum to its length, so the load is t (b - a).
 TEST(CaseLoad, TractionOnAnInterval) {
