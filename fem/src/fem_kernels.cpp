@@ -598,14 +598,8 @@ struct NodeUpdate {
     const V4 vy0 = __builtin_shufflevector(v0, v0, 1, 3, 5, 7);
     const V4 fx = __builtin_shufflevector(f, f, 0, 2, 4, 6) + px;
     const V4 fy = __builtin_shufflevector(f, f, 1, 3, 5, 7) + py;
-    // dashpot_velocity, mask 0.
-    const double h = 0.5 * dt;
-    const V4 rx = mi * vx0 - h * (cxx * vx0 + cxy * vy0) + dt * fx;
-    const V4 ry = mi * vy0 - h * (cxy * vx0 + cyy * vy0) + dt * fy;
-    const V4 A = mi + h * cxx, B = h * cxy, Dd = mi + h * cyy;
-    const V4 det = A * Dd - B * B;
-    const V4 vx = (Dd * rx - B * ry) / det;
-    const V4 vy = (A * ry - B * rx) / det;
+    V4 vx, vy;
+    dashpot_velocity_free(mi, cxx, cxy, cyy, vx0, vy0, fx, fy, dt, vx, vy);
     const V4 bx = 0.5 * (vx0 + vx), by = 0.5 * (vy0 + vy);
     const V4 e = bx * (cxx * bx + cxy * by) + by * (cxy * bx + cyy * by) - px * bx - py * by;
     double a = absorbed;  // (in a register)

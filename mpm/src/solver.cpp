@@ -1632,14 +1632,10 @@ bool Solver::trapezoidal_dashpots4(long j, const double* vx, const double* vy, d
   const V4 cyy = __builtin_shufflevector(hi01, hi23, 0, 1, 4, 5);
   const V4 v_x = load(vx), v_y = load(vy);
   const V4 fx = load(grid.fx.data() + j), fy = load(grid.fy.data() + j);
-  // dashpot_velocity, mask 0.
-  const double DT = dt, h = 0.5 * DT;
-  const V4 rx = m * v_x - h * (cxx * v_x + cxy * v_y) + DT * fx;
-  const V4 ry = m * v_y - h * (cxy * v_x + cyy * v_y) + DT * fy;
-  const V4 A = m + h * cxx, B = h * cxy, D = m + h * cyy;
-  const V4 det = A * D - B * B;
-  kernels::simd::store(ux, (D * rx - B * ry) / det);
-  kernels::simd::store(uy, (A * ry - B * rx) / det);
+  V4 ax, ay;
+  dashpot_velocity_free(m, cxx, cxy, cyy, v_x, v_y, fx, fy, dt, ax, ay);
+  kernels::simd::store(ux, ax);
+  kernels::simd::store(uy, ay);
   return true;
 }
 

@@ -42,6 +42,20 @@ inline void dashpot_velocity(double m, double cxx, double cxy, double cyy, doubl
   }
 }
 
+// dashpot_velocity's free case (mask 0) for any arithmetic type T: a double, or a vector of
+// doubles whose lanes are several nodes (each lane then the scalar arithmetic, the same bits).
+template <class T>
+inline void dashpot_velocity_free(T m, T cxx, T cxy, T cyy, T vx, T vy, T fx, T fy, double dt,
+                                  T& ax, T& ay) {
+  const double h = 0.5 * dt;
+  const T rx = m * vx - h * (cxx * vx + cxy * vy) + dt * fx;
+  const T ry = m * vy - h * (cxy * vx + cyy * vy) + dt * fy;
+  const T A = m + h * cxx, B = h * cxy, D = m + h * cyy;
+  const T det = A * D - B * B;
+  ax = (D * rx - B * ry) / det;
+  ay = (A * ry - B * rx) / det;
+}
+
 // Perfectly matched layers (docs/physics.md section 9.3), shared by the FE far field and the
 // particles. psi(t + dt) = e psi(t) + ca g(t) + cb g(t + dt) is the exact solution of
 // psi' = -beta psi + g over one step with g linear in between (recursive convolution with
