@@ -22,7 +22,9 @@
 //
 // The MPM PML runs under USL, timed against a free square under USL too (the other MPM variants
 // use MUSL, the default scheme); with --ppc 4 or 9 also under MUSL, whose layer damps its
-// particles (docs/physics.md section 9.3).
+// particles (docs/physics.md section 9.3). The LK and Kelvin-Voigt edges run under USL as well:
+// there their dashpots act on the trapezoidal mean, under MUSL on the particles' mean, whose solve
+// (docs/physics.md section 4) is most of their cost; the two rows show its price.
 //
 //   build/bench_layers [--cells W] [--layer L] [--steps S] [--rounds R] [--threads T]
 //                      [--only mpm|fem] [--kind lk|kv|damping|pml] [--ppc 1|4|9]
@@ -195,7 +197,7 @@ int main(int argc, char** argv) {
         v.c = load_case_text(mpm_case(o, k, "MUSL"), (dir / "mpm.json").string());
         vs.push_back(std::move(v));
       }
-      for (const char* k : {"free", "pml"}) {
+      for (const char* k : {"free", "lk", "kv", "pml"}) {
         Variant v{"MPM", k, "USL", {}, 0, {}};
         v.c = load_case_text(mpm_case(o, k, "USL"), (dir / "mpm.json").string());
         vs.push_back(std::move(v));

@@ -1288,8 +1288,9 @@ void Solver::apply_loads() {
   if (dist_) sum_halo(false, true);
   // Gravity: f_i += m_i g, the nodal form of sum_p m_p g N_i (the lumped mass is sum_p m_p N_i).
   // On the grid's field; in multi-field contact the bodies' fields differ from it by their own
-  // deviation, in which g cancels.
-  if (opt.gravity_x != 0 || opt.gravity_y != 0) {
+  // deviation, in which g cancels. Without hooks, whose after_forces comes between, grid_update's
+  // pass adds it (the same operation at every node; one pass over the nodes fewer).
+  if ((opt.gravity_x != 0 || opt.gravity_y != 0) && !gravity_in_update()) {
     const double gx = opt.gravity_x, gy = opt.gravity_y;
     const long n = static_cast<long>(grid.nodes());
     const double* m = grid.m.data();
@@ -1322,16 +1323,25 @@ inline bool four_free_dashpots(const uint8_t* fix) {
 // reaches the nodes' updated velocities this step (x - x is 0 only for finite x). Returns 1 if
 // one is not finite. Called with its own copy per thread, so its pointers stay in registers.
 struct NodeUpdate {
-  const double *m, *px, *py, *fx, *fy;
+  const double *m, *px, *py;
+  double *fx, *fy;
   const uint8_t* fix;
   double *vx, *vy, *ux, *uy;
   double floor, dt;
   bool stream;  // the velocities with streaming stores (see stores_stream), SSE2's two halves
+  // Gravity's force first, f += m g at every node (apply_loads' pass, which then does not run).
+  bool gravity;
+  double gx, gy;
   int run(long i0, long i1) const {
-    if (!stream) return run_with<false>(i0, i1);
+    if (gravity) return run_on<true>(i0, i1);
+    return run_on<false>(i0, i1);
+  }
+  template <bool GRAVITY>
+  int run_on(long i0, long i1) const {
+    if (!stream) return run_with<false, GRAVITY>(i0, i1);
     // The first node of four on an even index, as the streaming halves want.
     const long a = std::min(i1, i0 + (i0 & 1));
-    return run_with<false>(i0, a) | run_with<true>(a, i1);
+    return run_with<false, GRAVITY>(i0, a) | run_with<true, GRAVITY>(a, i1);
   }
   template <bool STREAM>
   static void put(double* a, kernels::simd::V4 v) {
@@ -1344,7 +1354,7 @@ struct NodeUpdate {
 #endif
     kernels::simd::store(a, v);
   }
-  template <bool STREAM>
+  template <bool STREAM, bool GRAVITY>
   int run_with(long i0, long i1) const {
     // Four nodes at a time (each lane the scalar loop's operations), then the rest one by one.
     using kernels::simd::V4;
@@ -1354,6 +1364,10 @@ struct NodeUpdate {
     const V4 zero = {0, 0, 0, 0};
     for (; i + 4 <= i1; i += 4) {
       const V4 mi = kernels::simd::load(m + i);
+      if constexpr (GRAVITY) {
+        kernels::simd::store(fx + i, kernels::simd::load(fx + i) + mi * gx);
+        kernels::simd::store(fy + i, kernels::simd::load(fy + i) + mi * gy);
+      }
       M4 hx, hy;
       kernels::simd::held(fix + i, hx, hy);
       const M4 heavy = mi > floor, light = mi <= floor;
@@ -1370,6 +1384,10 @@ struct NodeUpdate {
     int bad = (any_bad[0] | any_bad[1] | any_bad[2] | any_bad[3]) != 0;
     for (; i < i1; ++i) {
       const double mi = m[i];
+      if constexpr (GRAVITY) {
+        fx[i] += mi * gx;
+        fy[i] += mi * gy;
+      }
       const bool heavy = mi > floor;
       const double vxi = heavy && !(fix[i] & 1) ? px[i] / mi : 0.0;
       const double vyi = heavy && !(fix[i] & 2) ? py[i] / mi : 0.0;
@@ -1394,7 +1412,7 @@ void Solver::grid_update() {
   const double* m = grid.m.data();
   const uint8_t* fix = grid.fix.data();
   const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
-  const double* fx = grid.fx.data(); const double* fy = grid.fy.data();
+  double* fx = grid.fx.data(); double* fy = grid.fy.data();
   const double* ux = grid.vnx.data(); const double* uy = grid.vny.data();
   // Streaming in halves of four nodes wants each array 16-byte aligned (as the allocator gives
   // them). The dashpot nodes' lines below are vx's; large arrays, each mapped on its own pages,
@@ -1406,7 +1424,9 @@ void Solver::grid_update() {
     aligned = aligned && reinterpret_cast<std::uintptr_t>(a) % 16 == 0;
   const NodeUpdate nodes{m, grid.px.data(), grid.py.data(), fx, fy, fix, grid.vx.data(),
                          grid.vy.data(), grid.vnx.data(), grid.vny.data(), mass_floor_, dt,
-                         aligned && stores_stream()};
+                         aligned && stores_stream(),
+                         (opt.gravity_x != 0 || opt.gravity_y != 0) && gravity_in_update(),
+                         opt.gravity_x, opt.gravity_y};
   int bad = 0;
   if (!has_nodal_dashpot_) {
 #pragma omp parallel num_threads(nthreads_) reduction(| : bad)

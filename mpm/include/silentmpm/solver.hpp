@@ -465,6 +465,9 @@ class Solver {
   bool pml_damps_particles() const { return opt.scheme != Scheme::USL; }
   template <class S> void pml_advance(const std::vector<double>& vx, const std::vector<double>& vy);
   void grid_update();
+  // Whether grid_update's pass adds gravity's force m g (apply_loads then does not): no hook's
+  // after_forces runs between the two.
+  bool gravity_in_update() const { return hooks_.empty(); }
   int update_dashpot_node(long i, bool delayed, double gx, double gy);
   // Its trapezoidal update (no delayed closure) from node i's velocity (vx, vy) into (ux, uy);
   // a node not heavier than the mass floor keeps them.
