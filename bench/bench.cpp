@@ -13,11 +13,13 @@
 // would need if every byte came from memory; its fraction of the triad says how far the step is
 // from the limit. Where the problem fits in the last-level cache the fraction can pass 1.
 //
-//   build/bench [--quick] [--shape bilinear|gimp|bspline|all] [--threads N,M,...]
-//               [--sizes N,M,...] [--rounds R]
+//   build/bench [--quick] [--shape bilinear|gimp|bspline|all] [--scheme musl|usl|usf]
+//               [--threads N,M,...] [--sizes N,M,...] [--rounds R]
 //     --quick: only the 1e5 size, fewer steps; --shape: the grid shape functions (default
 //     bilinear; all: the three, alternating per size and thread count; the byte count is that of
-//     the bilinear step); --threads: the thread counts to run (default 1 and all; the triad is
+//     the bilinear step); --scheme: the update scheme (default MUSL, whose silent edge's dashpots
+//     act on the particles' mean velocity and solve for it; USL's act on the trapezoidal mean; the
+//     byte count is MUSL's); --threads: the thread counts to run (default 1 and all; the triad is
 //     measured on each); --sizes: about how many particles (default 1e5, 1e6, 4e6; from 1e3 to
 //     1e8); --rounds: how many times each free and silent pair runs, alternating (default 1).
 //     Steps per rate: 200, 30 or 10 by size, times half the thread count from 4 threads on.
@@ -52,6 +54,9 @@ namespace {
 // reaches the edge halfway through the `steps` timed after the 3 of warm-up: the silent edge's
 // dashpots, and their solve's iterations, work while they are timed (a quiet edge costs only its
 // fixed part). The free plate gets the same pulse: the same work per particle.
+// The update scheme of every plate (--scheme).
+Scheme bench_scheme = Scheme::MUSL;
+
 std::unique_ptr<Solver> pulse_plate(double h, bool silent, int threads,
                                     ShapeKind shape = ShapeKind::Bilinear, int steps = 0) {
   auto s = std::make_unique<Solver>();
@@ -76,6 +81,7 @@ std::unique_ptr<Solver> pulse_plate(double h, bool silent, int threads,
   }
   s->opt.threads = threads;
   s->opt.shape = shape;
+  s->opt.scheme = bench_scheme;
   s->dt = 0.237 * h / w.cd;
   if (steps > 0) {
     const double sig = 16 * h / 2.3548, xc = Lx - 0.237 * h * (3 + 0.5 * steps);
@@ -199,6 +205,15 @@ int main(int argc, char** argv) {
                      v.c_str());
         return 1;
       }
+    } else if (std::strcmp(argv[i], "--scheme") == 0 && i + 1 < argc) {
+      const std::string v = argv[++i];
+      if (v == "musl") bench_scheme = Scheme::MUSL;
+      else if (v == "usl") bench_scheme = Scheme::USL;
+      else if (v == "usf") bench_scheme = Scheme::USF;
+      else {
+        std::fprintf(stderr, "bench: --scheme: must be musl, usl or usf, got \"%s\"\n", v.c_str());
+        return 1;
+      }
     } else if ((std::strcmp(argv[i], "--threads") == 0 || std::strcmp(argv[i], "--sizes") == 0 ||
                 std::strcmp(argv[i], "--rounds") == 0) && i + 1 < argc) {
       // A comma-separated list of numbers, each in [lo, hi] (--rounds: one whole number).
@@ -226,17 +241,20 @@ int main(int argc, char** argv) {
       else sizes = list;
     } else {
       std::fprintf(stderr, "bench: unknown argument \"%s\"; usage: bench [--quick] "
-                           "[--shape bilinear|gimp|bspline|all] [--threads N,M,...] [--sizes N,M,...] "
+                           "[--shape bilinear|gimp|bspline|all] [--scheme musl|usl|usf] [--threads N,M,...] "
+                           "[--sizes N,M,...] "
                            "[--rounds R]\n", argv[i]);
       return 1;
     }
   }
   const int all = omp_get_max_threads();
   if (thread_counts.empty()) thread_counts = all > 1 ? std::vector<int>{1, all} : std::vector<int>{1};
-  std::printf("silentmpm bench: pulse plate 50 x 200 mm, tungsten, elastic, MUSL, 1 ppc; a plane "
-              "P pulse crosses the right edge while the steps are timed\n");
+  std::printf("silentmpm bench: pulse plate 50 x 200 mm, tungsten, elastic, %s, 1 ppc; a plane "
+              "P pulse crosses the right edge while the steps are timed\n",
+              scheme_name(bench_scheme));
   std::printf("bytes per particle (particle arrays): %zu\n", Particles::bytes_per_particle());
-  std::printf("bytes one step moves (R read, W written, RW both; per particle + per grid node):\n");
+  std::printf("bytes one %sstep moves (R read, W written, RW both; per particle + per grid node):\n",
+              bench_scheme == Scheme::MUSL ? "" : "MUSL ");
   for (const PassBytes& p : kMuslStep)
     std::printf("  %-20s %4.0f + %4.0f  %s\n", p.pass, p.particle, p.node, p.arrays);
   std::vector<double> triad;
@@ -302,11 +320,12 @@ int main(int argc, char** argv) {
           lo = std::min(lo, f / sr - 1);
           hi = std::max(hi, f / sr - 1);
         }
-        std::printf("# %zu particles, %d thread%s, %s: the silent edge costs %.1f %% over the free "
+        std::printf("# %zu particles, %d thread%s, %s, %s: the silent edge costs %.1f %% over the free "
                     "one (median of %d paired steps; %.1f %% between the steps' 10th "
                     "percentiles; the rates above: %.1f %% between the best of %d round%s, %.1f to "
                     "%.1f %% round by round; its solve %.1f iterations a step)\n",
-                    n, th, th == 1 ? "" : "s", shape_name(shapes[si]), 100 * paired,
+                    n, th, th == 1 ? "" : "s", shape_name(shapes[si]), scheme_name(bench_scheme),
+                    100 * paired,
                     blocks * (block - 1), 100 * lo10, 100 * (best_free / best_silent - 1), rounds,
                     rounds == 1 ? "" : "s", 100 * lo, 100 * hi, solve_iterations);
       }
