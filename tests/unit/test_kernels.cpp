@@ -205,6 +205,18 @@ void expect_same(const KernelState& w, const KernelState& s, const char* pass) {
   EXPECT_TRUE(same_bits(a.vol, b.vol) && same_bits(a.eps_p, b.eps_p)) << pass << ": volumes";
   for (int i = 0; i < 11; ++i) EXPECT_TRUE(same_bits(w.a[i], s.a[i])) << pass << ": nodal array " << i;
 }
+
+// Two solvers' particles (positions, velocities, stresses) and energy account (absorbed,
+// external work), bit for bit.
+void expect_same_run(const Solver& a, const Solver& b, const std::string& what) {
+  const Particles &p = a.p, &q = b.p;
+  EXPECT_TRUE(same_bits(p.x, q.x) && same_bits(p.y, q.y)) << what;
+  EXPECT_TRUE(same_bits(p.vx, q.vx) && same_bits(p.vy, q.vy)) << what;
+  EXPECT_TRUE(same_bits(p.sxx, q.sxx) && same_bits(p.syy, q.syy) && same_bits(p.sxy, q.sxy)) << what;
+  const double e0[] = {a.energy.absorbed, a.energy.external_work};
+  const double e1[] = {b.energy.absorbed, b.energy.external_work};
+  EXPECT_EQ(std::memcmp(e0, e1, sizeof e0), 0) << what;
+}
 }  // namespace
 
 class Kernels : public ::testing::TestWithParam<int> {};
@@ -353,15 +365,9 @@ TEST(Step, StreamingStoresGiveTheSameBits) {
       EXPECT_EQ(run[mode]->store_mode(), mode);
       for (int i = 0; i < 100; ++i) run[mode]->step();
     }
-    const Particles &p = run[0]->p, &q = run[1]->p;
     const std::string c = std::string(scheme_name(scheme)) + ", " + std::to_string(threads) +
                           " threads, " + (end == End::Free ? "free end" : "silent end");
-    EXPECT_TRUE(same_bits(p.x, q.x) && same_bits(p.y, q.y)) << c;
-    EXPECT_TRUE(same_bits(p.vx, q.vx) && same_bits(p.vy, q.vy)) << c;
-    EXPECT_TRUE(same_bits(p.sxx, q.sxx) && same_bits(p.syy, q.syy) && same_bits(p.sxy, q.sxy)) << c;
-    const double e0[] = {run[0]->energy.absorbed, run[0]->energy.external_work};
-    const double e1[] = {run[1]->energy.absorbed, run[1]->energy.external_work};
-    EXPECT_EQ(std::memcmp(e0, e1, sizeof e0), 0) << c;
+    expect_same_run(*run[0], *run[1], c);
     if (end == End::Silent) {
       EXPECT_GT(run[0]->energy.absorbed, 0.0) << c;
     }
@@ -403,16 +409,11 @@ TEST(Step, GravityInTheGridUpdateAsInItsOwnPass) {
       for (int i = 0; i < 100; ++i) run[hooked]->step();
       if (hooked) run[hooked]->detach(&nothing);
     }
-    const Particles &p = run[0]->p, &q = run[1]->p;
+    const Particles& p = run[0]->p;
     const std::string c = std::string(scheme_name(scheme)) + (band ? ", band" : ", LK end") +
                           (mode ? ", streaming, " : ", plain, ") + std::to_string(threads) +
                           " thread(s)";
-    EXPECT_TRUE(same_bits(p.x, q.x) && same_bits(p.y, q.y)) << c;
-    EXPECT_TRUE(same_bits(p.vx, q.vx) && same_bits(p.vy, q.vy)) << c;
-    EXPECT_TRUE(same_bits(p.sxx, q.sxx) && same_bits(p.syy, q.syy) && same_bits(p.sxy, q.sxy)) << c;
-    const double e0[] = {run[0]->energy.absorbed, run[0]->energy.external_work};
-    const double e1[] = {run[1]->energy.absorbed, run[1]->energy.external_work};
-    EXPECT_EQ(std::memcmp(e0, e1, sizeof e0), 0) << c;
+    expect_same_run(*run[0], *run[1], c);
     // Gravity acted (along +x): against the same column without it, the particles' momentum
     // grew by more than a tenth of M g t (the end's dashpot takes back less than half of it
     // while its wave has not crossed the column).
