@@ -939,41 +939,64 @@ void Solver::pml_loads() {
   constexpr int K = S::kNodes;
   const bool nodal = !pml_damps_particles();
   if (nodal) has_nodal_dashpot_ = true;
+  // The arrays as local pointers: add_dashpot_node's flag stores (bytes, which may alias
+  // anything) would otherwise have every array's address loaded again for each particle.
+  const uint32_t* __restrict idx = P.layer.idx.data();
+  const long* __restrict nodes_of = P.nodes.data();
+  const double* __restrict N_of = P.N.data();
+  const double* __restrict dNx_of = P.dNx.data();
+  const double* __restrict dNy_of = P.dNy.data();
+  const double* __restrict H_of = P.H.data();
+  double* __restrict xi_of = P.xi.data();
+  const double* __restrict cx_of = P.cx.data();
+  const double* __restrict cy_of = P.cy.data();
+  const double* __restrict pdx = P.dx.data();
+  const double* __restrict pdy = P.dy.data();
+  const double* __restrict pu = P.u.data();
+  double* __restrict zeta = P.zeta.data();
+  double* __restrict f_of = P.f.data();
+  const double* __restrict vol = p.vol.data();
+  const double* __restrict mass = p.mass.data();
+  const auto* __restrict group = p.group.data();
+  double* __restrict gfx = grid.fx.data();
+  double* __restrict gfy = grid.fy.data();
+  double* __restrict dash = grid.dash.data();
+  const double alpha = P.alpha, e_a = P.e_a, ca_a = P.ca_a, cb_a = P.cb_a;
   for (std::size_t q = 0; q < n; ++q) {
-    const uint32_t k = P.layer.idx[q];
-    const long* nodes = P.nodes.data() + K * q;
-    const double* N = P.N.data() + K * q;
-    const double* dNx = P.dNx.data() + K * q;
-    const double* dNy = P.dNy.data() + K * q;
-    const Material& m = materials[p.group[k]];
+    const uint32_t k = idx[q];
+    const long* nodes = nodes_of + K * q;
+    const double* N = N_of + K * q;
+    const double* dNx = dNx_of + K * q;
+    const double* dNy = dNy_of + K * q;
+    const Material& m = materials[group[k]];
     const double L = m.lambda + 2 * m.mu, mu = m.mu;
-    const double* H = P.H.data() + 4 * q;
-    double* xi = P.xi.data() + 4 * q;
-    const double* cx = P.cx.data() + 3 * q;
-    const double* cy = P.cy.data() + 3 * q;
+    const double* H = H_of + 4 * q;
+    double* xi = xi_of + 4 * q;
+    const double* cx = cx_of + 3 * q;
+    const double* cy = cy_of + 3 * q;
     const double pxx = xi[0] + cx[2] * H[0], pxy = xi[1] + cx[2] * H[1];
     const double pyx = xi[2] + cy[2] * H[2], pyy = xi[3] + cy[2] * H[3];
     xi[0] = cx[0] * pxx + cx[1] * H[0];
     xi[1] = cx[0] * pxy + cx[1] * H[1];
     xi[2] = cy[0] * pyx + cy[1] * H[2];
     xi[3] = cy[0] * pyy + cy[1] * H[3];
-    const double kx = (P.dy[q] - P.dx[q]) * p.vol[k];
-    double* f = P.f.data() + 6 * q;
+    const double kx = (pdy[q] - pdx[q]) * vol[k];
+    double* f = f_of + 6 * q;
     f[0] = kx * L * pxx;
     f[1] = kx * mu * pxy;
     f[2] = -kx * mu * pyx;
     f[3] = -kx * L * pyy;
-    const double sum = P.dx[q] + P.dy[q], prod = P.dx[q] * P.dy[q];
+    const double sum = pdx[q] + pdy[q], prod = pdx[q] * pdy[q];
     for (int c = 0; c < 2; ++c)
-      f[4 + c] = p.mass[k] * pml_mass_term(sum, prod, P.alpha, P.u[2 * q + c],
-                                           P.zeta.data() + 4 * q + 2 * c, P.e_a, P.ca_a, P.cb_a);
-    const double cm = sum * p.mass[k];
+      f[4 + c] = mass[k] * pml_mass_term(sum, prod, alpha, pu[2 * q + c], zeta + 4 * q + 2 * c,
+                                         e_a, ca_a, cb_a);
+    const double cm = sum * mass[k];
     for (int a = 0; a < K; ++a) {
-      grid.fx[nodes[a]] += f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
-      grid.fy[nodes[a]] += f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
+      gfx[nodes[a]] += f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
+      gfy[nodes[a]] += f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
       if (!nodal) continue;
-      grid.cxx(nodes[a]) += cm * N[a];
-      grid.cyy(nodes[a]) += cm * N[a];
+      dash[Grid::kDash * nodes[a]] += cm * N[a];
+      dash[Grid::kDash * nodes[a] + 2] += cm * N[a];
       add_dashpot_node(nodes[a]);
     }
   }
@@ -1076,15 +1099,20 @@ void Solver::pml_advance(const std::vector<double>& vx, const std::vector<double
     const double* dNy = pml.dNy.data() + K * q;
     double* H = pml.H.data() + 4 * q;
     double* u = pml.u.data() + 2 * q;
+    // The sums in registers (the stores to H and u could otherwise alias the velocities'
+    // loads); each term added in the same order.
+    double h0 = H[0], h1 = H[1], h2 = H[2], h3 = H[3], u0 = u[0], u1 = u[1];
     for (int a = 0; a < K; ++a) {
       const double wx = vx[nodes[a]], wy = vy[nodes[a]];
-      H[0] += dt * dNx[a] * wx;
-      H[1] += dt * dNx[a] * wy;
-      H[2] += dt * dNy[a] * wx;
-      H[3] += dt * dNy[a] * wy;
-      u[0] += dt * N[a] * wx;
-      u[1] += dt * N[a] * wy;
+      h0 += dt * dNx[a] * wx;
+      h1 += dt * dNx[a] * wy;
+      h2 += dt * dNy[a] * wx;
+      h3 += dt * dNy[a] * wy;
+      u0 += dt * N[a] * wx;
+      u1 += dt * N[a] * wy;
     }
+    H[0] = h0; H[1] = h1; H[2] = h2; H[3] = h3;
+    u[0] = u0; u[1] = u1;
   }
 }
 
