@@ -342,8 +342,12 @@ bool pml_tensor_weights(const double* g, double* w) {
 // derivatives blended from the four edge differences, and the forces gathered the same way
 // (each point's x part, summed over the points of a row, goes to the row's edge difference;
 // each y part, summed over a column, to the column's).
-inline void pml_cell_tensor(Solver::Impl::Pml& P, std::int64_t c, const double* __restrict u,
-                            const std::int32_t* __restrict dn, double* __restrict f) {
+// (Inlined into the cells' loop: GCC kept it a call per cell, 6.6-7.0 free cells per layer cell
+// against 6.2-6.5 inlined, the same bits.)
+__attribute__((always_inline)) inline void pml_cell_tensor(Solver::Impl::Pml& P, std::int64_t c,
+                                                           const double* __restrict u,
+                                                           const std::int32_t* __restrict dn,
+                                                           double* __restrict f) {
   const std::uint32_t* cn = P.cell_nodes.data() + c * 4;
   const double* w = P.tensor_w.data() + 8 * static_cast<std::size_t>(P.shape[c]);
   V2 U[4];
