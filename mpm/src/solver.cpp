@@ -2391,11 +2391,13 @@ void Solver::boundary_work(bool remapped) {
       const double* dNx = pml.dNx.data() + K * q;
       const double* dNy = pml.dNy.data() + K * q;
       const double* f = pml.f.data() + 6 * q;
+      // (The loads in registers: T's stores could alias them.)
+      const double f0 = f[0], f1 = f[1], f2 = f[2], f3 = f[3], f4 = f[4], f5 = f[5];
       for (int a = 0; a < K; ++a) {
         double bx, by;
         wbar(pn[a], bx, by);
-        const double fx = f[4] * N[a] - (f[0] * dNx[a] + f[2] * dNy[a]);
-        const double fy = f[5] * N[a] - (f[1] * dNx[a] + f[3] * dNy[a]);
+        const double fx = f4 * N[a] - (f0 * dNx[a] + f2 * dNy[a]);
+        const double fy = f5 * N[a] - (f1 * dNx[a] + f3 * dNy[a]);
         T[a] = dt * (fx * bx + fy * by);
       }
     }, energy.absorbed, true);
