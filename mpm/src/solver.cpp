@@ -1975,6 +1975,7 @@ void Solver::consistent_dashpots() {
   for (std::size_t t = 0; t < nh; ++t)
     std::copy_n(cm_ps_.data() + K * cm_hits_[t], K, cm_key_next_.data() + K * t);
   if (cm_key_next_ != cm_key_ || cm_cnt_.size() != ns) {
+    // A new pattern; its products are summed as they are listed (the order of the pass below).
     cm_key_.clear();  // (no pattern, should the build below throw)
     cm_pair_.clear();
     cm_cnt_.assign(ns, 0);
@@ -1982,6 +1983,8 @@ void Solver::consistent_dashpots() {
     cm_w_.resize(kCmRow * ns);
     for (std::size_t t = 0; t < nh; ++t) {
       const int* sls = cm_key_next_.data() + K * t;
+      const std::uint32_t q = cm_hits_[t];
+      const double* N = cm_pN_.data() + K * q;
       for (int a = 0; a < K; ++a) {
         const int i = sls[a];
         if (i < 0) continue;
@@ -1994,19 +1997,22 @@ void Solver::consistent_dashpots() {
           if (e == cm_cnt_[i]) {
             if (e == kCmRow) throw std::logic_error("consistent_dashpots: a row of more than 24 slots");
             ci[e] = j;
+            cm_w_[kCmRow * i + e] = 0.0;
             ++cm_cnt_[i];
           }
           cm_pair_.push_back({kCmRow * i + e, static_cast<int>(t), a, b});
+          cm_w_[kCmRow * i + e] += cm_pm_[q] * N[a] * N[b];
         }
       }
     }
     cm_key_.swap(cm_key_next_);
-  }
-  for (std::size_t i = 0; i < ns; ++i) std::fill_n(cm_w_.data() + kCmRow * i, cm_cnt_[i], 0.0);
-  for (const CmPair& c : cm_pair_) {
-    const std::uint32_t q = cm_hits_[c.hit];
-    const double* N = cm_pN_.data() + K * q;
-    cm_w_[c.place] += cm_pm_[q] * N[c.a] * N[c.b];
+  } else {
+    for (std::size_t i = 0; i < ns; ++i) std::fill_n(cm_w_.data() + kCmRow * i, cm_cnt_[i], 0.0);
+    for (const CmPair& c : cm_pair_) {
+      const std::uint32_t q = cm_hits_[c.hit];
+      const double* N = cm_pN_.data() + K * q;
+      cm_w_[c.place] += cm_pm_[q] * N[c.a] * N[c.b];
+    }
   }
   // Each slot's equation as an affine map, vbar = b - Q o (Q = P / (2 m), P the inverse of
   // I + kappa C on the free components, b = P (v + 1/2 Mc dv0 / m)), and its g = G vbar
