@@ -2028,7 +2028,10 @@ void Solver::consistent_dashpots() {
   double* vby = vbx + nsp;
   double* ox = cm_o_.data();
   double* oy = ox + nsp;
-  for (std::size_t k = 0; k < ns; ++k) {
+  // Each slot its own: in parallel, the same values.
+  const long nsl = static_cast<long>(ns);
+#pragma omp parallel for schedule(static) num_threads(nthreads_) if (nsl >= 256)
+  for (long k = 0; k < nsl; ++k) {
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
     double* n = cm_node_.data() + k;  // n[nsp * c]: column c
     const double* c = cm_.data() + kCm * k;
@@ -2160,7 +2163,6 @@ void Solver::consistent_dashpots() {
     dashpot_solve.max_iterations = std::max(dashpot_solve.max_iterations, static_cast<long>(it + 1));
   }
   // Each slot its own: in parallel, the same values.
-  const long nsl = static_cast<long>(ns);
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nsl >= 256)
   for (long k = 0; k < nsl; ++k) {
     const long i = cm_nodes_[k];
