@@ -20,30 +20,8 @@ inline void lk_block(double zn, double zt, double nx, double ny, double& bxx, do
   byy = zn * ny * ny + zt * (1 - ny * ny);
 }
 
-inline void dashpot_velocity(double m, double cxx, double cxy, double cyy, double vx, double vy,
-                             double fx, double fy, double dt, std::uint8_t mask, double& ax,
-                             double& ay) {
-  const double h = 0.5 * dt;
-  const double rx = m * vx - h * (cxx * vx + cxy * vy) + dt * fx;
-  const double ry = m * vy - h * (cxy * vx + cyy * vy) + dt * fy;
-  const double A = m + h * cxx, B = h * cxy, D = m + h * cyy;
-  ax = 0;
-  ay = 0;
-  switch (mask & 3) {
-    case 0: {
-      const double det = A * D - B * B;
-      ax = (D * rx - B * ry) / det;
-      ay = (A * ry - B * rx) / det;
-      break;
-    }
-    case 1: ay = ry / D; break;  // x held: solve for y alone
-    case 2: ax = rx / A; break;  // y held
-    default: break;
-  }
-}
-
-// dashpot_velocity's free case (mask 0) for any arithmetic type T: a double, or a vector of
-// doubles whose lanes are several nodes (each lane then the scalar arithmetic, the same bits).
+// The free case (mask 0) for any arithmetic type T: a double (dashpot_velocity's), or a vector
+// of doubles whose lanes are several nodes (each lane then the scalar arithmetic, the same bits).
 template <class T>
 inline void dashpot_velocity_free(T m, T cxx, T cxy, T cyy, T vx, T vy, T fx, T fy, double dt,
                                   T& ax, T& ay) {
@@ -54,6 +32,27 @@ inline void dashpot_velocity_free(T m, T cxx, T cxy, T cyy, T vx, T vy, T fx, T 
   const T det = A * D - B * B;
   ax = (D * rx - B * ry) / det;
   ay = (A * ry - B * rx) / det;
+}
+
+// The update of one node (the free components of `mask`; a held one is zero).
+inline void dashpot_velocity(double m, double cxx, double cxy, double cyy, double vx, double vy,
+                             double fx, double fy, double dt, std::uint8_t mask, double& ax,
+                             double& ay) {
+  if ((mask & 3) == 0) {
+    dashpot_velocity_free(m, cxx, cxy, cyy, vx, vy, fx, fy, dt, ax, ay);
+    return;
+  }
+  const double h = 0.5 * dt;
+  const double rx = m * vx - h * (cxx * vx + cxy * vy) + dt * fx;
+  const double ry = m * vy - h * (cxy * vx + cyy * vy) + dt * fy;
+  const double A = m + h * cxx, D = m + h * cyy;
+  ax = 0;
+  ay = 0;
+  switch (mask & 3) {
+    case 1: ay = ry / D; break;  // x held: solve for y alone
+    case 2: ax = rx / A; break;  // y held
+    default: break;
+  }
 }
 
 // Perfectly matched layers (docs/physics.md section 9.3), shared by the FE far field and the
