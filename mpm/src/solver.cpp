@@ -1511,6 +1511,11 @@ void Solver::grid_update() {
   // and no closure is delayed, a whole line goes through a buffer instead, below). The runs
   // between go whole, streamed where the step streams: whole lines, never a line shared with
   // plain stores.
+  // The lines that hold a dashpot node, as bits: line l holds nodes [8 l - 8 + phase, 8 l + phase).
+  auto line_of = [phase](long i) { return (i + 8 - phase) / 8; };
+  dash_lines_.assign(static_cast<std::size_t>(line_of(n - 1) / 64 + 1), 0);
+  for (const long i : dashpot_nodes_) dash_lines_[line_of(i) / 64] |= 1ull << (line_of(i) % 64);
+  const std::uint64_t* lines = dash_lines_.data();
 #pragma omp parallel num_threads(nthreads_) reduction(| : bad)
   {
     const NodeUpdate u = nodes;
@@ -1519,16 +1524,21 @@ void Solver::grid_update() {
     long i0, i1;
     omp_range(n, i0, i1);
     long from = i0;
-    for (long g = i0; g < i1;) {
-      const long ge = std::min(i1, g + 8 - (((g - phase) % 8) + 8) % 8);  // the next line's start
-      bool any = false;
-      if (ge - g == 8) {  // the flags eight at a time
-        std::uint64_t w;
-        std::memcpy(&w, u.fix + g, 8);
-        any = (w & (0x0101010101010101ull * Grid::kDashpotNode)) != 0;
-      } else {
-        for (long j = g; j < ge; ++j) any = any || (u.fix[j] & Grid::kDashpotNode);
+    // Each marked line within [i0, i1), in order; a line cut by the range's ends takes only
+    // its part (whose own flags say whether it holds a dashpot node).
+    const long l0 = i0 < i1 ? line_of(i0) : 0, l1 = i0 < i1 ? line_of(i1 - 1) : -1;
+    for (long l = l0; l <= l1;) {
+      std::uint64_t w = lines[l / 64] >> (l % 64);
+      if (w == 0) {
+        l = (l / 64 + 1) * 64;
+        continue;
       }
+      l += __builtin_ctzll(w);
+      if (l > l1) break;
+      const long g = std::max(i0, 8 * l - 8 + phase), ge = std::min(i1, 8 * l + phase);
+      ++l;
+      bool any = ge - g == 8;
+      for (long j = g; j < ge && !any; ++j) any = (u.fix[j] & Grid::kDashpotNode) != 0;
       if (any && u.stream && !delayed && ge - g == 8) {
         // A whole line, streamed as the runs around it: its eight nodes' velocities into a
         // buffer, its dashpot nodes' update there (update_dashpot_node without a delayed
@@ -1578,7 +1588,6 @@ void Solver::grid_update() {
         }
         from = ge;
       }
-      g = ge;
     }
     bad |= u.run(from, i1);
     if (u.stream) fence();
