@@ -91,8 +91,9 @@ bool root() { return smpm::process_rank() == 0; }
 int run_main(int argc, char** argv) {
   CLI::App app{
       "silentmpm - explicit 2D plane-strain MPM with the Lysmer-Kuhlemeyer silent boundary layer "
-      "of Shen & Chen (2005).\nCase files are JSON in SI units; every key is documented in "
-      "docs/case-reference.md."};
+      "of Shen & Chen (2005), a finite-element far field (deal.II) and the two coupled; LK, "
+      "Kelvin-Voigt, damping-band and PML boundaries in both.\nCase files are JSON in SI units; "
+      "every key is documented in docs/case-reference.md."};
   app.footer("Exit status: 0 success; 1 bad input (case file, command line, restart file); "
              "2 the run failed (instability, I/O error: DIR/RUN_INCOMPLETE says why); "
              "3 interrupted by SIGINT/SIGTERM (a checkpoint was written: continue with --restart).");
