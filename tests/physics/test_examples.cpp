@@ -109,8 +109,9 @@ TEST(Examples, HalfSpaceEnergyBalanceCloses) {
 // receiver within the 80 us), relative L2 of each receiver's columns over the run, the same
 // 12 us pulse in each. Measured: MPM PML 0.30-0.57 %, LK 10.5-15.9 %; FE PML 0.34-0.59 %.
 // And the two methods against each other, both with their PMLs: 3.4 % at the deep receiver
-// (1.1 % with 1 mm cells), 19-34 % at the surface ones, where MPM's Rayleigh wave converges
-// about as h (4-11 % with 1 mm cells; FE's own change from 2 to 1 mm 2-7 %). Bounds: each PML
+// (1.1 % with 1 mm cells), 19-34 % at the surface ones, where MPM's Rayleigh wave carries about
+// five times FE's error at the same cells, both falling as h^2 (studies/absorbing/README.md,
+// "What it means"). Bounds: each PML
 // column within 1.5 % (the half-space goal), LK's mean at least 5 times the MPM PML's, the two
 // methods within 5 % at depth.
 TEST(Examples, HalfSpacePmlAgainstTheExtendedDomain) {
