@@ -1511,7 +1511,8 @@ void Solver::grid_update() {
   // and no closure is delayed, a whole line goes through a buffer instead, below). The runs
   // between go whole, streamed where the step streams: whole lines, never a line shared with
   // plain stores.
-  // The lines that hold a dashpot node, as bits: line l holds nodes [8 l - 8 + phase, 8 l + phase).
+  // The lines that hold a dashpot node, as bits: line l holds nodes [8 l - 8 + phase,
+  // 8 l + phase).
   auto line_of = [phase](long i) { return (i + 8 - phase) / 8; };
   dash_lines_.assign(static_cast<std::size_t>(line_of(n - 1) / 64 + 1), 0);
   for (const long i : dashpot_nodes_) dash_lines_[line_of(i) / 64] |= 1ull << (line_of(i) % 64);

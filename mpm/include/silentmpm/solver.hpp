@@ -263,8 +263,8 @@ class Solver {
   // grid.fix (Grid::kDashpotNode) with its index in the list.
   std::vector<long> dashpot_nodes_;
   std::vector<int> dashpot_index_;
-  // grid_update: a bit per cache line of the velocity arrays that holds a dashpot node (set and
-  // cleared there, from dashpot_nodes_), so that its pass finds those lines without reading
+  // grid_update: a bit per cache line of the velocity arrays that holds a dashpot node (made
+  // afresh each step from dashpot_nodes_), so that its pass finds those lines without reading
   // every node's flags.
   std::vector<std::uint64_t> dash_lines_;
   std::vector<double> dn_work_;        // boundary_work: each node's terms (scratch)
