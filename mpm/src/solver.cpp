@@ -160,6 +160,16 @@ void Solver::finalize() {
     whole_y0_ = grid.y0;
   }
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
+  // The mass correction (correct_increments): MUSL and USF, whose particles are strained with
+  // the velocity they map back (USL strains them with the corrected v+, whose largest
+  // eigenvalues need half the time step), on one velocity field.
+  if (opt.mass_correction < 0 || opt.mass_correction > 8)
+    throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
+                                std::to_string(opt.mass_correction));
+  if (opt.mass_correction > 0 && opt.scheme == Scheme::USL)
+    throw std::invalid_argument("mass_correction: needs MUSL or USF");
+  if (opt.mass_correction > 0 && contact.multi())
+    throw std::invalid_argument("mass_correction: not with multi-field contact");
   for (const Material& m : materials)
     if (m.model == Model::J2Film && !p.has_film()) p.enable_film();
   nstrips_ = 2 * nthreads_;
@@ -2473,6 +2483,56 @@ void Solver::merge_rows(int s, const RowSpan& r) {
   strip_hi_[s] = std::max(strip_hi_[s], r.hi);
 }
 
+// The consistent-mass correction of the increment (docs/physics.md section 1.1). Under MUSL
+// and USF the velocity the particles map back to a node after their FLIP update is v + R dv, R
+// = M^-1 M_c (M the lumped mass, M_c = N^T m N the particles' consistent mass), so the grid's
+// waves move as if each node weighed M R^-1: the scheme's frequencies are those of the lumped
+// mass times the square root of R's eigenvalue, 1 - (kh)^2 / 12 and below. The increment taken
+// as sum_{j=0..k} (I - R)^j dv, the first k + 1 terms of R^-1 dv, leaves (I - R)^(k+1) of that
+// error. Each term costs one pass over the particles (a gather and a scatter); a held component
+// and a void node take none.
+template <class S>
+void Solver::correct_increments() {
+  const long n = static_cast<long>(grid.nodes());
+  for (auto* v : {&mc_tx_, &mc_ty_, &mc_ax_, &mc_ay_}) v->resize(static_cast<std::size_t>(n));
+  double* tx = mc_tx_.data(); double* ty = mc_ty_.data();
+  double* ax = mc_ax_.data(); double* ay = mc_ay_.data();
+  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
+  double* ux = grid.vnx.data(); double* uy = grid.vny.data();
+  const double* m = grid.m.data();
+  const uint8_t* fix = grid.fix.data();
+  const double floor = mass_floor_;
+#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
+  for (long i = 0; i < n; ++i) {
+    const bool heavy = m[i] > floor;
+    tx[i] = heavy && !(fix[i] & 1) ? ux[i] - vx[i] : 0.0;
+    ty[i] = heavy && !(fix[i] & 2) ? uy[i] - vy[i] : 0.0;
+  }
+  const VelocityField& F = fields_.front();
+  for (int term = 0; term < opt.mass_correction; ++term) {
+#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
+    for (long i = 0; i < n; ++i) {
+      ax[i] = 0;
+      ay[i] = 0;
+    }
+    scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int) {
+      kernels::consistent_mass_product<S>(grid, p, b, e, inv_rho(g), tx, ty, ax, ay);
+    });
+    if (dist_) {
+      double* const sums[2] = {ax, ay};
+      dist_->sum_halo(sums, 2, nullptr);
+    }
+#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
+    for (long i = 0; i < n; ++i) {
+      const bool heavy = m[i] > floor;
+      tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
+      ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
+      ux[i] += tx[i];
+      uy[i] += ty[i];
+    }
+  }
+}
+
 // Particle velocities from every field (FLIP/PIC blend); MUSL re-maps the particle momenta to
 // the field at the same positions; USF moves the particles here.
 template <class S>
@@ -2676,6 +2736,7 @@ void Solver::step_with() {
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
   if (consistent_) consistent_dashpots<S>();
+  if (opt.mass_correction > 0) correct_increments<S>();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
   bool remapped_power = sc == Scheme::MUSL || (sc == Scheme::USF && usf_remapped_power());
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });

@@ -43,6 +43,7 @@ struct ColumnSpec {
   double pml_alpha = 0;
   bool updated_edge = false;  // MUSL: strain with the updated velocity at the end's dashpot nodes
   bool delayed_edge = false;  // MUSL, USF: the delayed closure at the end's dashpot nodes
+  int mass_correction = 0;    // MUSL, USF: terms of the consistent-mass correction
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -98,6 +99,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
   s->opt.shape = c.shape;
   s->opt.threads = c.threads;
   s->opt.gravity_x = c.gravity;
+  s->opt.mass_correction = c.mass_correction;
   s->dt = c.cfl * c.h / s->materials[0].cd;
   s->finalize();
   return s;

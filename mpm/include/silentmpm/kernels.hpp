@@ -931,6 +931,35 @@ inline double update_stress(const Grid& g, Particles& p, uint32_t b, uint32_t e,
   return diss;
 }
 
+// The consistent mass matrix of particles [b, e) times a nodal vector field t: a_i += sum_p m_p
+// N_i(x_p) sum_j N_j(x_p) t_j (one gather and one scatter per particle; Solver::correct_increments).
+template <class Shape>
+inline void consistent_mass_product(const Grid& g, const Particles& p, uint32_t b, uint32_t e,
+                                    double inv_rho, const double* tx, const double* ty, double* ax,
+                                    double* ay) {
+  const double ih = g.inv_h;
+  const long nnx = g.nnx;
+  const double* X = p.x.data(); const double* Y = p.y.data();
+  const double* M = p.mass.data();
+  Shape sf;
+  long nodes[Shape::kNodes];
+  for (uint32_t k = b; k < e; ++k) {
+    if constexpr (Shape::kSized) sf.size(M[k], inv_rho, ih);
+    sf.eval(g, X[k], Y[k]);
+    sf.node_indices(nnx, nodes);
+    double ux = 0, uy = 0;
+    for (int a = 0; a < Shape::kNodes; ++a) {
+      ux += sf.N[a] * tx[nodes[a]];
+      uy += sf.N[a] * ty[nodes[a]];
+    }
+    const double mx = M[k] * ux, my = M[k] * uy;
+    for (int a = 0; a < Shape::kNodes; ++a) {
+      ax[nodes[a]] += mx * sf.N[a];
+      ay[nodes[a]] += my * sf.N[a];
+    }
+  }
+}
+
 // fn(node index) over the nodes of a box, rows in parallel.
 template <class Fn>
 inline void for_box(const NodeBox& bx, long nnx, int threads, Fn&& fn) {

@@ -58,6 +58,10 @@ struct SolverOptions {
   // (initial + |external work|); 0 turns it off (the hybrid does: energy also enters through
   // its FE region).
   double energy_bound = 10;
+  // MUSL and USF, one velocity field: the number of terms k of the consistent-mass correction
+  // of the grid's increment (correct_increments; docs/physics.md section 1.1). 0 keeps the
+  // lumped mass's increment.
+  int mass_correction = 0;
 };
 
 struct ProbeSample {
@@ -480,6 +484,12 @@ class Solver {
   // floor (false, and nothing written, otherwise): velocities from vx, vy into ux, uy (four each).
   bool trapezoidal_dashpots4(long j, const double* vx, const double* vy, double* ux,
                              double* uy) const;
+  // The grid's increment v+ - v replaced with sum_{j=0..k} (I - R)^j (v+ - v), R = M^-1 M_c the
+  // lumped mass's inverse times the particles' consistent mass, k = opt.mass_correction: the
+  // velocity the particles then map back to the grid has nearly taken the lumped mass's
+  // increment (docs/physics.md section 1.1). Held components and void nodes take none.
+  template <class S> void correct_increments();
+  std::vector<double> mc_tx_, mc_ty_, mc_ax_, mc_ay_;  // its term and product (per node)
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made

@@ -1,0 +1,110 @@
+// The MPM step's dispersion relation in closed form (docs/physics.md section 1.1): a standing
+// wave of a free column, every particle started on the grid's interpolant of cos(kx), follows a
+// two-term recurrence whose coefficients the scheme, the particles per cell and the mass
+// correction fix exactly; and the mass correction's effect on a wave's travel time.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "common.hpp"
+
+using namespace smpm;
+using namespace smpm::testing;
+
+namespace {
+
+struct Recurrence {
+  double trace = 0, det = 0;  // A[n+1] = trace A[n] - det A[n-1]
+};
+
+// The column's mode n (wavenumber n pi / L) from rest with velocity amplitude v0: the
+// recurrence fitted by least squares to 400 steps of the mode's amplitude on the particles.
+Recurrence fit_mode(const ColumnSpec& c, int n, double& kh, double& x) {
+  auto s = make_column(c);
+  const double L = c.cells * c.h, k = n * M_PI / L, v0 = 1e-3;
+  const Grid& g = s->grid;
+  // The grid's interpolant (no part of the particles' velocity outside the grid's picture).
+  for (std::size_t q = 0; q < s->p.size(); ++q) {
+    const double f = (s->p.x[q] - g.x0) / g.h;
+    const double i = std::floor(f), a = f - i;
+    s->p.vx[q] = v0 * ((1 - a) * std::cos(k * g.node_x(static_cast<int>(i))) +
+                       a * std::cos(k * g.node_x(static_cast<int>(i) + 1)));
+    s->p.vy[q] = 0;
+  }
+  auto amplitude = [&] {
+    double a = 0;
+    for (std::size_t q = 0; q < s->p.size(); ++q) a += s->p.mass[q] * s->p.vx[q] * std::cos(k * s->p.x0[q]);
+    return a;
+  };
+  std::vector<double> A{amplitude()};
+  for (int step = 0; step < 400; ++step) {
+    s->step();
+    A.push_back(amplitude());
+  }
+  double s11 = 0, s12 = 0, s22 = 0, r1 = 0, r2 = 0;
+  for (std::size_t i = 1; i + 1 < A.size(); ++i) {
+    s11 += A[i] * A[i]; s12 += A[i] * A[i - 1]; s22 += A[i - 1] * A[i - 1];
+    r1 += A[i] * A[i + 1]; r2 += A[i - 1] * A[i + 1];
+  }
+  const double d = s11 * s22 - s12 * s12;
+  const double cd = s->materials[0].cd;
+  kh = k * c.h;
+  x = std::pow(s->dt * 2 * cd / c.h * std::sin(kh / 2), 2);  // (dt omega_lumped-static)^2
+  return {(r1 * s22 - r2 * s12) / d, -(s11 * r2 - s12 * r1) / d};
+}
+
+// R's eigenvalue for a wave along x: the consistent mass over the lumped one of particles at
+// the centres of the ppc x ppc sub-cells, 1 - (2 / ppc) sum_j xi_j (1 - xi_j) (1 - cos kh).
+double mass_ratio(int ppc, double kh) {
+  double sum = 0;
+  for (int j = 0; j < ppc; ++j) {
+    const double xi = (j + 0.5) / ppc;
+    sum += xi * (1 - xi);
+  }
+  return 1 - 2.0 / ppc * sum * (1 - std::cos(kh));
+}
+
+}  // namespace
+
+// With x = (dt omega)^2 of the lumped-mass grid (omega = 2 c_d / h sin(kh / 2)) and r = R's
+// eigenvalue: MUSL and USF A[n+1] = (2 - rho x) A[n] - A[n-1] with rho = 1 - (1 - r)^(k+1) for k
+// terms of the mass correction (rho = r without it); USL (no correction) trace 2 - x, det
+// 1 - (1 - r) x. Measured to 1e-12 of the trace; bound 1e-9 (and on the determinant).
+TEST(Dispersion, ColumnModeFollowsTheSchemesClosedForm) {
+  struct Run { Scheme scheme; int terms; };
+  const Run runs[] = {{Scheme::MUSL, 0}, {Scheme::USF, 0}, {Scheme::USL, 0},
+                      {Scheme::MUSL, 1}, {Scheme::USF, 1}, {Scheme::MUSL, 2}};
+  for (const Run& run : runs)
+    for (const int ppc : {1, 2, 3})
+      for (const int n : {4, 10}) {
+        ColumnSpec c;
+        c.cells = 40;
+        c.height = 2;
+        c.ppc_side = ppc;
+        c.end = End::Free;
+        c.amplitude = 0;
+        c.cells_beyond = 2;
+        c.scheme = run.scheme;
+        c.mass_correction = run.terms;
+        double kh = 0, x = 0;
+        const Recurrence f = fit_mode(c, n, kh, x);
+        const double r = mass_ratio(ppc, kh);
+        Recurrence cf;
+        if (run.scheme == Scheme::USL) {
+          cf = {2 - x, 1 - (1 - r) * x};
+        } else {
+          const double rho = 1 - std::pow(1 - r, run.terms + 1);
+          cf = {2 - rho * x, 1};
+        }
+        // The frequency over the lumped mass's (FE Q1's) at this step.
+        const double ratio = std::acos(f.trace / (2 * std::sqrt(f.det))) / std::acos(1 - x / 2);
+        std::printf("  [%s, %d terms, %d ppc, kh %.3f] trace %.12f (closed form %.12f), det %.12f"
+                    " (%.12f); frequency over the lumped mass's %.5f\n",
+                    scheme_name(run.scheme), run.terms, ppc * ppc, kh, f.trace, cf.trace, f.det,
+                    cf.det, ratio);
+        EXPECT_NEAR(f.trace, cf.trace, 1e-9) << scheme_name(run.scheme) << " " << ppc * ppc;
+        EXPECT_NEAR(f.det, cf.det, 1e-9) << scheme_name(run.scheme) << " " << ppc * ppc;
+      }
+}
