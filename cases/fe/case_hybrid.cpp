@@ -124,6 +124,10 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
     }
     throw CaseError(msg);
   }
+  if (c.solver && c.solver->opt.mass_correction > 0)
+    ctx.fail("scheme.mass_correction", "is not available in a hybrid (MPM + FEM) case (the "
+                                       "interface nodes carry the far field's mass, not their "
+                                       "particles')");
 
   // FEM probes: the same checks as the FEM parser's.
   std::vector<ProbeSpec> all;

@@ -286,6 +286,7 @@ void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {
   j["scheme"] = scheme_name(s.opt.scheme);
   j["shape"] = shape_name(s.opt.shape);
   j["flip"] = s.opt.flip;
+  j["mass_correction"] = s.opt.mass_correction;
   j["grid"] = {{"origin", {s.grid.x0, s.grid.y0}}, {"cells", {s.grid.nx, s.grid.ny}}, {"cell", s.grid.h}};
 }
 

@@ -42,6 +42,10 @@ TEST(HybridCase, ErrorsNameTheKey) {
   c["fem"]["size"] = 0.5 * h;  // FE spacing h/2 at the interface
   EXPECT_NE(case_error(c).find("h.json: fem: hybrid: FE node"), std::string::npos) << case_error(c);
   c = plate_case("hybrid");
+  c["scheme"]["mass_correction"] = 1;  // the interface nodes' mass is not their particles'
+  EXPECT_NE(case_error(c).find("h.json: scheme.mass_correction: is not available in a hybrid"),
+            std::string::npos) << case_error(c);
+  c = plate_case("hybrid");
   c["time"]["dt"] = 2 * h / cd;
   EXPECT_NE(case_error(c).find("time.dt"), std::string::npos) << case_error(c);
   c = plate_case("hybrid");
