@@ -58,6 +58,7 @@ struct PlateSpec {
   bool updated = false;        // MUSL, USF: the LK edges strained with the updated velocity
   bool delayed = false;        // MUSL, USF: the LK edges with the delayed closure (1 ppc)
   bool skeleton = false;       // the case without its particles (Solver::seed_nothing)
+  int mass_correction = 0;     // MUSL, USF: terms of the consistent-mass correction
 };
 
 // A tungsten plate on a grid with margins: a sin^2 pressure pulse on its top edge, LK silent
@@ -121,6 +122,7 @@ std::unique_ptr<Solver> make_plate(const PlateSpec& c) {
   if (!c.other_layers) s->silents.push_back(kv);
   s->opt.scheme = c.scheme;
   s->opt.shape = c.shape;
+  s->opt.mass_correction = c.mass_correction;
   s->opt.threads = 1;
   s->dt = 0.3 * h / s->materials[0].cd;
   s->finalize();
@@ -282,6 +284,18 @@ TEST(Ranks, PulsePlateAgreesWithOneProcessEveryScheme) {
     c.springs = false;
     c.delayed = true;
     const Outcome s = expect_layouts_agree(c, 200, std::string(scheme_name(sc)) + ", delayed edges");
+    EXPECT_GT(s.e.absorbed, 0.01 * s.e.external_work) << "the pulse reached the silent layers";
+  }
+}
+
+// The consistent-mass correction: each term's product summed over the halo before the nodes
+// divide it by their mass (two terms, the LK and Kelvin-Voigt edges, MUSL and USF).
+TEST(Ranks, MassCorrectionAgreesWithOneProcess) {
+  for (Scheme sc : {Scheme::MUSL, Scheme::USF}) {
+    PlateSpec c;
+    c.scheme = sc;
+    c.mass_correction = 2;
+    const Outcome s = expect_layouts_agree(c, 200, std::string(scheme_name(sc)) + ", mass correction");
     EXPECT_GT(s.e.absorbed, 0.01 * s.e.external_work) << "the pulse reached the silent layers";
   }
 }
