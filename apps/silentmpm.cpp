@@ -238,9 +238,13 @@ int run_main(int argc, char** argv) {
       std::printf("  particles %zu, grid %d x %d cells of %g m, dt %g s (CFL %.3f), %ld steps\n",
                   s.p.size(), s.grid.nx, s.grid.ny, s.grid.h, s.dt, s.dt / s.critical_dt(),
                   static_cast<long>(std::ceil(c.t_end / s.dt - 1e-9)));
-      std::printf("  scheme %s, shape %s, flip %g; %zu traction(s), %zu silent layer(s), "
+      const std::string mc = s.opt.mass_correction > 0
+                                 ? ", mass correction " + std::to_string(s.opt.mass_correction) +
+                                       " term(s)"
+                                 : "";
+      std::printf("  scheme %s, shape %s, flip %g%s; %zu traction(s), %zu silent layer(s), "
                   "%zu constraint(s), %zu probe(s)\n", smpm::scheme_name(s.opt.scheme),
-                  smpm::shape_name(s.opt.shape), s.opt.flip, s.tractions.size(),
+                  smpm::shape_name(s.opt.shape), s.opt.flip, mc.c_str(), s.tractions.size(),
                   s.silents.size(), s.constraints.size(), c.probes.size());
       for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
       return 0;
