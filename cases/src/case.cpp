@@ -326,6 +326,7 @@ struct BodySpec {
   int ppc = 1;
   double vx = 0, vy = 0;
   int surface = -1;  // body from a gmsh physical surface: index into Geometry::surfaces
+  Solver::Seeding seeding = Solver::Seeding::Uniform;
 };
 
 const std::vector<std::string> kSides = {"left", "right", "bottom", "top"};
@@ -912,7 +913,7 @@ class Builder {
     const double tol = 1e-6 * grid_.h;
     for (std::size_t i = 0; i < arr.size(); ++i) {
       Obj o(ctx_, arr[i], index_path("bodies", i));
-      o.allow({"name", "material", "box", "surface", "particles_per_cell", "velocity"});
+      o.allow({"name", "material", "box", "surface", "particles_per_cell", "seeding", "velocity"});
       BodySpec b;
       b.name = o.str("name");
       if (b.name.empty()) o.fail("name", "must not be empty");
@@ -943,6 +944,23 @@ class Builder {
         if (n != 1 && n != 4 && n != 9)
           o.fail("particles_per_cell", "must be 1, 4 or 9, got " + std::to_string(n));
         b.ppc = static_cast<int>(n);
+      }
+      // Where in each cell the particles sit (docs/physics.md section 1.1): the centres of its
+      // n x n sub-cells, or its n x n Gauss points (FE's quadrature), each with its weight's
+      // share of the cell.
+      if (o.choice("seeding", {"uniform", "gauss"}, "uniform") == "gauss") {
+        b.seeding = Solver::Seeding::Gauss;
+        if (s_->opt.shape == ShapeKind::UGimp)
+          o.fail("seeding", "\"gauss\" is for point particles: under scheme.shape \"gimp\" each "
+                            "particle is a square of its initial size, and squares about the "
+                            "Gauss points do not tile the cell");
+        if (b.surface < 0)
+          for (const double w : {b.x1 - b.x0, b.y1 - b.y0})
+            if (std::abs(w / grid_.h - std::round(w / grid_.h)) > 1e-6)
+              o.fail("seeding", "\"gauss\" needs a box of whole cells (its Gauss points are each "
+                                "cell's), got " + fmt((b.x1 - b.x0) / grid_.h) + " x " +
+                                fmt((b.y1 - b.y0) / grid_.h) + " cells of " + fmt(grid_.h) +
+                                " m");
       }
       const auto v = o.nums("velocity", std::vector<double>{0.0, 0.0});
       b.vx = v[0];
@@ -1125,7 +1143,7 @@ class Builder {
       const std::size_t added =
           b.surface >= 0 ? seed_body_surface(i, n)
                          : s_->seed_rectangle(b.x0, b.y0, b.x1, b.y1, n, b.material,
-                                              static_cast<int>(i), b.vx, b.vy);
+                                              static_cast<int>(i), b.vx, b.vy, b.seeding);
       if (added == 0)
         ctx_.fail(index_path("bodies", i) + (b.surface >= 0 ? ".surface" : ".box"),
                   "seeds no particle");
@@ -1632,7 +1650,7 @@ class Builder {
     const BodySpec& b = bodies_[i];
     try {
       return seed_surface(*s_, *geo_, geo_->surfaces[b.surface], n, b.material,
-                          static_cast<int>(i), b.vx, b.vy);
+                          static_cast<int>(i), b.vx, b.vy, b.seeding);
     } catch (const GeometryError& e) {
       ctx_.fail(index_path("bodies", i) + ".surface", e.what());
     }

@@ -166,7 +166,7 @@ inline bool in_box(const BodyRegion& r, double x, double y) {
 // ---------------------------------------------------------------------------------------------
 
 std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface& s, int n,
-                         int group, int body, double vx0, double vy0) {
+                         int group, int body, double vx0, double vy0, Seeding seeding) {
   const Grid& G = sol.grid;
   const auto b = g.bounds(s);
   const double tol = 1e-6 * G.h;
@@ -187,6 +187,15 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
   const long j0 = lo(b[1], G.y0, NY), j1 = hi(b[3], G.y0, NY);
   const long W = i1 - i0 + 1, H = j1 - j0 + 1;
   std::vector<uint8_t> mark(static_cast<std::size_t>(W) * H, 0);
+  // Sub-lattice point i's position: the sub-cell's centre, or Gauss point i % n of cell i / n
+  // (within 0.06 h of the centre: the elements' ranges below widen by one).
+  const bool gauss = seeding == Seeding::Gauss;
+  std::vector<double> gat(static_cast<std::size_t>(n)), gw(static_cast<std::size_t>(n));
+  for (int q = 0; q < n; ++q) Solver::gauss_point(n, q, gat[q], gw[q]);
+  auto pos = [&](long i, double o) {
+    return gauss ? o + (static_cast<double>(i / n) + gat[i % n]) * G.h : o + (i + 0.5) * sp;
+  };
+  const long widen = gauss ? 1 : 0;
   for (const auto& e : s.elems) {
     double ex0 = HUGE_VAL, ey0 = HUGE_VAL, ex1 = -HUGE_VAL, ey1 = -HUGE_VAL;
     for (int k = 0; k < 4; ++k) {
@@ -194,14 +203,16 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
       ex0 = std::min(ex0, g.x[e[k]]); ey0 = std::min(ey0, g.y[e[k]]);
       ex1 = std::max(ex1, g.x[e[k]]); ey1 = std::max(ey1, g.y[e[k]]);
     }
-    const long a0 = lo(ex0, G.x0, NX), a1 = hi(ex1, G.x0, NX);
-    const long c0 = lo(ey0, G.y0, NY), c1 = hi(ey1, G.y0, NY);
+    const long a0 = std::max(i0, lo(ex0, G.x0, NX) - widen);
+    const long a1 = std::min(i1, hi(ex1, G.x0, NX) + widen);
+    const long c0 = std::max(j0, lo(ey0, G.y0, NY) - widen);
+    const long c1 = std::min(j1, hi(ey1, G.y0, NY) + widen);
     for (long j = c0; j <= c1; ++j) {
-      const double py = G.y0 + (j + 0.5) * sp;
+      const double py = pos(j, G.y0);
       for (long i = a0; i <= a1; ++i) {
         uint8_t& m = mark[static_cast<std::size_t>(j - j0) * W + (i - i0)];
         if (m) continue;
-        if (in_element(g, e, G.x0 + (i + 0.5) * sp, py)) m = 1;
+        if (in_element(g, e, pos(i, G.x0), py)) m = 1;
       }
     }
   }
@@ -216,8 +227,8 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
   for (long j = j0; j <= j1; ++j)
     for (long i = i0; i <= i1; ++i) {
       if (!mark[static_cast<std::size_t>(j - j0) * W + (i - i0)]) continue;
-      p.place(k, G.x0 + (i + 0.5) * sp, G.y0 + (j + 0.5) * sp, sp * sp, rho, vx0, vy0, body,
-              group);
+      const double vol = gauss ? gw[i % n] * gw[j % n] * G.h * G.h : sp * sp;
+      p.place(k, pos(i, G.x0), pos(j, G.y0), vol, rho, vx0, vy0, body, group);
       ++k;
     }
   return count;

@@ -50,18 +50,54 @@ const char* model_name(Model m) {
 // Setup
 // ------------------------------------------------------------------------------------------
 
+void Solver::gauss_point(int n, int j, double& at, double& weight) {
+  if (n == 1) {
+    at = 0.5;
+    weight = 1;
+  } else if (n == 2) {
+    at = 0.5 + (j == 0 ? -0.5 : 0.5) / std::sqrt(3.0);
+    weight = 0.5;
+  } else if (n == 3) {
+    at = 0.5 + 0.5 * (j - 1) * std::sqrt(0.6);
+    weight = j == 1 ? 8.0 / 18.0 : 5.0 / 18.0;
+  } else {
+    throw std::invalid_argument("gauss_point: 1 to 3 points per cell side, got " +
+                                std::to_string(n));
+  }
+}
+
 std::size_t Solver::seed_rectangle(double x0, double y0, double x1, double y1, int n, int group,
-                                   int body, double vx0, double vy0) {
+                                   int body, double vx0, double vy0, Seeding seeding) {
   const double sp = grid.h / n;
   const long cx = std::max(1L, std::lround((x1 - x0) / sp));
   const long cy = std::max(1L, std::lround((y1 - y0) / sp));
   const double dx = (x1 - x0) / cx, dy = (y1 - y0) / cy;
   const double rho = materials.at(group).rho;
+  if (seeding == Seeding::Gauss && (cx % n != 0 || cy % n != 0))
+    throw std::invalid_argument("seed_rectangle: Gauss points need a whole number of cells, got " +
+                                std::to_string((x1 - x0) / grid.h) + " x " +
+                                std::to_string((y1 - y0) / grid.h));
   if (seed_nothing) return cx * cy;
   const std::size_t first = p.size();
   p.resize(first + cx * cy);
   ++order_version_;
   std::size_t k = first;
+  if (seeding == Seeding::Gauss) {
+    // Sub-lattice point i lies in cell i / n at its Gauss point i % n.
+    const double wx = n * dx, wy = n * dy;
+    for (long j = 0; j < cy; ++j) {
+      double ay, sy;
+      gauss_point(n, static_cast<int>(j % n), ay, sy);
+      for (long i = 0; i < cx; ++i, ++k) {
+        double ax, sx;
+        gauss_point(n, static_cast<int>(i % n), ax, sx);
+        p.place(k, x0 + (static_cast<double>(i / n) + ax) * wx,
+                y0 + (static_cast<double>(j / n) + ay) * wy, sx * sy * wx * wy, rho, vx0, vy0,
+                body, group);
+      }
+    }
+    return cx * cy;
+  }
   for (long j = 0; j < cy; ++j)
     for (long i = 0; i < cx; ++i, ++k)
       p.place(k, x0 + (i + 0.5) * dx, y0 + (j + 0.5) * dy, dx * dy, rho, vx0, vy0, body, group);

@@ -44,6 +44,7 @@ struct ColumnSpec {
   bool updated_edge = false;  // MUSL: strain with the updated velocity at the end's dashpot nodes
   bool delayed_edge = false;  // MUSL, USF: the delayed closure at the end's dashpot nodes
   int mass_correction = 0;    // MUSL, USF: terms of the consistent-mass correction
+  Seeding seeding = Seeding::Uniform;  // the particles at the sub-cells' centres or Gauss points
 };
 
 // A column [offset, offset + cells h] x [0, height h] of tungsten loaded on its left end.
@@ -52,7 +53,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
   s->materials.push_back(tungsten());
   const double L = c.cells * c.h;
   s->grid.init(-2 * c.h, 0.0, c.h, c.cells + 2 + c.cells_beyond, c.height);
-  s->seed_rectangle(c.offset, 0, c.offset + L, c.height * c.h, c.ppc_side, 0, 0, 0, 0);
+  s->seed_rectangle(c.offset, 0, c.offset + L, c.height * c.h, c.ppc_side, 0, 0, 0, 0, c.seeding);
   const double top = c.height * c.h;
   const uint8_t mask = c.shear ? 1 : 2;
   s->constraints.push_back({"bottom", s->nodes_in_box(-1, 0, 1, 0), mask});

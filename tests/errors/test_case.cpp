@@ -405,6 +405,22 @@ std::vector<Bad> bad_cases() {
                       {"side", "bottom"}, {"delta", 0.01}};
        },
        "boundaries[2]: the kelvin_voigt edge \"base\" lies on particles of 1 per cell"},
+      // Gauss seeding: a box of whole cells, point particles.
+      {"seeding_unknown", [](ojson& j) { j["bodies"][0]["seeding"] = "gauss_legendre"; },
+       "bodies[0].seeding: must be one of \"uniform\", \"gauss\", got \"gauss_legendre\""},
+      {"seeding_gauss_part_cells",
+       [](ojson& j) {
+         j["bodies"][0]["seeding"] = "gauss";
+         j["bodies"][0]["box"] = {0, 0, 0.01, 0.0045};
+       },
+       "bodies[0].seeding: \"gauss\" needs a box of whole cells (its Gauss points are each "
+       "cell's), got 10 x 4.5 cells of 0.001 m"},
+      {"seeding_gauss_gimp",
+       [](ojson& j) {
+         j["scheme"]["shape"] = "gimp";
+         j["bodies"][0]["seeding"] = "gauss";
+       },
+       "bodies[0].seeding: \"gauss\" is for point particles"},
       // The delayed closure: MUSL or USF, the nodal form, LK a = b = 1, 1 particle per cell, the
       // edge on a grid line along an axis.
       {"delayed_under_usl",

@@ -56,14 +56,17 @@ Recurrence fit_mode(const ColumnSpec& c, int n, double& kh, double& x) {
 }
 
 // R's eigenvalue for a wave along x: the consistent mass over the lumped one of particles at
-// the centres of the ppc x ppc sub-cells, 1 - (2 / ppc) sum_j xi_j (1 - xi_j) (1 - cos kh).
-double mass_ratio(int ppc, double kh) {
+// xi_j with shares w_j of the cell side, 1 - 2 sum_j w_j xi_j (1 - xi_j) (1 - cos kh): at the
+// centres of the ppc x ppc sub-cells (w_j = 1 / ppc), or at the Gauss points (then 2/3 + 1/3 cos
+// kh from 4 ppc on, FE's consistent mass).
+double mass_ratio(int ppc, double kh, Seeding seeding) {
   double sum = 0;
   for (int j = 0; j < ppc; ++j) {
-    const double xi = (j + 0.5) / ppc;
-    sum += xi * (1 - xi);
+    double xi = (j + 0.5) / ppc, w = 1.0 / ppc;
+    if (seeding == Seeding::Gauss) Solver::gauss_point(ppc, j, xi, w);
+    sum += w * xi * (1 - xi);
   }
-  return 1 - 2.0 / ppc * sum * (1 - std::cos(kh));
+  return 1 - 2 * sum * (1 - std::cos(kh));
 }
 
 }  // namespace
@@ -73,9 +76,15 @@ double mass_ratio(int ppc, double kh) {
 // terms of the mass correction (rho = r without it); USL (no correction) trace 2 - x, det
 // 1 - (1 - r) x. Measured to 1e-12 of the trace; bound 1e-9 (and on the determinant).
 TEST(Dispersion, ColumnModeFollowsTheSchemesClosedForm) {
-  struct Run { Scheme scheme; int terms; };
+  struct Run {
+    Scheme scheme;
+    int terms;
+    Seeding seeding = Seeding::Uniform;
+  };
   const Run runs[] = {{Scheme::MUSL, 0}, {Scheme::USF, 0}, {Scheme::USL, 0},
-                      {Scheme::MUSL, 1}, {Scheme::USF, 1}, {Scheme::MUSL, 2}};
+                      {Scheme::MUSL, 1}, {Scheme::USF, 1}, {Scheme::MUSL, 2},
+                      {Scheme::MUSL, 0, Seeding::Gauss}, {Scheme::USL, 0, Seeding::Gauss},
+                      {Scheme::MUSL, 2, Seeding::Gauss}};
   for (const Run& run : runs)
     for (const int ppc : {1, 2, 3})
       for (const int n : {4, 10}) {
@@ -88,9 +97,10 @@ TEST(Dispersion, ColumnModeFollowsTheSchemesClosedForm) {
         c.cells_beyond = 2;
         c.scheme = run.scheme;
         c.mass_correction = run.terms;
+        c.seeding = run.seeding;
         double kh = 0, x = 0;
         const Recurrence f = fit_mode(c, n, kh, x);
-        const double r = mass_ratio(ppc, kh);
+        const double r = mass_ratio(ppc, kh, run.seeding);
         Recurrence cf;
         if (run.scheme == Scheme::USL) {
           cf = {2 - x, 1 - (1 - r) * x};
@@ -100,10 +110,11 @@ TEST(Dispersion, ColumnModeFollowsTheSchemesClosedForm) {
         }
         // The frequency over the lumped mass's (FE Q1's) at this step.
         const double ratio = std::acos(f.trace / (2 * std::sqrt(f.det))) / std::acos(1 - x / 2);
-        std::printf("  [%s, %d terms, %d ppc, kh %.3f] trace %.12f (closed form %.12f), det %.12f"
-                    " (%.12f); frequency over the lumped mass's %.5f\n",
-                    scheme_name(run.scheme), run.terms, ppc * ppc, kh, f.trace, cf.trace, f.det,
-                    cf.det, ratio);
+        std::printf("  [%s, %d terms, %d ppc%s, kh %.3f] trace %.12f (closed form %.12f), det "
+                    "%.12f (%.12f); frequency over the lumped mass's %.5f\n",
+                    scheme_name(run.scheme), run.terms, ppc * ppc,
+                    run.seeding == Seeding::Gauss ? " at the Gauss points" : "", kh, f.trace,
+                    cf.trace, f.det, cf.det, ratio);
         EXPECT_NEAR(f.trace, cf.trace, 1e-9) << scheme_name(run.scheme) << " " << ppc * ppc;
         EXPECT_NEAR(f.det, cf.det, 1e-9) << scheme_name(run.scheme) << " " << ppc * ppc;
       }

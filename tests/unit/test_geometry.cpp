@@ -118,6 +118,43 @@ TEST(GeometrySeeding, RectangleExact) {
   }
 }
 
+// Gauss seeding (docs/physics.md section 1.1): each cell's n x n Gauss-Legendre points, the
+// weights' shares of the cell; the box and the gmsh rectangle give the same particles. Each cell
+// integrates x^(2n-1) y^(2n-1) exactly (the rule's degree), and its particles' volumes sum to
+// the cell's.
+TEST(GeometrySeeding, GaussPointsOfEachCell) {
+  auto s = make_solver();
+  const Geometry g = load_geometry(write_file("rect_gauss.geo", kRectangle).string(), 0.5 * kH);
+  for (int n : {1, 2, 3}) {
+    s->p.resize(0);
+    const std::size_t added = seed_surface(*s, g, g.surfaces[0], n, 0, 0, 0, 0, Seeding::Gauss);
+    EXPECT_EQ(added, static_cast<std::size_t>(200 * n * n)) << "n = " << n;
+    Solver ref;
+    ref.materials = s->materials;
+    ref.grid = s->grid;
+    ref.seed_rectangle(0, 0, 0.02, 0.01, n, 0, 0, 0, 0, Seeding::Gauss);
+    ASSERT_EQ(ref.p.size(), s->p.size());
+    // Per cell: the volume and the moment of x^(2n-1) y^(2n-1) about the cell's corner.
+    const double h = s->grid.h;
+    std::vector<double> vol(200, 0.0), mom(200, 0.0);
+    double dmax = 0;
+    for (std::size_t k = 0; k < ref.p.size(); ++k) {
+      dmax = std::max({dmax, std::fabs(ref.p.x[k] - s->p.x[k]), std::fabs(ref.p.y[k] - s->p.y[k]),
+                       std::fabs(ref.p.vol[k] - s->p.vol[k])});
+      const double cx = std::floor(ref.p.x[k] / h), cy = std::floor(ref.p.y[k] / h);
+      const auto c = static_cast<std::size_t>(cy * 20 + cx);
+      const double u = ref.p.x[k] / h - cx, v = ref.p.y[k] / h - cy;
+      vol[c] += ref.p.vol[k];
+      mom[c] += ref.p.vol[k] * std::pow(u, 2 * n - 1) * std::pow(v, 2 * n - 1);
+    }
+    EXPECT_LT(dmax, 1e-15) << "n = " << n;
+    for (std::size_t c = 0; c < 200; ++c) {
+      EXPECT_NEAR(vol[c], h * h, 1e-12 * h * h) << "n = " << n << ", cell " << c;
+      EXPECT_NEAR(mom[c], h * h / (4.0 * n * n), 1e-12 * h * h) << "n = " << n << ", cell " << c;
+    }
+  }
+}
+
 // Seeded area against the exact one: the error is a boundary effect, bounded by half a lattice
 // spacing times the perimeter; in practice far below it.
 void check_area(const Geometry& g, double exact_area, double perimeter, const char* what) {

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "silentmpm/boundary.hpp"
+#include "silentmpm/particles.hpp"
 
 namespace smpm {
 
@@ -93,9 +94,11 @@ Geometry load_geometry_groups(const std::string& file, double size,
 // Lattice seeding of surface `s` into solver `sol` (grid already initialised, materials set):
 // points grid.x0 + (i + 1/2) h / n, grid.y0 + (j + 1/2) h / n inside an element, volume
 // (h / n)^2, mass rho (h / n)^2. Returns the number of particles added. Throws GeometryError if
-// the surface reaches outside the grid.
+// the surface reaches outside the grid. Seeding::Gauss takes each grid cell's n x n
+// Gauss-Legendre points instead (Solver::gauss_point), each with its weights' share of h^2.
 std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface& s, int n_per_side,
-                         int group, int body, double vx0, double vy0);
+                         int group, int body, double vx0, double vy0,
+                         Seeding seeding = Seeding::Uniform);
 
 // Which side of a curve the body lies on: the body's surface (for a body seeded from the
 // geometry) or its box.

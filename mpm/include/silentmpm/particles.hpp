@@ -7,6 +7,10 @@
 
 namespace smpm {
 
+// Where a body's particles sit in each cell: the centres of its n x n sub-cells, or its n x n
+// Gauss-Legendre points (Solver::seed_rectangle, docs/physics.md section 1.1).
+enum class Seeding { Uniform, Gauss };
+
 struct Particles {
   std::vector<double> x, y;          // position
   std::vector<double> x0, y0;        // position where it was seeded (displacement = x - x0)

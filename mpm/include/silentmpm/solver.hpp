@@ -113,9 +113,17 @@ class Solver {
   bool seed_nothing = false;
   // Fill the rectangle [x0, x1] x [y0, y1] with particles on a lattice of n x n per cell
   // (n = 1, 2, 3), spacing adjusted so the rectangle is covered exactly. Returns the number added
-  // (with seed_nothing, the number it would add).
+  // (with seed_nothing, the number it would add). Seeding::Gauss puts them at the n x n
+  // Gauss-Legendre points of each cell of the rectangle's lattice, each with its weight's share
+  // of the cell's volume (docs/physics.md section 1.1): the rectangle must then be a whole number
+  // of cells (std::invalid_argument otherwise).
+  using Seeding = smpm::Seeding;
   std::size_t seed_rectangle(double x0, double y0, double x1, double y1, int n_per_side,
-                             int group, int body, double vx0, double vy0);
+                             int group, int body, double vx0, double vy0,
+                             Seeding seeding = Seeding::Uniform);
+  // Point j (0 .. n-1) of n Gauss-Legendre points on a cell side, as a fraction of the side from
+  // its start, and its weight (the weights sum to 1).
+  static void gauss_point(int n, int j, double& at, double& weight);
   // Particles of `body` within `width` inside the straight edge p0 -> p1 whose outward normal is
   // (nx, ny) (the edge is the segment; particles must project onto it).
   BoundaryLayer select_layer(const std::string& name, int body, double ex0, double ey0,
