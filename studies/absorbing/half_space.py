@@ -101,7 +101,7 @@ def main(out):
     ax.set_ylabel("vertical velocity 50 mm along the surface (m/s)")
     ax.set_title("The surface wave in MPM and FE (2 mm cells)")
     ax.set_xlim(0, T_END * 1e6)
-    ax.legend(loc="upper right")
+    ax.legend(loc="lower right")
     fig.savefig(os.path.join(out, "half_space_methods.png"))
 
 
