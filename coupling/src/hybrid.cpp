@@ -54,6 +54,10 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
                         "\" has \"edge_velocity\": \"delayed\", which the coupled step does "
                         "not support (its interface nodes take the FE region's velocity); use "
                         "\"remapped\" or \"updated\"");
+  if (mpm_.opt.mass_correction > 0)
+    throw HybridError("hybrid: the MPM region's scheme.mass_correction is not available in the "
+                      "coupled step (its interface nodes carry the FE region's mass, not their "
+                      "particles')");
   if (fe_.degree() != 1)
     throw HybridError("hybrid: the FEM region must use fem.degree 1 (Q1, like the MPM grid), got " +
                       std::to_string(fe_.degree()));

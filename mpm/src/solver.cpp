@@ -197,8 +197,8 @@ void Solver::finalize() {
   }
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
   // The mass correction (correct_increments): MUSL and USF, whose particles are strained with
-  // the velocity they map back (USL strains them with the corrected v+, whose largest
-  // eigenvalues need half the time step), on one velocity field.
+  // the velocity they map back (USL strains them with the corrected v+, which needs a shorter
+  // time step), on one velocity field (the hybrid refuses it too).
   if (opt.mass_correction < 0 || opt.mass_correction > 8)
     throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
                                 std::to_string(opt.mass_correction));
@@ -2522,10 +2522,10 @@ void Solver::merge_rows(int s, const RowSpan& r) {
 // The consistent-mass correction of the increment (docs/physics.md section 1.1). Under MUSL
 // and USF the velocity the particles map back to a node after their FLIP update is v + R dv, R
 // = M^-1 M_c (M the lumped mass, M_c = N^T m N the particles' consistent mass), so the grid's
-// waves move as if each node weighed M R^-1: the scheme's frequencies are those of the lumped
-// mass times the square root of R's eigenvalue, 1 - (kh)^2 / 12 and below. The increment taken
-// as sum_{j=0..k} (I - R)^j dv, the first k + 1 terms of R^-1 dv, leaves (I - R)^(k+1) of that
-// error. Each term costs one pass over the particles (a gather and a scatter); a held component
+// waves move as if each node weighed M R^-1: the scheme's frequencies are the lumped mass's
+// times the square root of R's eigenvalue r (1 - (kh)^2 / 6 and below for a wave along an axis).
+// The increment taken as sum_{j=0..k} (I - R)^j dv, the first k + 1 terms of R^-1 dv, makes
+// that factor 1 - (1 - r)^(k+1). Each term costs one pass over the particles (a gather and a scatter); a held component
 // and a void node take none.
 template <class S>
 void Solver::correct_increments() {
