@@ -954,13 +954,20 @@ class Builder {
           o.fail("seeding", "\"gauss\" is for point particles: under scheme.shape \"gimp\" each "
                             "particle is a square of its initial size, and squares about the "
                             "Gauss points do not tile the cell");
-        if (b.surface < 0)
-          for (const double w : {b.x1 - b.x0, b.y1 - b.y0})
-            if (std::abs(w / grid_.h - std::round(w / grid_.h)) > 1e-6)
-              o.fail("seeding", "\"gauss\" needs a box of whole cells (its Gauss points are each "
-                                "cell's), got " + fmt((b.x1 - b.x0) / grid_.h) + " x " +
-                                fmt((b.y1 - b.y0) / grid_.h) + " cells of " + fmt(grid_.h) +
-                                " m");
+        if (b.surface < 0) {
+          // On the grid's lines: its Gauss points are then the grid cells' own.
+          auto off_line = [&](double v, double origin) {
+            const double c = (v - origin) / grid_.h;
+            return std::abs(c - std::round(c)) > 1e-6;
+          };
+          if (off_line(b.x0, grid_.x0) || off_line(b.x1, grid_.x0) || off_line(b.y0, grid_.y0) ||
+              off_line(b.y1, grid_.y0) || (b.x1 - b.x0) < 0.5 * grid_.h ||
+              (b.y1 - b.y0) < 0.5 * grid_.h)
+            o.fail("seeding", "\"gauss\" needs a box of whole grid cells, its sides on the grid's "
+                              "lines (its Gauss points are the cells'), got " + fmt_list(box) +
+                              " on a grid of " + fmt(grid_.h) + " m cells from (" +
+                              fmt(grid_.x0) + ", " + fmt(grid_.y0) + ")");
+        }
       }
       const auto v = o.nums("velocity", std::vector<double>{0.0, 0.0});
       b.vx = v[0];
@@ -1455,7 +1462,7 @@ class Builder {
     // grid's pattern that such particles do not map back, which the dashpots' solve leaves out.
     if (s_->opt.mass_correction > 0)
       for (const std::uint32_t k : sb.layer.idx)
-        if (s_->p.vol[k] > 0.5 * grid_.h * grid_.h)
+        if (s_->p.body[k] < bodies_.size() && bodies_[s_->p.body[k]].ppc == 1)
           o.fail("", "the " + type + " edge \"" + name + "\" lies on particles of 1 per cell "
                      "(the particle at (" + fmt(s_->p.x[k]) + ", " + fmt(s_->p.y[k]) +
                      ") fills " + fmt(s_->p.vol[k] / (grid_.h * grid_.h)) + " of a cell), "

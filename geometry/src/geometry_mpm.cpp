@@ -191,7 +191,8 @@ std::size_t seed_surface(Solver& sol, const Geometry& g, const Geometry::Surface
   // (within 0.06 h of the centre: the elements' ranges below widen by one).
   const bool gauss = seeding == Seeding::Gauss;
   std::vector<double> gat(static_cast<std::size_t>(n)), gw(static_cast<std::size_t>(n));
-  for (int q = 0; q < n; ++q) Solver::gauss_point(n, q, gat[q], gw[q]);
+  if (gauss)
+    for (int q = 0; q < n; ++q) Solver::gauss_point(n, q, gat[q], gw[q]);
   auto pos = [&](long i, double o) {
     return gauss ? o + (static_cast<double>(i / n) + gat[i % n]) * G.h : o + (i + 0.5) * sp;
   };

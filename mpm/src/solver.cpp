@@ -2525,8 +2525,8 @@ void Solver::merge_rows(int s, const RowSpan& r) {
 // waves move as if each node weighed M R^-1: the scheme's frequencies are the lumped mass's
 // times the square root of R's eigenvalue r (1 - (kh)^2 / 6 and below for a wave along an axis).
 // The increment taken as sum_{j=0..k} (I - R)^j dv, the first k + 1 terms of R^-1 dv, makes
-// that factor 1 - (1 - r)^(k+1). Each term costs one pass over the particles (a gather and a scatter); a held component
-// and a void node take none.
+// that factor 1 - (1 - r)^(k+1). Each term costs one pass over the particles (a gather and a
+// scatter); a held component and a void node take none.
 template <class S>
 void Solver::correct_increments() {
   const long n = static_cast<long>(grid.nodes());

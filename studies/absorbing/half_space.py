@@ -14,7 +14,7 @@ the 80 us of the run:
     each with 2 mm and 1 mm cells.
 
 Writes OUTDIR/half_space/metrics.json and OUTDIR/half_space/half_space_methods.png (the receiver
-50 mm along the surface) and prints the table. About a minute on 2 cores.
+50 mm along the surface) and prints the table. About 20 s on 2 cores.
 """
 import json
 import os

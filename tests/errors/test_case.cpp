@@ -413,8 +413,15 @@ std::vector<Bad> bad_cases() {
          j["bodies"][0]["seeding"] = "gauss";
          j["bodies"][0]["box"] = {0, 0, 0.01, 0.0045};
        },
-       "bodies[0].seeding: \"gauss\" needs a box of whole cells (its Gauss points are each "
-       "cell's), got 10 x 4.5 cells of 0.001 m"},
+       "bodies[0].seeding: \"gauss\" needs a box of whole grid cells, its sides on the grid's "
+       "lines (its Gauss points are the cells'), got [0, 0, 0.01, 0.0045]"},
+      {"seeding_gauss_off_the_grid_lines",
+       [](ojson& j) {
+         j["bodies"][0]["seeding"] = "gauss";
+         j["bodies"][0]["box"] = {0.0005, 0, 0.0095, 0.005};
+       },
+       "bodies[0].seeding: \"gauss\" needs a box of whole grid cells, its sides on the grid's "
+       "lines"},
       {"seeding_gauss_gimp",
        [](ojson& j) {
          j["scheme"]["shape"] = "gimp";

@@ -1025,17 +1025,6 @@ TEST(Column, LayerFlagsMarkTheLayers) {
   }
 }
 
-// LK at normal incidence on 16-cell (FWHM) pulses, every scheme, 1, 4 and 9 ppc: the reflected
-// amplitude, the square root of the reflected energy fraction (97-99 % of that energy is in
-// front of the last fifth of the column, i.e. it travels back: a reflection, not a residue at
-// the end). Measured, P / S:
-//   USL   0.19 / 0.11 % (1 ppc), 0.10 / 0.17 % (4), 0.11 / 0.17 % (9)
-//   MUSL  0.74 / 0.58 % (1 ppc), 0.26 / 0.26 % (4), 0.24 / 0.25 % (9); USF within 1 % of MUSL.
-// USL meets 0.3 % everywhere, MUSL and USF from 4 ppc on; at 1 ppc they strain each particle
-// with its two neighbours' velocities, whose odd-even pattern the end excites (docs/physics.md
-// section 4). With the trapezoidal mean of the lumped mass at the dashpot nodes instead of the
-// particles' own (Solver::consistent_dashpots), MUSL and USF gave 1.12 / 0.75 %, 0.39 / 0.33 %
-// and 0.35 / 0.31 %. The 1-ppc MUSL energy account closes to 1.1 % here (1 % on 8-cell pulses).
 // The silent end of a 100-cell column under 16-cell pulses: the reflected amplitude, printed.
 double pulse16_reflection(Scheme sc, int ppc, bool shear, int mass_correction = 0) {
   ColumnSpec c;
@@ -1051,6 +1040,17 @@ double pulse16_reflection(Scheme sc, int ppc, bool shear, int mass_correction = 
   return amp;
 }
 
+// LK at normal incidence on 16-cell (FWHM) pulses, every scheme, 1, 4 and 9 ppc: the reflected
+// amplitude, the square root of the reflected energy fraction (97-99 % of that energy is in
+// front of the last fifth of the column, i.e. it travels back: a reflection, not a residue at
+// the end). Measured, P / S:
+//   USL   0.19 / 0.11 % (1 ppc), 0.10 / 0.17 % (4), 0.11 / 0.17 % (9)
+//   MUSL  0.74 / 0.58 % (1 ppc), 0.26 / 0.26 % (4), 0.24 / 0.25 % (9); USF within 1 % of MUSL.
+// USL meets 0.3 % everywhere, MUSL and USF from 4 ppc on; at 1 ppc they strain each particle
+// with its two neighbours' velocities, whose odd-even pattern the end excites (docs/physics.md
+// section 4). With the trapezoidal mean of the lumped mass at the dashpot nodes instead of the
+// particles' own (Solver::consistent_dashpots), MUSL and USF gave 1.12 / 0.75 %, 0.39 / 0.33 %
+// and 0.35 / 0.31 %. The 1-ppc MUSL energy account closes to 1.1 % here (1 % on 8-cell pulses).
 TEST(SilentLayer, NormalIncidence16CellPulsesEveryScheme) {
   for (const Scheme sc : {Scheme::MUSL, Scheme::USL, Scheme::USF})
     for (const int ppc : {1, 2, 3})

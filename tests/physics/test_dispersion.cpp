@@ -1,7 +1,7 @@
 // The MPM step's dispersion relation in closed form (docs/physics.md section 1.1): a standing
 // wave of a free column, every particle started on the grid's interpolant of cos(kx), follows a
-// two-term recurrence whose coefficients the scheme, the particles per cell and the mass
-// correction fix exactly; and the mass correction's effect on a wave's travel time.
+// two-term recurrence whose coefficients the scheme, the particles' places in the cell and the
+// mass correction fix exactly.
 #include <gtest/gtest.h>
 
 #include <cmath>
