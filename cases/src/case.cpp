@@ -868,10 +868,6 @@ class Builder {
     const long mc = s.integer("mass_correction", 0);
     s.ge("mass_correction", static_cast<double>(mc), 0);
     s.le("mass_correction", static_cast<double>(mc), 8);
-    if (mc > 0 && s_->opt.scheme == Scheme::USL)
-      s.fail("mass_correction", "needs scheme.update \"MUSL\" or \"USF\" (USL strains the "
-                                "particles with the corrected increment, whose fastest waves "
-                                "then need half the time step)");
     s_->opt.mass_correction = static_cast<int>(mc);
     const long th = s.integer("threads", 0);
     s.ge("threads", static_cast<double>(th), 0);
@@ -1457,17 +1453,19 @@ class Builder {
     SilentBoundary sb;
     std::string what;
     sb.layer = select_layer(o, name, what);
-    // At 1 particle per cell the mass correction made a column's silent end reflect 8 % (0.7 %
-    // without it; docs/physics.md section 1.1): the correction doubles the increment of the
-    // grid's pattern that such particles do not map back, which the dashpots' solve leaves out.
-    if (s_->opt.mass_correction > 0)
+    // At 1 particle per cell under MUSL and USF the mass correction made a column's silent end
+    // reflect 8 % (0.7 % without it; docs/physics.md section 1.1): the correction doubles the
+    // increment of the grid's pattern that such particles do not map back, which the dashpots'
+    // solve leaves out. (Under USL, whose dashpots solve nothing, it reflects less than without.)
+    if (s_->opt.mass_correction > 0 && s_->opt.scheme != Scheme::USL)
       for (const std::uint32_t k : sb.layer.idx)
         if (s_->p.body[k] < bodies_.size() && bodies_[s_->p.body[k]].ppc == 1)
           o.fail("", "the " + type + " edge \"" + name + "\" lies on particles of 1 per cell "
                      "(the particle at (" + fmt(s_->p.x[k]) + ", " + fmt(s_->p.y[k]) +
                      ") fills " + fmt(s_->p.vol[k] / (grid_.h * grid_.h)) + " of a cell), "
-                     "where scheme.mass_correction makes its dashpots reflect about 8 %: seed "
-                     "2 or more particles per cell side, or set scheme.mass_correction to 0");
+                     "where scheme.mass_correction under " + scheme_name(s_->opt.scheme) +
+                     " makes its dashpots reflect about 8 %: seed 2 or more particles per cell "
+                     "side, use scheme.update \"USL\", or set scheme.mass_correction to 0");
     sb.a = o.num("a", 1.0);
     o.ge("a", sb.a, 0);
     sb.b = o.num("b", 1.0);

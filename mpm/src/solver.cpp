@@ -196,14 +196,11 @@ void Solver::finalize() {
     whole_y0_ = grid.y0;
   }
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
-  // The mass correction (correct_increments): MUSL and USF, whose particles are strained with
-  // the velocity they map back (USL strains them with the corrected v+, which needs a shorter
-  // time step), on one velocity field (the hybrid refuses it too).
+  // The mass correction (correct_increments), on one velocity field (the hybrid refuses it
+  // too).
   if (opt.mass_correction < 0 || opt.mass_correction > 8)
     throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
                                 std::to_string(opt.mass_correction));
-  if (opt.mass_correction > 0 && opt.scheme == Scheme::USL)
-    throw std::invalid_argument("mass_correction: needs MUSL or USF");
   if (opt.mass_correction > 0 && contact.multi())
     throw std::invalid_argument("mass_correction: not with multi-field contact");
   for (const Material& m : materials)
@@ -2526,7 +2523,10 @@ void Solver::merge_rows(int s, const RowSpan& r) {
 // times the square root of R's eigenvalue r (1 - (kh)^2 / 6 and below for a wave along an axis).
 // The increment taken as sum_{j=0..k} (I - R)^j dv, the first k + 1 terms of R^-1 dv, makes
 // that factor 1 - (1 - r)^(k+1). Each term costs one pass over the particles (a gather and a
-// scatter); a held component and a void node take none.
+// scatter); a held component and a void node take none. USL strains the particles with v+
+// itself: there v+ keeps the lumped increment (whose time step it needs) and the correction's
+// extra increment goes to the particles alone, through the start velocity g2p subtracts
+// (shift_start_velocities).
 template <class S>
 void Solver::correct_increments() {
   const long n = static_cast<long>(grid.nodes());
@@ -2545,6 +2545,13 @@ void Solver::correct_increments() {
     ty[i] = heavy && !(fix[i] & 2) ? uy[i] - vy[i] : 0.0;
   }
   const VelocityField& F = fields_.front();
+  const bool usl = opt.scheme == Scheme::USL;
+  if (usl) {
+    mc_ex_.assign(static_cast<std::size_t>(n), 0.0);
+    mc_ey_.assign(static_cast<std::size_t>(n), 0.0);
+  }
+  double* ex = usl ? mc_ex_.data() : ux;  // where the terms go: USL's extra increment, or v+
+  double* ey = usl ? mc_ey_.data() : uy;
   for (int term = 0; term < opt.mass_correction; ++term) {
 #pragma omp parallel for simd schedule(static) num_threads(nthreads_)
     for (long i = 0; i < n; ++i) {
@@ -2563,9 +2570,23 @@ void Solver::correct_increments() {
       const bool heavy = m[i] > floor;
       tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
       ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
-      ux[i] += tx[i];
-      uy[i] += ty[i];
+      ex[i] += tx[i];
+      ey[i] += ty[i];
     }
+  }
+}
+
+// USL with the mass correction, just before g2p: the start velocity less the correction's extra
+// increment, so that the particles' FLIP increment v+ - v is the corrected one while v+ (the
+// strain's and the positions' velocity) keeps the lumped increment.
+void Solver::shift_start_velocities() {
+  const long n = static_cast<long>(grid.nodes());
+  double* vx = grid.vx.data(); double* vy = grid.vy.data();
+  const double* ex = mc_ex_.data(); const double* ey = mc_ey_.data();
+#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
+  for (long i = 0; i < n; ++i) {
+    vx[i] -= ex[i];
+    vy[i] -= ey[i];
   }
 }
 
@@ -2788,6 +2809,7 @@ void Solver::step_with() {
       update_stress<S>(true, false, true);
       break;
     case Scheme::USL:
+      if (opt.mass_correction > 0) shift_start_velocities();
       g2p<S>(false, false);
       update_stress<S>(false, false, true);
       break;

@@ -73,8 +73,9 @@ double mass_ratio(int ppc, double kh, Seeding seeding) {
 
 // With x = (dt omega)^2 of the lumped-mass grid (omega = 2 c_d / h sin(kh / 2)) and r = R's
 // eigenvalue: MUSL and USF A[n+1] = (2 - rho x) A[n] - A[n-1] with rho = 1 - (1 - r)^(k+1) for k
-// terms of the mass correction (rho = r without it); USL (no correction) trace 2 - x, det
-// 1 - (1 - r) x. Measured to 1e-12 of the trace; bound 1e-9 (and on the determinant).
+// terms of the mass correction (rho = r without it); USL, which strains with the lumped
+// increment, trace 2 - x and det 1 - (1 - rho) x. Measured to 1e-12 of the trace; bound 1e-9
+// (and on the determinant).
 TEST(Dispersion, ColumnModeFollowsTheSchemesClosedForm) {
   struct Run {
     Scheme scheme;
@@ -83,8 +84,9 @@ TEST(Dispersion, ColumnModeFollowsTheSchemesClosedForm) {
   };
   const Run runs[] = {{Scheme::MUSL, 0}, {Scheme::USF, 0}, {Scheme::USL, 0},
                       {Scheme::MUSL, 1}, {Scheme::USF, 1}, {Scheme::MUSL, 2},
+                      {Scheme::USL, 1}, {Scheme::USL, 2},
                       {Scheme::MUSL, 0, Seeding::Gauss}, {Scheme::USL, 0, Seeding::Gauss},
-                      {Scheme::MUSL, 2, Seeding::Gauss}};
+                      {Scheme::MUSL, 2, Seeding::Gauss}, {Scheme::USL, 2, Seeding::Gauss}};
   for (const Run& run : runs)
     for (const int ppc : {1, 2, 3})
       for (const int n : {4, 10}) {
@@ -101,13 +103,10 @@ TEST(Dispersion, ColumnModeFollowsTheSchemesClosedForm) {
         double kh = 0, x = 0;
         const Recurrence f = fit_mode(c, n, kh, x);
         const double r = mass_ratio(ppc, kh, run.seeding);
-        Recurrence cf;
-        if (run.scheme == Scheme::USL) {
-          cf = {2 - x, 1 - (1 - r) * x};
-        } else {
-          const double rho = 1 - std::pow(1 - r, run.terms + 1);
-          cf = {2 - rho * x, 1};
-        }
+        // R's factor with k terms of the correction (r itself with none).
+        const double rho = 1 - std::pow(1 - r, run.terms + 1);
+        const Recurrence cf = run.scheme == Scheme::USL ? Recurrence{2 - x, 1 - (1 - rho) * x}
+                                                        : Recurrence{2 - rho * x, 1};
         // The frequency over the lumped mass's (FE Q1's) at this step.
         const double ratio = std::acos(f.trace / (2 * std::sqrt(f.det))) / std::acos(1 - x / 2);
         std::printf("  [%s, %d terms, %d ppc%s, kh %.3f] trace %.12f (closed form %.12f), det "

@@ -58,9 +58,9 @@ struct SolverOptions {
   // (initial + |external work|); 0 turns it off (the hybrid does: energy also enters through
   // its FE region).
   double energy_bound = 10;
-  // MUSL and USF, one velocity field: the number of terms k of the consistent-mass correction
-  // of the grid's increment (correct_increments; docs/physics.md section 1.1). 0 keeps the
-  // lumped mass's increment.
+  // One velocity field: the number of terms k of the consistent-mass correction of the grid's
+  // increment (correct_increments; docs/physics.md section 1.1). 0 keeps the lumped mass's
+  // increment.
   int mass_correction = 0;
 };
 
@@ -498,6 +498,8 @@ class Solver {
   // increment (docs/physics.md section 1.1). Held components and void nodes take none.
   template <class S> void correct_increments();
   std::vector<double> mc_tx_, mc_ty_, mc_ax_, mc_ay_;  // its term and product (per node)
+  std::vector<double> mc_ex_, mc_ey_;  // USL: the correction's extra increment (per node)
+  void shift_start_velocities();
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
