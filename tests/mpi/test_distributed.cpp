@@ -289,9 +289,9 @@ TEST(Ranks, PulsePlateAgreesWithOneProcessEveryScheme) {
 }
 
 // The consistent-mass correction: each term's product summed over the halo before the nodes
-// divide it by their mass (two terms, the LK and Kelvin-Voigt edges, MUSL and USF).
+// divide it by their mass (two terms, the LK and Kelvin-Voigt edges, MUSL, USF and USL).
 TEST(Ranks, MassCorrectionAgreesWithOneProcess) {
-  for (Scheme sc : {Scheme::MUSL, Scheme::USF}) {
+  for (Scheme sc : {Scheme::MUSL, Scheme::USF, Scheme::USL}) {
     PlateSpec c;
     c.scheme = sc;
     c.mass_correction = 2;
