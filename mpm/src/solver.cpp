@@ -2543,6 +2543,8 @@ void Solver::correct_increments() {
     const bool heavy = m[i] > floor;
     tx[i] = heavy && !(fix[i] & 1) ? ux[i] - vx[i] : 0.0;
     ty[i] = heavy && !(fix[i] & 2) ? uy[i] - vy[i] : 0.0;
+    ax[i] = 0;  // each term's product; the update below clears it again once read
+    ay[i] = 0;
   }
   const VelocityField& F = fields_.front();
   const bool usl = opt.scheme == Scheme::USL;
@@ -2553,11 +2555,6 @@ void Solver::correct_increments() {
   double* ex = usl ? mc_ex_.data() : ux;  // where the terms go: USL's extra increment, or v+
   double* ey = usl ? mc_ey_.data() : uy;
   for (int term = 0; term < opt.mass_correction; ++term) {
-#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
-    for (long i = 0; i < n; ++i) {
-      ax[i] = 0;
-      ay[i] = 0;
-    }
     scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int) {
       kernels::consistent_mass_product<S>(grid, p, b, e, inv_rho(g), tx, ty, ax, ay);
     });
@@ -2572,6 +2569,8 @@ void Solver::correct_increments() {
       ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
       ex[i] += tx[i];
       ey[i] += ty[i];
+      ax[i] = 0;
+      ay[i] = 0;
     }
   }
 }
