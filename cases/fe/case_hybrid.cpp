@@ -124,10 +124,6 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
     }
     throw CaseError(msg);
   }
-  if (c.solver && c.solver->opt.mass_correction > 0)
-    ctx.fail("scheme.mass_correction", "is not available in a hybrid (MPM + FEM) case (the "
-                                       "interface nodes carry the far field's mass, not their "
-                                       "particles')");
 
   // FEM probes: the same checks as the FEM parser's.
   std::vector<ProbeSpec> all;
@@ -180,7 +176,10 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
   try {
     c.hybrid = std::make_unique<Hybrid>(*c.solver, *c.fem);
   } catch (const HybridError& e) {
-    ctx.fail("fem", e.what());
+    const std::string msg = e.what();
+    ctx.fail(msg.find("scheme.mass_correction") != std::string::npos ? "scheme.mass_correction"
+                                                                    : "fem",
+             msg);
   }
   // Time step: time.dt, or time.cfl times the smaller of both regions' limits.
   const ojson& t = doc["time"];

@@ -54,10 +54,6 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
                         "\" has \"edge_velocity\": \"delayed\", which the coupled step does "
                         "not support (its interface nodes take the FE region's velocity); use "
                         "\"remapped\" or \"updated\"");
-  if (mpm_.opt.mass_correction > 0)
-    throw HybridError("hybrid: the MPM region's scheme.mass_correction is not available in the "
-                      "coupled step (its interface nodes carry the FE region's mass, not their "
-                      "particles')");
   if (fe_.degree() != 1)
     throw HybridError("hybrid: the FEM region must use fem.degree 1 (Q1, like the MPM grid), got " +
                       std::to_string(fe_.degree()));
@@ -149,12 +145,14 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   gnx_ = g.nx;
   gny_ = g.ny;
   if (const long k = particle_in_fe_cell(true); k >= 0) report_particle_in_fe_cell(k, true);
-  std::vector<double> cell_vol(fe_cell_.size(), 0.0);
+  std::vector<double> cell_vol(fe_cell_.size(), 0.0), cell_big(fe_cell_.size(), 0.0);
   const Particles& P = mpm_.p;
   for (std::size_t k = 0; k < P.size(); ++k) {
     const long i = static_cast<long>(std::floor((P.x[k] - g.x0) * g.inv_h));
     const long j = static_cast<long>(std::floor((P.y[k] - g.y0) * g.inv_h));
-    if (i >= 0 && j >= 0 && i < g.nx && j < g.ny) cell_vol[j * g.nx + i] += P.vol[k];
+    if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) continue;
+    cell_vol[j * g.nx + i] += P.vol[k];
+    cell_big[j * g.nx + i] = std::max(cell_big[j * g.nx + i], P.vol[k]);
   }
   // Grid nodes that are a corner of an occupied cell / of a cell not covered by the FE mesh.
   std::vector<std::uint8_t> node_mpm(g.nodes(), 0), node_open(g.nodes(), 0);
@@ -253,6 +251,20 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
           << " touches the interface but is partly filled (particle volume " << fill
           << " h^2): MPM cells next to the FE region must be full (a half-empty cell is a density "
              "jump that reflects); align the MPM bodies with the grid at the interface";
+        throw HybridError(o.str());
+      }
+      // One particle per cell: the grid's odd-even pattern, which such particles do not map
+      // back (R's eigenvalue 0), takes k + 1 times its increment from the correction, and the FE
+      // nodes take it too: the interface then reflects more than without the correction
+      // (docs/physics.md section 7).
+      if (mpm_.opt.mass_correction > 0 && cell_big[c] > 0.5 * h * h) {
+        std::ostringstream o;
+        o << "hybrid: scheme.mass_correction needs 2 or more particles per cell side next to "
+             "the interface, but the MPM cell ("
+          << i << ", " << j << ") at " << pt(g.x0 + (i + 0.5) * h, g.y0 + (j + 0.5) * h)
+          << " holds a particle of " << cell_big[c] / (h * h)
+          << " h^2 (at 1 particle per cell the correction makes the interface reflect more, "
+             "not less); seed more particles per cell, or set scheme.mass_correction to 0";
         throw HybridError(o.str());
       }
     }
@@ -537,6 +549,20 @@ void Hybrid::after_grid_update(Solver& S) {
   step_absorbed_ = absorbed;
 }
 
+// The mass correction's product at the shared nodes: their FE lumped mass, beside the
+// particles' consistent mass. R = M^-1 (M_c + M_FE) there, so that the velocity the particles
+// and the FE node map back next step, (p_MPM + m_FE v_FE) / m, moves by R times the increment
+// both took (docs/physics.md section 7).
+void Hybrid::add_mass_product(Solver&, const double* tx, const double* ty, double* ax,
+                              double* ay) {
+  for (std::size_t k = 0; k < shared_.size(); ++k) {
+    const std::int64_t n = node_[k];
+    if (n < 0) continue;  // not in this rank's window
+    ax[n] += fe_m_[k] * tx[n];
+    ay[n] += fe_m_[k] * ty[n];
+  }
+}
+
 // After the MPM boundary work is booked, before the particles take their velocities.
 void Hybrid::before_g2p(Solver& S) {
   Grid& g = S.grid;
@@ -556,8 +582,11 @@ void Hybrid::before_g2p(Solver& S) {
     if (mpm_own_[k]) {
       vel_[4 * k] = g.vx[n];
       vel_[4 * k + 1] = g.vy[n];
-      vel_[4 * k + 2] = g.vnx[n];
-      vel_[4 * k + 3] = g.vny[n];
+      // USL with the mass correction: the particles take its extra increment beyond v+, and
+      // so does the FE node's velocity (its displacement advances with v+, as theirs do).
+      const double ex = S.correction_extra_x(n), ey = S.correction_extra_y(n);
+      vel_[4 * k + 2] = ex != 0 ? g.vnx[n] + ex : g.vnx[n];
+      vel_[4 * k + 3] = ey != 0 ? g.vny[n] + ey : g.vny[n];
     }
     if (!(g.fix[n] & 1)) g.vx[n] = mpm_v_[2 * k];
     if (!(g.fix[n] & 2)) g.vy[n] = mpm_v_[2 * k + 1];

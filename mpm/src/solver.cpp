@@ -196,8 +196,7 @@ void Solver::finalize() {
     whole_y0_ = grid.y0;
   }
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
-  // The mass correction (correct_increments), on one velocity field (the hybrid refuses it
-  // too).
+  // The mass correction (correct_increments), on one velocity field.
   if (opt.mass_correction < 0 || opt.mass_correction > 8)
     throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
                                 std::to_string(opt.mass_correction));
@@ -2562,6 +2561,7 @@ void Solver::correct_increments() {
       double* const sums[2] = {ax, ay};
       dist_->sum_halo(sums, 2, nullptr);
     }
+    call([&](StepHooks& h) { h.add_mass_product(*this, tx, ty, ax, ay); });
 #pragma omp parallel for simd schedule(static) num_threads(nthreads_)
     for (long i = 0; i < n; ++i) {
       const bool heavy = m[i] > floor;
@@ -2792,8 +2792,8 @@ void Solver::step_with() {
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
   if (consistent_) consistent_dashpots<S>();
-  if (opt.mass_correction > 0) correct_increments<S>();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
+  if (opt.mass_correction > 0) correct_increments<S>();  // after every dashpot's update
   bool remapped_power = sc == Scheme::MUSL || (sc == Scheme::USF && usf_remapped_power());
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
   if (!remapped_power) boundary_work<S>(false);

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "silentmpm/geo_box.hpp"
 #include "common.hpp"
@@ -54,6 +55,8 @@ struct Strip {
   double v0 = 0;          // initial x velocity of the particles
   bool load = true;       // the traction on the left end
   double gravity_x = 0, gravity_y = 0;  // both regions' (m/s^2)
+  int mass_correction = 0;  // the MPM region's scheme.mass_correction
+  Seeding seeding = Seeding::Uniform;
 };
 
 struct HybRun {
@@ -122,7 +125,7 @@ inline HybRun make_strip(const Strip& c) {
     s->materials.push_back(testing::tungsten());
     const int nx = (c.mpm_cells < c.cells ? c.mpm_cells : c.cells) + 4;
     s->grid.init(-2 * h, 0.0, h, nx, c.height);
-    s->seed_rectangle(0, 0, xi, H, c.ppc_side, 0, 0, c.v0, 0);
+    s->seed_rectangle(0, 0, xi, H, c.ppc_side, 0, 0, c.v0, 0, c.seeding);
     if (c.rollers) {
       s->constraints.push_back({"bottom", s->nodes_in_box(-1, 0, 1, 0), 2});
       s->constraints.push_back({"top", s->nodes_in_box(-1, H, 1, H), 2});
@@ -140,6 +143,7 @@ inline HybRun make_strip(const Strip& c) {
       s->silents.push_back(sb);
     }
     s->opt.scheme = c.scheme;
+    s->opt.mass_correction = c.mass_correction;
     s->opt.threads = 1;
     s->opt.gravity_x = c.gravity_x;
     s->opt.gravity_y = c.gravity_y;
@@ -204,6 +208,31 @@ inline HybRun make_uniform_strain_patch(Strip& c, double eps) {
     m.hyb->set_dt(m.dt);
   }
   return m;
+}
+
+// sigma_xx history at (x, y): from the particles where x lies in the MPM part, else from the FE.
+struct Probe {
+  HybRun& m;
+  double x, y, xi;
+  int fe_index = -1;
+  Probe(HybRun& m_, double x_, double y_, double xi_) : m(m_), x(x_), y(y_), xi(xi_) {
+    if (!(m.mpm && x < xi)) fe_index = m.fe->add_probe(x, y);
+  }
+  double sxx() const {
+    if (fe_index < 0) return m.mpm->sample(x, y).sxx;
+    return m.fe->sample()[fe_index].sxx;
+  }
+};
+
+// The probe's sigma_xx after every step up to t_end.
+inline std::vector<double> record(HybRun& m, const Strip& c, double x, double y, double t_end) {
+  Probe p(m, x, y, c.mpm_cells * c.h);
+  std::vector<double> out;
+  while (m.time() < t_end - 0.5 * m.dt) {
+    m.step();
+    out.push_back(p.sxx());
+  }
+  return out;
 }
 
 inline TimeFunction bell(double duration) {

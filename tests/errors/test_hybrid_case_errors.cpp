@@ -42,8 +42,11 @@ TEST(HybridCase, ErrorsNameTheKey) {
   c["fem"]["size"] = 0.5 * h;  // FE spacing h/2 at the interface
   EXPECT_NE(case_error(c).find("h.json: fem: hybrid: FE node"), std::string::npos) << case_error(c);
   c = plate_case("hybrid");
-  c["scheme"]["mass_correction"] = 1;  // the interface nodes' mass is not their particles'
-  EXPECT_NE(case_error(c).find("h.json: scheme.mass_correction: is not available in a hybrid"),
+  c["scheme"]["mass_correction"] = 2;  // at 4 particles per cell: accepted
+  EXPECT_EQ(case_error(c), "");
+  c["bodies"][0]["particles_per_cell"] = 1;  // the interface would reflect more, not less
+  EXPECT_NE(case_error(c).find("h.json: scheme.mass_correction: hybrid: scheme.mass_correction "
+                               "needs 2 or more particles per cell side next to the interface"),
             std::string::npos) << case_error(c);
   c = plate_case("hybrid");
   c["time"]["dt"] = 2 * h / cd;

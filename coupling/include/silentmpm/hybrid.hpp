@@ -12,7 +12,9 @@
 //   grid update                      v+ = v + dt f / m (semi-implicit where a dashpot block sits,
 //                                    FE dashpot blocks included at shared nodes)
 //   FE nodes not shared              (m + dt/2 C) v+ = (m - dt/2 C) v + dt f, constraints
-//   FE nodes shared                  v_FE+ = grid v+
+//   FE nodes shared                  v_FE+ = grid v+ (with scheme.mass_correction the corrected
+//                                    increment, the FE mass joining the particles' consistent
+//                                    mass in its product: add_mass_product)
 //   particles                        g2p: the FLIP increment at a shared node is v+ - p_MPM/m_MPM
 //                                    (the particles' own old velocity there), so that
 //                                    Sum_p m_p dv_p + m_FE dv_FE = dt f: momentum is exact;
@@ -30,7 +32,9 @@
 //   * FE degree 1 only; FE cells touching the MPM region must be exactly one grid cell (same
 //     spacing h, nodes on grid nodes); an FE node on an occupied MPM cell must sit on a grid node;
 //   * a particle inside an FE cell (at setup and after every step);
-//   * an MPM cell touching the interface must be full (particle volume h^2 within 0.1 %);
+//   * an MPM cell touching the interface must be full (particle volume h^2 within 0.1 %), and
+//     with scheme.mass_correction hold no particle of more than half a cell (at 1 particle per
+//     cell the correction makes the interface reflect more);
 //   * no MPM traction on an interface node (setup) and no FE load on an interface node carrying
 //     MPM mass (checked every step: the FE load is evaluated there anyway);
 //   * the same gravity in both regions (a shared node's weight is (m_MPM + m_FE) g: the MPM
@@ -88,6 +92,8 @@ class Hybrid : public StepHooks {
   void after_momentum(Solver& s) override;     // guards: scheme, contact
   void after_forces(Solver& s) override;       // FE forces, masses and momenta on shared nodes
   void after_grid_update(Solver& s) override;  // FE dashpot blocks at shared nodes
+  void add_mass_product(Solver& s, const double* tx, const double* ty, double* ax,
+                        double* ay) override;  // the mass correction: m_FE t at shared nodes
   void before_g2p(Solver& s) override;         // FE-only nodes advance; the particles' own v
   void after_remap(Solver& s) override;        // MUSL: FE momentum at shared nodes in q
   void end_of_step(Solver& s) override;        // shared displacements, FE clock, particle check

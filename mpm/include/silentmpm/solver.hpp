@@ -9,6 +9,7 @@
 //                  particles, damping bands, gravity                       -> after_forces
 //   grid update    v+ = v + dt f / m (semi-implicit on nodes with a dashpot block), constraints;
 //                  a non-finite velocity stops the run here                -> after_grid_update
+//   [mass correction of the increment (opt.mass_correction)                 add_mass_product]
 //   boundary work  work of tractions and gravity, energy absorbed by dashpots and bands
 //                                                                           -> before_g2p
 //   g2p            particle velocities (FLIP/PIC); MUSL re-maps the momenta -> after_remap
@@ -153,6 +154,14 @@ class Solver {
   // Hook sets: attach before the first step; a set must outlive its attachment.
   void attach(StepHooks* h);
   void detach(StepHooks* h);
+  // USL with the mass correction, from the correction to the end of the step: node i's extra
+  // increment, which the particles take beyond v+ (0 otherwise).
+  double correction_extra_x(long i) const {
+    return mc_ex_.empty() || opt.scheme != Scheme::USL ? 0.0 : mc_ex_[static_cast<std::size_t>(i)];
+  }
+  double correction_extra_y(long i) const {
+    return mc_ey_.empty() || opt.scheme != Scheme::USL ? 0.0 : mc_ey_[static_cast<std::size_t>(i)];
+  }
   // One field per body (multi-field contact; called from finalize): the bodies' nodal arrays,
   // and the body of every material group (groups must not mix bodies).
   void use_body_fields(const std::vector<NodalField>& fields, const std::vector<int>& body_of_group);

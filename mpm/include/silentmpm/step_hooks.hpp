@@ -13,6 +13,11 @@ class StepHooks {
   virtual void after_momentum(Solver&) {}     // p2g done (nodal mass and momentum on every field)
   virtual void after_forces(Solver&) {}       // internal forces and loads on the grid
   virtual void after_grid_update(Solver&) {}  // v+ on the grid, before its boundary work is booked
+  // The consistent-mass correction's product a = M_c t (Solver::correct_increments, one call per
+  // term, after the particles' share and its sums over the ranks): a hook set adds the mass its
+  // nodes carry beyond the particles' (the hybrid: the far field's lumped mass at shared nodes).
+  virtual void add_mass_product(Solver&, const double* /*tx*/, const double* /*ty*/,
+                                double* /*ax*/, double* /*ay*/) {}
   virtual void before_g2p(Solver&) {}         // boundary work booked; particles not yet updated
   virtual void after_remap(Solver&) {}        // MUSL: re-mapped momenta, not yet divided by mass
   virtual void end_of_step(Solver&) {}        // clock advanced, particles checked
