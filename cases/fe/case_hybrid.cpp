@@ -176,10 +176,9 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
   try {
     c.hybrid = std::make_unique<Hybrid>(*c.solver, *c.fem);
   } catch (const HybridError& e) {
-    const std::string msg = e.what();
-    ctx.fail(msg.find("scheme.mass_correction") != std::string::npos ? "scheme.mass_correction"
-                                                                    : "fem",
-             msg);
+    const std::string msg = e.what(), mc = "hybrid: scheme.mass_correction ";
+    if (msg.rfind(mc, 0) == 0) ctx.fail("scheme.mass_correction", msg.substr(mc.size()));
+    ctx.fail("fem", msg);
   }
   // Time step: time.dt, or time.cfl times the smaller of both regions' limits.
   const ojson& t = doc["time"];

@@ -253,21 +253,19 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
              "jump that reflects); align the MPM bodies with the grid at the interface";
         throw HybridError(o.str());
       }
-      // One particle per cell: the grid's odd-even pattern, which such particles do not map
-      // back (R's eigenvalue 0), takes k + 1 times its increment from the correction, and the FE
-      // nodes take it too: the interface then reflects more than without the correction
-      // (docs/physics.md section 7).
-      if (mpm_.opt.mass_correction > 0 && cell_big[c] > 0.5 * h * h) {
+      // A particle of a cell side (one per cell, or one per side along an axis): the grid's
+      // odd-even pattern, which such particles do not map back (R's eigenvalue 0), takes k + 1
+      // times its increment from the mass correction, and the FE nodes take it too: the
+      // interface then reflects more than without the correction (docs/physics.md section 7).
+      if (coarse_cell_.empty() && cell_big[c] > 0.3 * h * h) {
         std::ostringstream o;
-        o << "hybrid: scheme.mass_correction needs 2 or more particles per cell side next to "
-             "the interface, but the MPM cell ("
-          << i << ", " << j << ") at " << pt(g.x0 + (i + 0.5) * h, g.y0 + (j + 0.5) * h)
-          << " holds a particle of " << cell_big[c] / (h * h)
-          << " h^2 (at 1 particle per cell the correction makes the interface reflect more, "
-             "not less); seed more particles per cell, or set scheme.mass_correction to 0";
-        throw HybridError(o.str());
+        o << "the MPM cell (" << i << ", " << j << ") at "
+          << pt(g.x0 + (i + 0.5) * h, g.y0 + (j + 0.5) * h) << " holds a particle of "
+          << cell_big[c] / (h * h) << " h^2";
+        coarse_cell_ = o.str();
       }
     }
+  check_mass_correction(mpm_);
 
   // No MPM traction on an interface node.
   {
@@ -463,7 +461,18 @@ void Hybrid::distribute(Decomposition& d) {
 
 // ---- the hooks of the coupled step ----------------------------------------------------------
 
+// The mass correction needs 2 or more particles per cell side next to the interface (checked
+// at set-up and at every step, for a correction turned on later).
+void Hybrid::check_mass_correction(const Solver& S) const {
+  if (S.opt.mass_correction > 0 && !coarse_cell_.empty())
+    throw HybridError("hybrid: scheme.mass_correction needs 2 or more particles per cell side next "
+                      "to the interface, but " + coarse_cell_ +
+                      " (with fewer the correction makes the interface reflect more, not less); "
+                      "seed more particles per cell, or set scheme.mass_correction to 0");
+}
+
 void Hybrid::after_momentum(Solver& S) {
+  check_mass_correction(S);
   if (S.contact.multi())
     throw HybridError("hybrid: multi-velocity-field contact is not supported with an FEM region");
   if (S.opt.scheme == Scheme::USF)
@@ -542,6 +551,8 @@ void Hybrid::after_grid_update(Solver& S) {
                      g.fy[n], dt, g.fix[n], a, b);
     g.vnx[n] = a;
     g.vny[n] = b;
+    // Booked with the velocity this update applied (the mass correction, opt.mass_correction,
+    // changes v+ afterwards).
     if (!mpm_own_[k]) continue;  // every copy updates; the owner books
     const double bx = 0.5 * (vx + a), by = 0.5 * (vy + b);
     absorbed += dt * (bx * (cxx * bx + cxy * by) + by * (cxy * bx + cyy * by));

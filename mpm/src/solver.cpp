@@ -2525,7 +2525,8 @@ void Solver::merge_rows(int s, const RowSpan& r) {
 // scatter); a held component and a void node take none. USL strains the particles with v+
 // itself: there v+ keeps the lumped increment (whose time step it needs) and the correction's
 // extra increment goes to the particles alone, through the start velocity g2p subtracts
-// (shift_start_velocities).
+// (shift_start_velocities). A hook set adds to M_c the mass its nodes carry beyond the
+// particles' (add_mass_product: the hybrid's FE mass at shared nodes, R = M^-1 (M_c + M_FE)).
 template <class S>
 void Solver::correct_increments() {
   const long n = static_cast<long>(grid.nodes());

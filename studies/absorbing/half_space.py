@@ -18,7 +18,7 @@ the 80 us of the run:
 
 Writes OUTDIR/half_space/metrics.json, OUTDIR/half_space/half_space_methods.png and
 OUTDIR/half_space/half_space_hybrid.png (the receiver 50 mm along the surface) and prints the
-table. About 2 minutes on 2 cores.
+table. About 30 s on 2 cores.
 """
 import json
 import os

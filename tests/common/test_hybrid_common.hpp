@@ -56,6 +56,7 @@ struct Strip {
   bool load = true;       // the traction on the left end
   double gravity_x = 0, gravity_y = 0;  // both regions' (m/s^2)
   int mass_correction = 0;  // the MPM region's scheme.mass_correction
+  bool fe_side_dashpots = false;  // without rollers: LK dashpots on the elements' top and bottom
   Seeding seeding = Seeding::Uniform;
 };
 
@@ -99,6 +100,10 @@ inline std::unique_ptr<fem::Solver> strip_fe(const Strip& c, double x0, bool loa
     s.boundaries.push_back(load);
   }
   if (c.right == Right::Dashpot) s.boundaries.push_back(fe_bc(fem::Boundary::Kind::Dashpot, 12, "right"));
+  if (c.fe_side_dashpots && !c.rollers) {
+    s.boundaries.push_back(fe_bc(fem::Boundary::Kind::Dashpot, 13, "bottom"));
+    s.boundaries.push_back(fe_bc(fem::Boundary::Kind::Dashpot, 14, "top"));
+  }
   return std::make_unique<fem::Solver>(s);
 }
 

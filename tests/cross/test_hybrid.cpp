@@ -11,7 +11,6 @@
 using namespace smpm;
 using namespace smpm::hybrid_testing;
 
-
 namespace {
 
 // The wave the interface reflects: the largest difference, after t0, between the probe's
@@ -56,7 +55,7 @@ Reflection twenty_cell_pulse(Strip c) {
 // only that reflection can reach the probe it must stay below 2 % of the pulse amplitude
 // (docs/physics.md: ~0.5 % in a 1D prototype). With one particle per cell at the cell centre and u
 // a function of x only, MPM and lumped Q1 coincide, so the reflection is the MPM noise floor.
-// Measured (MUSL, 1 ppc): 0.86 % for this 20-cell pulse; 0.24 % for 40 cells; USL 0.15 %.
+// Measured (MUSL, 1 ppc): 0.86 % for this 20-cell pulse; 0.24 % for 40 cells; USL 0.19 %.
 TEST(Hybrid, PlanePWaveCrossesTheInterface) {
   Strip c;
   {

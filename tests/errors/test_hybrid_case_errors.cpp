@@ -45,8 +45,8 @@ TEST(HybridCase, ErrorsNameTheKey) {
   c["scheme"]["mass_correction"] = 2;  // at 4 particles per cell: accepted
   EXPECT_EQ(case_error(c), "");
   c["bodies"][0]["particles_per_cell"] = 1;  // the interface would reflect more, not less
-  EXPECT_NE(case_error(c).find("h.json: scheme.mass_correction: hybrid: scheme.mass_correction "
-                               "needs 2 or more particles per cell side next to the interface"),
+  EXPECT_NE(case_error(c).find("h.json: scheme.mass_correction: needs 2 or more particles per "
+                               "cell side next to the interface, but the MPM cell"),
             std::string::npos) << case_error(c);
   c = plate_case("hybrid");
   c["time"]["dt"] = 2 * h / cd;

@@ -113,6 +113,25 @@ TEST(HybridErrors, PartlyFilledCellAtTheInterface) {
   EXPECT_NE(e.find("partly filled"), std::string::npos) << e;
 }
 
+// The mass correction next to cells of one particle (docs/physics.md section 7): refused when
+// the hybrid is built, and at the first step when it is turned on afterwards.
+TEST(HybridErrors, MassCorrectionAtOneParticlePerCell) {
+  auto s = particles();
+  auto f = elements(20e-3, 1e-3);
+  s->opt.mass_correction = 1;
+  std::string e = error_of([&] { Hybrid hy(*s, *f); });
+  const std::string want = "hybrid: scheme.mass_correction needs 2 or more particles per cell side "
+                           "next to the interface, but the MPM cell (21, 0) at (0.0195, 0.0005) "
+                           "holds a particle of 1 h^2";
+  EXPECT_NE(e.find(want), std::string::npos) << e;
+  s->opt.mass_correction = 0;
+  Hybrid hy(*s, *f);
+  hy.set_dt(s->dt);
+  s->opt.mass_correction = 1;
+  e = error_of([&] { hy.step(); });
+  EXPECT_NE(e.find(want), std::string::npos) << e;
+}
+
 TEST(HybridErrors, MpmLoadOnAnInterfaceNode) {
   auto s = particles(20, 0, true);
   auto f = elements(20e-3, 1e-3);

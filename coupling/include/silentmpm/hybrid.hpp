@@ -33,8 +33,8 @@
 //     spacing h, nodes on grid nodes); an FE node on an occupied MPM cell must sit on a grid node;
 //   * a particle inside an FE cell (at setup and after every step);
 //   * an MPM cell touching the interface must be full (particle volume h^2 within 0.1 %), and
-//     with scheme.mass_correction hold no particle of more than half a cell (at 1 particle per
-//     cell the correction makes the interface reflect more);
+//     with scheme.mass_correction hold no particle of more than 0.3 of a cell (at 1 particle per
+//     cell side the correction makes the interface reflect more; checked at every step too);
 //   * no MPM traction on an interface node (setup) and no FE load on an interface node carrying
 //     MPM mass (checked every step: the FE load is evaluated there anyway);
 //   * the same gravity in both regions (a shared node's weight is (m_MPM + m_FE) g: the MPM
@@ -181,6 +181,10 @@ class Hybrid : public StepHooks {
   [[noreturn]] void report_particle_in_fe_cell(long k, bool at_setup) const;
   // Sums v over the ranks (nothing on one process).
   void share(std::vector<double>& v) const;
+  // The first MPM cell next to the interface whose particles are a cell side wide (described;
+  // empty if none), and the guard that refuses the mass correction there.
+  std::string coarse_cell_;
+  void check_mass_correction(const Solver& S) const;
   void fe_energies(bool with_step_force);
 };
 

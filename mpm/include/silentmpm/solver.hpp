@@ -157,10 +157,13 @@ class Solver {
   // USL with the mass correction, from the correction to the end of the step: node i's extra
   // increment, which the particles take beyond v+ (0 otherwise).
   double correction_extra_x(long i) const {
-    return mc_ex_.empty() || opt.scheme != Scheme::USL ? 0.0 : mc_ex_[static_cast<std::size_t>(i)];
+    return correcting_usl() ? mc_ex_[static_cast<std::size_t>(i)] : 0.0;
   }
   double correction_extra_y(long i) const {
-    return mc_ey_.empty() || opt.scheme != Scheme::USL ? 0.0 : mc_ey_[static_cast<std::size_t>(i)];
+    return correcting_usl() ? mc_ey_[static_cast<std::size_t>(i)] : 0.0;
+  }
+  bool correcting_usl() const {
+    return opt.mass_correction > 0 && opt.scheme == Scheme::USL && !mc_ex_.empty();
   }
   // One field per body (multi-field contact; called from finalize): the bodies' nodal arrays,
   // and the body of every material group (groups must not mix bodies).
