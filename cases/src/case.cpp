@@ -840,9 +840,6 @@ class Builder {
     if (o.has("friction") && type != "multi")
       o.fail("friction", "friction needs \"type\": \"multi\" (a single velocity field has "
                          "no slip)");
-    if (type == "multi" && s_->opt.mass_correction > 0)
-      o.fail("type", "\"multi\" is not available with scheme.mass_correction (the correction "
-                     "acts on one velocity field)");
     s_->contact.friction = o.num("friction", 0.0);
     o.ge("friction", s_->contact.friction, 0);
     o.done();

@@ -28,6 +28,10 @@ namespace {
 constexpr double kWeakGradient = 0.25;
 // Bodies closer than this fraction of a cell (gap between their particle domains) are in contact.
 constexpr double kGapTolerance = 0.01;
+// How far behind a body's surface its particles' centroid at a node on that surface lies, for
+// particles of size l on a lattice of n = h / l per cell side (the mean of xi (1 - xi) over
+// (1 - xi) at xi = (j + 1/2) / n): h / 3 + l^2 / (6 h); l / 2 at one particle per cell.
+inline double reach(double l, double h) { return h / 3 + l * l / (6 * h); }
 
 }  // namespace
 
@@ -188,8 +192,6 @@ void Contact::split_updated(Solver& s) {
       vny_[b][i] = (g.fix[i] & 2) ? 0.0 : g.vny[i] + dy;
     }
   }
-  for (auto& f : force) f = {0.0, 0.0};
-  correct(s, vnx_, vny_, true);
 }
 
 // Contact correction of the fields (vx, vy) at the contact nodes. With count, the impulses are
@@ -233,7 +235,7 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
       if (mb <= floor) continue;
       if (b != hb) {
         const double gap = (xm_[b][i] / mb - xh) * Nx + (ym_[b][i] / mb - yh) * Ny -
-                           0.5 * (sm_[b][i] / mb + sh);
+                           reach(sm_[b][i] / mb, g.h) - reach(sh, g.h);
         if (gap > tol) continue;
         ++touching;
       }
@@ -293,6 +295,11 @@ void Contact::after_momentum(Solver& s) { find_contact_nodes(s); }
 void Contact::after_grid_update(Solver& s) {
   split_start(s);
   split_updated(s);
+  // The mass correction of each body's increment (docs/physics.md section 1.1), before the
+  // contact correction, so that the corrected velocities keep the contact conditions.
+  if (s.opt.mass_correction > 0) s.correct_body_increments();
+  for (auto& f : force) f = {0.0, 0.0};
+  correct(s, vnx_, vny_, true);
 }
 
 }  // namespace smpm

@@ -200,8 +200,6 @@ void Solver::finalize() {
   if (opt.mass_correction < 0 || opt.mass_correction > 8)
     throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
                                 std::to_string(opt.mass_correction));
-  if (opt.mass_correction > 0 && contact.multi())
-    throw std::invalid_argument("mass_correction: not with multi-field contact");
   for (const Material& m : materials)
     if (m.model == Model::J2Film && !p.has_film()) p.enable_film();
   nstrips_ = 2 * nthreads_;
@@ -2529,31 +2527,53 @@ void Solver::merge_rows(int s, const RowSpan& r) {
 // particles' (add_mass_product: the hybrid's FE mass at shared nodes, R = M^-1 (M_c + M_FE)).
 template <class S>
 void Solver::correct_increments() {
+  const std::size_t n = grid.nodes();
+  for (auto* v : {&mc_tx_, &mc_ty_, &mc_ax_, &mc_ay_}) v->resize(n);
+  const bool usl = opt.scheme == Scheme::USL;
+  if (usl) {  // one block of nodes per field
+    mc_ex_.assign(n * fields_.size(), 0.0);
+    mc_ey_.assign(n * fields_.size(), 0.0);
+  }
+  for (std::size_t k = 0; k < fields_.size(); ++k)
+    correct_field<S>(fields_[k], usl ? mc_ex_.data() + k * n : nullptr,
+                     usl ? mc_ey_.data() + k * n : nullptr);
+}
+
+// The nodes of field F: every node of the grid's own field, a body's box of its field.
+template <class Fn>
+void Solver::field_nodes(const VelocityField& F, Fn&& fn) {
+  if (F.body >= 0) {
+    kernels::for_box(F.box, grid.nnx, nthreads_, fn);
+    return;
+  }
   const long n = static_cast<long>(grid.nodes());
-  for (auto* v : {&mc_tx_, &mc_ty_, &mc_ax_, &mc_ay_}) v->resize(static_cast<std::size_t>(n));
+#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
+  for (long i = 0; i < n; ++i) fn(i);
+}
+
+// One field's correction (correct_increments): its increment, its particles' consistent mass,
+// the terms into its v+ or, under USL, into (ex, ey).
+template <class S>
+void Solver::correct_field(const VelocityField& F, double* ex, double* ey) {
   double* tx = mc_tx_.data(); double* ty = mc_ty_.data();
   double* ax = mc_ax_.data(); double* ay = mc_ay_.data();
-  const double* vx = grid.vx.data(); const double* vy = grid.vy.data();
-  double* ux = grid.vnx.data(); double* uy = grid.vny.data();
-  const double* m = grid.m.data();
+  const NodalField& f = F.f;
+  const double* vx = f.vx; const double* vy = f.vy;
+  double* ux = f.vnx; double* uy = f.vny;
+  const double* m = f.m;
   const uint8_t* fix = grid.fix.data();
   const double floor = mass_floor_;
-#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
-  for (long i = 0; i < n; ++i) {
+  field_nodes(F, [=](long i) {
     const bool heavy = m[i] > floor;
     tx[i] = heavy && !(fix[i] & 1) ? ux[i] - vx[i] : 0.0;
     ty[i] = heavy && !(fix[i] & 2) ? uy[i] - vy[i] : 0.0;
     ax[i] = 0;  // each term's product; the update below clears it again once read
     ay[i] = 0;
+  });
+  if (!ex) {  // where the terms go: USL's extra increment, or v+
+    ex = ux;
+    ey = uy;
   }
-  const VelocityField& F = fields_.front();
-  const bool usl = opt.scheme == Scheme::USL;
-  if (usl) {
-    mc_ex_.assign(static_cast<std::size_t>(n), 0.0);
-    mc_ey_.assign(static_cast<std::size_t>(n), 0.0);
-  }
-  double* ex = usl ? mc_ex_.data() : ux;  // where the terms go: USL's extra increment, or v+
-  double* ey = usl ? mc_ey_.data() : uy;
   for (int term = 0; term < opt.mass_correction; ++term) {
     scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int) {
       kernels::consistent_mass_product<S>(grid, p, b, e, inv_rho(g), tx, ty, ax, ay);
@@ -2563,8 +2583,7 @@ void Solver::correct_increments() {
       dist_->sum_halo(sums, 2, nullptr);
     }
     call([&](StepHooks& h) { h.add_mass_product(*this, tx, ty, ax, ay); });
-#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
-    for (long i = 0; i < n; ++i) {
+    field_nodes(F, [=](long i) {
       const bool heavy = m[i] > floor;
       tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
       ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
@@ -2572,21 +2591,30 @@ void Solver::correct_increments() {
       ey[i] += ty[i];
       ax[i] = 0;
       ay[i] = 0;
-    }
+    });
   }
 }
 
-// USL with the mass correction, just before g2p: the start velocity less the correction's extra
-// increment, so that the particles' FLIP increment v+ - v is the corrected one while v+ (the
-// strain's and the positions' velocity) keeps the lumped increment.
+void Solver::correct_body_increments() {
+  switch (opt.shape) {
+    case ShapeKind::Bilinear: return correct_increments<Bilinear>();
+    case ShapeKind::UGimp: return correct_increments<UGimp>();
+    case ShapeKind::BSpline2: return correct_increments<BSpline2>();
+  }
+}
+
+// USL with the mass correction, just before g2p: the start velocity of each field less the
+// correction's extra increment, so that the particles' FLIP increment v+ - v is the corrected
+// one while v+ (the strain's and the positions' velocity) keeps the lumped increment.
 void Solver::shift_start_velocities() {
-  const long n = static_cast<long>(grid.nodes());
-  double* vx = grid.vx.data(); double* vy = grid.vy.data();
-  const double* ex = mc_ex_.data(); const double* ey = mc_ey_.data();
-#pragma omp parallel for simd schedule(static) num_threads(nthreads_)
-  for (long i = 0; i < n; ++i) {
-    vx[i] -= ex[i];
-    vy[i] -= ey[i];
+  const std::size_t n = grid.nodes();
+  for (std::size_t k = 0; k < fields_.size(); ++k) {
+    double* vx = fields_[k].f.vx; double* vy = fields_[k].f.vy;
+    const double* ex = mc_ex_.data() + k * n; const double* ey = mc_ey_.data() + k * n;
+    field_nodes(fields_[k], [=](long i) {
+      vx[i] -= ex[i];
+      vy[i] -= ey[i];
+    });
   }
 }
 
@@ -2794,7 +2822,9 @@ void Solver::step_with() {
   grid_update();
   if (consistent_) consistent_dashpots<S>();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
-  if (opt.mass_correction > 0) correct_increments<S>();  // after every dashpot's update
+  // After every dashpot's update; multi-field contact corrects its bodies' fields itself,
+  // before its contact correction (correct_body_increments).
+  if (opt.mass_correction > 0 && !contact.multi()) correct_increments<S>();
   bool remapped_power = sc == Scheme::MUSL || (sc == Scheme::USF && usf_remapped_power());
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
   if (!remapped_power) boundary_work<S>(false);

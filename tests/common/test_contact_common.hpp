@@ -37,6 +37,7 @@ struct Impact {
   double friction = 0;
   Scheme scheme = Scheme::MUSL;
   int threads = 1;
+  int mass_correction = 0;  // scheme.mass_correction
 };
 
 struct Oracle {

@@ -367,20 +367,14 @@ std::vector<Bad> bad_cases() {
       {"edge_velocity_unknown", [](ojson& j) { bnd(j, 2)["edge_velocity"] = "update"; },
        "boundaries[2].edge_velocity: must be one of \"remapped\", \"updated\", \"delayed\", got "
        "\"update\""},
-      // The consistent-mass correction: 0 to 8 terms, one velocity field, and under MUSL or USF
-      // no silent or Kelvin-Voigt edge on particles of 1 per cell.
+      // The consistent-mass correction: 0 to 8 terms, and under MUSL or USF no silent or
+      // Kelvin-Voigt edge on particles of 1 per cell.
       {"mass_correction_negative", [](ojson& j) { j["scheme"]["mass_correction"] = -1; },
        "scheme.mass_correction: must be >= 0, got -1"},
       {"mass_correction_too_many", [](ojson& j) { j["scheme"]["mass_correction"] = 9; },
        "scheme.mass_correction: must be <= 8, got 9"},
       {"mass_correction_not_integer", [](ojson& j) { j["scheme"]["mass_correction"] = 0.5; },
        "scheme.mass_correction: expected an integer, got 0.5"},
-      {"mass_correction_multi_contact",
-       [](ojson& j) {
-         j["scheme"]["mass_correction"] = 1;
-         j["contact"] = {{"type", "multi"}};
-       },
-       "contact.type: \"multi\" is not available with scheme.mass_correction"},
       {"mass_correction_silent_one_ppc",
        [](ojson& j) {
          j["scheme"]["mass_correction"] = 1;

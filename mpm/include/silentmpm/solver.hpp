@@ -154,8 +154,11 @@ class Solver {
   // Hook sets: attach before the first step; a set must outlive its attachment.
   void attach(StepHooks* h);
   void detach(StepHooks* h);
+  // Multi-field contact (its after_grid_update hook): the mass correction of every body's
+  // field, after the bodies' own updates and before their contact correction.
+  void correct_body_increments();
   // USL with the mass correction, from the correction to the end of the step: node i's extra
-  // increment, which the particles take beyond v+ (0 otherwise).
+  // increment in the first field, which its particles take beyond v+ (0 otherwise).
   double correction_extra_x(long i) const {
     return correcting_usl() ? mc_ex_[static_cast<std::size_t>(i)] : 0.0;
   }
@@ -509,8 +512,11 @@ class Solver {
   // velocity the particles then map back to the grid has nearly taken the lumped mass's
   // increment (docs/physics.md section 1.1). Held components and void nodes take none.
   template <class S> void correct_increments();
+  template <class S> void correct_field(const VelocityField& F, double* ex, double* ey);
+  template <class Fn> void field_nodes(const VelocityField& F, Fn&& fn);
   std::vector<double> mc_tx_, mc_ty_, mc_ax_, mc_ay_;  // its term and product (per node)
-  std::vector<double> mc_ex_, mc_ey_;  // USL: the correction's extra increment (per node)
+  // USL: the correction's extra increment (per node, one block of nodes per field).
+  std::vector<double> mc_ex_, mc_ey_;
   void shift_start_velocities();
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
