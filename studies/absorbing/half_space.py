@@ -112,33 +112,29 @@ def main(out):
         json.dump(metrics, f, indent=1)
 
     style.apply()
-    fig, ax = plt.subplots(figsize=(7.0, 4.2))
-    ax.plot(ref["time"] * 1e6, ref["S50.vy"], color="black", lw=2.2, label="FE Q1, 0.5 mm")
-    for i, key in enumerate(["fem_2mm", "uniform_2mm", "corrected_1_2mm", "gauss_2_2mm"]):
-        h, label = runs[key]
-        ax.plot(h["time"] * 1e6, h["S50.vy"], color=style.COLOURS[i],
-                ls=style.LINESTYLES[i % len(style.LINESTYLES)], label=label)
-    ax.set_xlabel("time (µs)")
-    ax.set_ylabel("vertical velocity 50 mm along the surface (m/s)")
-    ax.set_title("The surface wave in MPM and FE (2 mm cells)")
-    ax.set_xlim(0, T_END * 1e6)
-    ax.legend(loc="lower right")
-    fig.savefig(os.path.join(out, "half_space_methods.png"))
-
+    s50_figure(ref, runs, ["fem_2mm", "uniform_2mm", "corrected_1_2mm", "gauss_2_2mm"],
+               "The surface wave in MPM and FE (2 mm cells)",
+               os.path.join(out, "half_space_methods.png"))
     # The hybrid: the surface wave made in the particles, read 20 mm beyond the interface.
+    s50_figure(ref, runs, ["fem_2mm", "hybrid_2mm", "hybrid_gauss_2_2mm"],
+               "A particle window in the FE half-space (2 mm cells)",
+               os.path.join(out, "half_space_hybrid.png"))
+
+
+def s50_figure(ref, runs, keys, title, path):
+    """The receiver 50 mm along the surface: the reference and the runs of `keys`."""
     fig, ax = plt.subplots(figsize=(7.0, 4.2))
     ax.plot(ref["time"] * 1e6, ref["S50.vy"], color="black", lw=2.2, label="FE Q1, 0.5 mm")
-    for i, key in enumerate(["fem_2mm", "hybrid_2mm", "hybrid_gauss_2_2mm"]):
+    for i, key in enumerate(keys):
         h, label = runs[key]
         ax.plot(h["time"] * 1e6, h["S50.vy"], color=style.COLOURS[i],
                 ls=style.LINESTYLES[i % len(style.LINESTYLES)], label=label)
     ax.set_xlabel("time (µs)")
     ax.set_ylabel("vertical velocity 50 mm along the surface (m/s)")
-    ax.set_title("A particle window in the FE half-space (2 mm cells)")
+    ax.set_title(title)
     ax.set_xlim(0, T_END * 1e6)
     ax.legend(loc="lower right")
-    fig.savefig(os.path.join(out, "half_space_hybrid.png"))
-
+    fig.savefig(path)
 
 if __name__ == "__main__":
     main(sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "out"))
