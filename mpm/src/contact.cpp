@@ -28,10 +28,22 @@ namespace {
 constexpr double kWeakGradient = 0.25;
 // Bodies closer than this fraction of a cell (gap between their particle domains) are in contact.
 constexpr double kGapTolerance = 0.01;
-// How far behind a body's surface its particles' centroid at a node on that surface lies, for
-// particles of size l on a lattice of n = h / l per cell side (the mean of xi (1 - xi) over
-// (1 - xi) at xi = (j + 1/2) / n): h / 3 + l^2 / (6 h); l / 2 at one particle per cell.
-inline double reach(double l, double h) { return h / 3 + l * l / (6 * h); }
+// How far behind a body's surface its particles' nodal centroid lies at a node on that surface,
+// for a lattice of particles of size l normal to it: the mean of their distances x_j = (j + 1/2) l
+// (x_j < h) weighted by N = 1 - x_j / h. l / 2 while one particle lies within h (l > 2h/3: one
+// particle per cell, also compressed or stretched), 3h/8 at two per cell side (l = h/2), 19h/54
+// at three (h / 3 + l^2 / (6 h) at n per side, l = h / n).
+inline double reach(double l, double h) {
+  if (!(l > 0)) return 0.0;
+  if (1.5 * l >= h) return 0.5 * l;
+  double sw = 0, swx = 0;
+  for (double x = 0.5 * l; x < h; x += l) {
+    const double w = 1 - x / h;
+    sw += w;
+    swx += w * x;
+  }
+  return swx / sw;
+}
 
 }  // namespace
 
@@ -223,8 +235,8 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
     if (!(NN > 0)) continue;
     Nx /= NN; Ny /= NN;
     // Which bodies touch h here: the gap along n between the nodal centroids of the two bodies'
-    // particles, less half of each one's particle size, must be closed. (Sharing a node only
-    // means the bodies are less than about a cell apart.)
+    // particles, less how far each one's centroid lies behind its surface (reach), must be
+    // closed. (Sharing a node only means the bodies are less than about a cell apart.)
     const double mh = m_[hb][i];
     const double xh = xm_[hb][i] / mh, yh = ym_[hb][i] / mh, sh = sm_[hb][i] / mh;
     int touching = 0;
@@ -235,7 +247,7 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
       if (mb <= floor) continue;
       if (b != hb) {
         const double gap = (xm_[b][i] / mb - xh) * Nx + (ym_[b][i] / mb - yh) * Ny -
-                           reach(sm_[b][i] / mb, g.h) - reach(sh, g.h);
+                           (reach(sm_[b][i] / mb, g.h) + reach(sh, g.h));
         if (gap > tol) continue;
         ++touching;
       }
@@ -296,7 +308,8 @@ void Contact::after_grid_update(Solver& s) {
   split_start(s);
   split_updated(s);
   // The mass correction of each body's increment (docs/physics.md section 1.1), before the
-  // contact correction, so that the corrected velocities keep the contact conditions.
+  // contact correction, so that under MUSL and USF the corrected velocities keep the contact
+  // conditions (under USL the particles' extra increment beyond v+ is their body's own).
   if (s.opt.mass_correction > 0) s.correct_body_increments();
   for (auto& f : force) f = {0.0, 0.0};
   correct(s, vnx_, vny_, true);

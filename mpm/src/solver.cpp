@@ -196,7 +196,7 @@ void Solver::finalize() {
     whole_y0_ = grid.y0;
   }
   if (contact.multi()) contact.setup(*this);  // splits material groups, one field per body
-  // The mass correction (correct_increments), on one velocity field.
+  // The mass correction (correct_increments): 0 to 8 terms.
   if (opt.mass_correction < 0 || opt.mass_correction > 8)
     throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
                                 std::to_string(opt.mass_correction));

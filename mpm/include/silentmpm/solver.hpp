@@ -59,8 +59,8 @@ struct SolverOptions {
   // (initial + |external work|); 0 turns it off (the hybrid does: energy also enters through
   // its FE region).
   double energy_bound = 10;
-  // One velocity field: the number of terms k of the consistent-mass correction of the grid's
-  // increment (correct_increments; docs/physics.md section 1.1). 0 keeps the lumped mass's
+  // The number of terms k of the consistent-mass correction of the grid's increment, on every
+  // velocity field (correct_increments; docs/physics.md section 1.1). 0 keeps the lumped mass's
   // increment.
   int mass_correction = 0;
 };

@@ -12,11 +12,11 @@ class StepHooks {
   virtual ~StepHooks() = default;
   virtual void after_momentum(Solver&) {}     // p2g done (nodal mass and momentum on every field)
   virtual void after_forces(Solver&) {}       // internal forces and loads on the grid
-  // v+ on the grid (before the mass correction, opt.mass_correction), its boundary work not yet
-  // booked.
+  // v+ on the grid (before the mass correction, opt.mass_correction; multi-field contact, which
+  // runs first, corrects its bodies' fields here), its boundary work not yet booked.
   virtual void after_grid_update(Solver&) {}
   // The consistent-mass correction's product a = M_c t (Solver::correct_increments, one call per
-  // term, after the particles' share and its sums over the ranks): a hook set adds the mass its
+  // velocity field and term, after the particles' share and its sums over the ranks): a hook set adds the mass its
   // nodes carry beyond the particles' (the hybrid: the far field's lumped mass at shared nodes).
   virtual void add_mass_product(Solver&, const double* /*tx*/, const double* /*ty*/,
                                 double* /*ax*/, double* /*ay*/) {}
