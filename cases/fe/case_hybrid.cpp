@@ -176,9 +176,8 @@ Case build_hybrid_case(const Ctx& ctx, const ojson& doc) {
   try {
     c.hybrid = std::make_unique<Hybrid>(*c.solver, *c.fem);
   } catch (const HybridError& e) {
-    const std::string msg = e.what(), mc = "hybrid: scheme.mass_correction ";
-    if (msg.rfind(mc, 0) == 0) ctx.fail("scheme.mass_correction", msg.substr(mc.size()));
-    ctx.fail("fem", msg);
+    if (!e.key.empty()) ctx.fail(e.key, e.detail);
+    ctx.fail("fem", e.what());
   }
   // Time step: time.dt, or time.cfl times the smaller of both regions' limits.
   const ojson& t = doc["time"];

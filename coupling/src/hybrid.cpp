@@ -465,8 +465,9 @@ void Hybrid::distribute(Decomposition& d) {
 // at set-up and at every step, for a correction turned on later).
 void Hybrid::check_mass_correction(const Solver& S) const {
   if (S.opt.mass_correction > 0 && !coarse_cell_.empty())
-    throw HybridError("hybrid: scheme.mass_correction needs 2 or more particles per cell side next "
-                      "to the interface, but " + coarse_cell_ +
+    throw HybridError("scheme.mass_correction",
+                      "needs 2 or more particles per cell side next to the interface, but " +
+                          coarse_cell_ +
                       " (with fewer the correction makes the interface reflect more, not less); "
                       "seed more particles per cell, or set scheme.mass_correction to 0");
 }

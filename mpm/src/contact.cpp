@@ -238,7 +238,7 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
     // particles, less how far each one's centroid lies behind its surface (reach), must be
     // closed. (Sharing a node only means the bodies are less than about a cell apart.)
     const double mh = m_[hb][i];
-    const double xh = xm_[hb][i] / mh, yh = ym_[hb][i] / mh, sh = sm_[hb][i] / mh;
+    const double xh = xm_[hb][i] / mh, yh = ym_[hb][i] / mh, rh = reach(sm_[hb][i] / mh, g.h);
     int touching = 0;
     double M = 0, cx = 0, cy = 0;
     for (int b = 0; b < nb_; ++b) {
@@ -247,7 +247,7 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
       if (mb <= floor) continue;
       if (b != hb) {
         const double gap = (xm_[b][i] / mb - xh) * Nx + (ym_[b][i] / mb - yh) * Ny -
-                           (reach(sm_[b][i] / mb, g.h) + reach(sh, g.h));
+                           (reach(sm_[b][i] / mb, g.h) + rh);
         if (gap > tol) continue;
         ++touching;
       }

@@ -63,6 +63,11 @@ namespace smpm {
 
 struct HybridError : std::runtime_error {
   using std::runtime_error::runtime_error;
+  // A fault of one case key's value: "hybrid: KEY DETAIL", with the key and the detail apart (a
+  // case file's error names the key; the others are the FEM region's, "fem").
+  HybridError(const std::string& key_, const std::string& detail_)
+      : std::runtime_error("hybrid: " + key_ + " " + detail_), key(key_), detail(detail_) {}
+  std::string key, detail;
 };
 
 // A hook set on the MPM solver's step (step_hooks.hpp): constructing a Hybrid attaches it, so
