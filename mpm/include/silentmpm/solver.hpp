@@ -517,6 +517,10 @@ class Solver {
   std::vector<double> mc_tx_, mc_ty_, mc_ax_, mc_ay_;  // its term and product (per node)
   // USL: the correction's extra increment (per node, one block of nodes per field).
   std::vector<double> mc_ex_, mc_ey_;
+  // MUSL and USF: each dashpot node's v+ before the correction (x, y in the order of
+  // dashpot_nodes_), the velocity its trapezoidal force acted with (boundary_work); empty when
+  // nothing was corrected this step.
+  std::vector<double> mc_dash_v_;
   void shift_start_velocities();
   template <class S> void boundary_work(bool remapped);
   template <class S> void g2p(bool remap, bool move);
