@@ -2201,7 +2201,9 @@ void Solver::consistent_dashpots() {
       update(cm_g_.data(), change, scale);
       cm_g0_.swap(cm_g_);
     }
-    if (change <= 1e-13 * scale) break;
+    // (Below the smallest normal double the relative test cannot hold: a wave's leading tail,
+    // some 1e-316 m/s, reached an edge and ran the iteration to its limit.)
+    if (change <= 1e-13 * scale || change < std::numeric_limits<double>::min()) break;
     if (it + 1 == kCmMaxIterations) {  // the last iterate stands; the run's summary counts it
       ++dashpot_solve.unconverged;
       break;
