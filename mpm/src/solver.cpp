@@ -905,15 +905,28 @@ template void Solver::layer_shape<Bilinear>(const BoundaryLayer&, std::size_t, A
 // the same happens once a boundary point has moved out of its body's last cell (an edge on a
 // node line that moves outward by u puts u/h of the load on the void node beyond): a
 // Kelvin-Voigt end settled 3 % short of its static force before this was done for every shape.
+// A node that holds only a sliver of mass keeps a share in proportion to its mass: at most
+// m_i / (kLightShare m_q) of the load's particle q. Its share's acceleration stays below
+// 1 / kLightShare times the particle's own, where a whole share on a node whose mass falls to
+// nothing would accelerate it without bound (the wide shapes reach the node row beyond an edge,
+// which a moving free surface fills with a sliver of the particles' domains; docs/physics.md
+// section 8.5). Nodes the particle itself weighs as much as its share (the particle anchor) and
+// those of an edge on or near a node line (at least half the share's mass at one ppc) keep theirs.
 template <class S>
 void Solver::load_weights(const BoundaryLayer& L, std::size_t q, Anchor anchor, S& sf,
                           long* nodes) const {
   layer_shape(L, q, anchor, sf, nodes);
-  double kept = 0, lost = 0;
-  for (int a = 0; a < S::kNodes; ++a)
-    (grid.m[nodes[a]] > mass_floor_ ? kept : lost) += sf.N[a];
+  constexpr double kLightShare = 0.25;
+  const double mq = kLightShare * p.mass[L.idx[q]];
+  double kept = 0, lost = 0, theta[S::kNodes];
+  for (int a = 0; a < S::kNodes; ++a) {
+    const double m = grid.m[nodes[a]], w = sf.N[a];
+    theta[a] = !(m > mass_floor_) ? 0.0 : m >= mq * w ? 1.0 : m / (mq * w);
+    kept += theta[a] * w;
+    lost += (1 - theta[a]) * w;
+  }
   if (lost == 0 || kept <= 0) return;
-  for (int a = 0; a < S::kNodes; ++a) sf.N[a] = grid.m[nodes[a]] > mass_floor_ ? sf.N[a] / kept : 0.0;
+  for (int a = 0; a < S::kNodes; ++a) sf.N[a] = theta[a] * sf.N[a] / kept;
 }
 
 // Traction vector of load tl on particle q of its layer at the current time.
