@@ -9,8 +9,8 @@ flagged all the same, with the scheme named), and a flagged run needs reading.
     scripts/combinations.py [--bin build/silentmpm] [--out DIR] [--cases column,pulse,...]
                             [--imbalance 0.01] [--threads 1]
 
-Snapshots are switched off (a full sweep with them writes tens of gigabytes). About 10 minutes
-for the default cases on 2 cores; `--cases` names a subset (see CASES below).
+Snapshots are switched off (a full sweep with them writes tens of gigabytes). About 13 minutes
+(432 runs) on 2 cores; `--cases` names a subset (see CASES below).
 """
 import argparse
 import csv
