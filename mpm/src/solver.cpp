@@ -2553,7 +2553,8 @@ void Solver::correct_increments() {
   // beyond a wide shape's edge takes a large corrected increment; booked with it, the column's
   // absorbed work came out 13 % short with GIMP and two terms).
   mc_dash_v_.clear();
-  if (!usl && has_nodal_dashpot_ && fields_.size() == 1 && fields_[0].body < 0) {
+  // (With multi-field contact the bodies' fields are corrected, not the grid's own.)
+  if (!usl && has_nodal_dashpot_ && !contact.multi()) {
     mc_dash_v_.resize(2 * dashpot_nodes_.size());
     for (std::size_t k = 0; k < dashpot_nodes_.size(); ++k) {
       mc_dash_v_[2 * k] = grid.vnx[dashpot_nodes_[k]];

@@ -1102,7 +1102,7 @@ TEST(SilentLayer, MassCorrectionHalvesTheReflectionFrom4Ppc) {
 // light dashpot node that keeps the trapezoidal update. Its force acted with the mean of v and
 // the lumped v+; booked with the corrected v+ (the sliver's increment, multiplied by the series)
 // the account missed 13 % of the work with GIMP and 0.78 % with B-splines. Measured, 16-cell P
-// pulse, 4 ppc, two terms, the pulse absorbed: |imbalance| / work 1.6-2.0e-5 (GIMP) and
+// pulse, 4 ppc, two terms, the pulse absorbed: |imbalance| / work 4.7-7.1e-6 (GIMP) and
 // 1.5-1.7e-4 (B-spline), MUSL and USF. Bound 1e-3.
 TEST(SilentLayer, MassCorrectionBooksTheWorkOfLightEndNodes) {
   for (const ShapeKind shape : {ShapeKind::UGimp, ShapeKind::BSpline2})
