@@ -28,21 +28,65 @@ namespace {
 constexpr double kWeakGradient = 0.25;
 // Bodies closer than this fraction of a cell (gap between their particle domains) are in contact.
 constexpr double kGapTolerance = 0.01;
-// How far behind a body's surface its particles' nodal centroid lies at a node on that surface,
-// for a lattice of particles of size l normal to it: the mean of their distances x_j = (j + 1/2) l
-// (x_j < h) weighted by N = 1 - x_j / h. l / 2 while one particle lies within h (l > 2h/3: one
-// particle per cell, also compressed or stretched), 3h/8 at two per cell side (l = h/2), 19h/54
-// at three (h / 3 + l^2 / (6 h) at n per side, l = h / n).
-inline double reach(double l, double h) {
-  if (!(l > 0)) return 0.0;
-  if (1.5 * l >= h) return 0.5 * l;
-  double sw = 0, swx = 0;
-  for (double x = 0.5 * l; x < h; x += l) {
-    const double w = 1 - x / h;
-    sw += w;
-    swx += w * x;
+// The gap check's model of a body near a node: a flat surface, the body's particles in layers
+// of thickness l parallel to it, their centres at depths (j + 1/2) l behind it. For a node d
+// outside the surface (d < 0: inside the body) the particles' nodal centroid then lies
+// offset(d) behind the node along the body's outward normal: the mean of the layers' distances
+// u_j = d + (j + 1/2) l from the node weighted by the case's 1D shape S(u_j / h) (the tensor
+// products' other factor is the same for every layer of a flat surface). At a node on the
+// surface (d = 0) the bilinear weights give l / 2 while one layer lies within h (1 ppc), 3h/8
+// at two layers per cell side, 19h/54 at three (h / 3 + l^2 / (6 h) at n per side, l = h / n);
+// the quadratic B-spline gives 27h/64 and 67h/162 at two and three. offset(d) grows with d, with
+// a slope of 0.63-1 at the surface (1 only at one particle per cell), so the measured offset
+// gives d back by bisection; the gap between two bodies at a node is the sum of their d.
+double weight_1d(ShapeKind k, double xi, double lp) {
+  const double r = std::abs(xi);
+  switch (k) {
+    case ShapeKind::Bilinear:
+      return r < 1 ? 1 - r : 0.0;
+    case ShapeKind::BSpline2:
+      if (r <= 0.5) return 0.75 - r * r;
+      return r < 1.5 ? 0.5 * (1.5 - r) * (1.5 - r) : 0.0;
+    case ShapeKind::UGimp: {
+      double w, d;
+      shape_detail::ugimp_1d(xi, lp, w, d);
+      return w;
+    }
   }
-  return swx / sw;
+  return 0.0;
+}
+
+// The support's half-width in cells.
+double support_1d(ShapeKind k, double lp) {
+  return k == ShapeKind::Bilinear ? 1.0 : k == ShapeKind::BSpline2 ? 1.5 : 1.0 + lp;
+}
+
+// offset(d) of the model above (cells: d, l in units of h); +infinity where no layer reaches.
+double centroid_offset(ShapeKind k, double d, double l, double lp) {
+  const double R = support_1d(k, lp);
+  double sw = 0, swu = 0;
+  for (double u = d + 0.5 * l; u < R; u += l) {
+    const double w = weight_1d(k, u, lp);
+    sw += w;
+    swu += w * u;
+  }
+  return sw > 0 ? swu / sw : std::numeric_limits<double>::infinity();
+}
+
+// The node's distance outside the body's surface (units of h) for a measured offset o of the
+// body's nodal centroid behind it (units of h), particles of size l (units of h).
+double node_outside(ShapeKind k, double o, double l) {
+  if (!(l > 0)) return o;
+  const double lp = std::min(0.5, 0.5 * l);
+  const double R = support_1d(k, lp);
+  double lo = -R, hi = R - 0.5 * l;  // the first layer at the support's end
+  if (o <= centroid_offset(k, lo, l, lp)) return lo;
+  for (int it = 0; it < 60 && hi - lo > 1e-12; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (centroid_offset(k, mid, l, lp) < o) lo = mid;
+    else hi = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 }  // namespace
@@ -214,6 +258,7 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
   double work = 0;
   long active = 0;
   const double tol = kGapTolerance * g.h;
+  const ShapeKind shape = s.opt.shape;
   std::vector<char> in(nb_, 0);
   for (uint32_t i : cnodes_) {
     // The heaviest body h at the node, and the sum of the mass gradients.
@@ -238,7 +283,11 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
     // particles, less how far each one's centroid lies behind its surface (reach), must be
     // closed. (Sharing a node only means the bodies are less than about a cell apart.)
     const double mh = m_[hb][i];
-    const double xh = xm_[hb][i] / mh, yh = ym_[hb][i] / mh, rh = reach(sm_[hb][i] / mh, g.h);
+    const double xh = xm_[hb][i] / mh, yh = ym_[hb][i] / mh;
+    const double xi = g.x0 + static_cast<double>(i % g.nnx) * g.h;
+    const double yi = g.y0 + static_cast<double>(i / g.nnx) * g.h;
+    const double dh = node_outside(shape, ((xi - xh) * Nx + (yi - yh) * Ny) * g.inv_h,
+                                   sm_[hb][i] / mh * g.inv_h);
     int touching = 0;
     double M = 0, cx = 0, cy = 0;
     for (int b = 0; b < nb_; ++b) {
@@ -246,8 +295,8 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
       in[b] = 0;
       if (mb <= floor) continue;
       if (b != hb) {
-        const double gap = (xm_[b][i] / mb - xh) * Nx + (ym_[b][i] / mb - yh) * Ny -
-                           (reach(sm_[b][i] / mb, g.h) + rh);
+        const double ob = (xm_[b][i] / mb - xi) * Nx + (ym_[b][i] / mb - yi) * Ny;
+        const double gap = (node_outside(shape, ob * g.inv_h, sm_[b][i] / mb * g.inv_h) + dh) * g.h;
         if (gap > tol) continue;
         ++touching;
       }

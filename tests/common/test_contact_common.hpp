@@ -38,6 +38,8 @@ struct Impact {
   Scheme scheme = Scheme::MUSL;
   int threads = 1;
   int mass_correction = 0;  // scheme.mass_correction
+  ShapeKind shape = ShapeKind::Bilinear;  // scheme.shape
+  double offset = 0;  // the grid moved left by this fraction of a cell: the contact face off its lines
 };
 
 struct Oracle {

@@ -35,18 +35,21 @@
 //    the normal is dropped (the contact acts along the free directions only).
 //
 //    Gap check: two bodies share a node as soon as their particles are less than about a cell
-//    apart, so sharing a node is not touching. At each shared node the nodal centroid of each
-//    body's particles, x_b = sum m_p N x_p / m_b, and their mean size s_b = sum m_p N sqrt(V_p)
-//    / m_b give the gap (x_b - x_h) . n - r(s_b) - r(s_h) between the particle domains, r(s) =
-//    h / 3 + s^2 / (6 h) the distance from a body's surface to its particles' centroid at a node
-//    on that surface (particles of size s, h / s per cell side; s / 2 at one particle per cell);
-//    only a body whose gap is closed (below 1 % of a cell) is in contact with h. Without it,
-//    bodies less than a cell apart keep exchanging impulses while not touching (a rebounding
-//    flyer stays within a cell of the target for tens of microseconds). (With s / 2 in place of
-//    r(s), right at one particle per cell only, bodies of 4 and 9 ppc met the contact a quarter
-//    and a third of a cell late: the 1D impact at 4 ppc lost 39 % of its energy and rebounded at
-//    half the closed form's speed, at 9 ppc it gained 43 %.)
-//
+//    apart (a cell and a half with the wide shapes), so sharing a node is not touching. At each
+//    shared node the nodal centroid of each body's particles, x_b = sum m_p N x_p / m_b, and
+//    their mean size s_b = sum m_p N sqrt(V_p) / m_b give how far the node lies outside that
+//    body's surface, d_b: a flat surface with layers of particles of size s_b behind it puts the
+//    centroid offset(d) behind the node, offset the layers' distances weighted by the case's own
+//    1D shape (contact.cpp), and the measured offset gives d_b back. The gap between the
+//    particle domains is d_h + d_b; only a body whose gap is closed (below 1 % of a cell) is in
+//    contact with h. Without the check, bodies less than a cell apart keep exchanging impulses
+//    while not touching (a rebounding flyer stays within a cell of the target for tens of
+//    microseconds). Earlier forms and what they did to the 1D impact (docs/physics.md §4): one
+//    reach per body, s / 2, exact at 1 ppc only (4 ppc lost 39 % of the energy and rebounded at
+//    half the closed form's speed, 9 ppc gained 43 %); one reach per body from the bilinear
+//    weights at a node on the surface, whose offset grows only 0.63-0.75 times as fast as d
+//    from 4 ppc on (the face 0.25 of a cell off the grid lines at 4 ppc: rebound 1.21 of the
+//    closed form, +15 %; B-splines on the lines: duration 1.07, rebound 1.04, +1.6 %).
 //    Each body's particles then take their own corrected field in g2p. The velocity gradient
 //    (MUSL: from the re-mapped momenta; USF: from the start-of-step momenta) is each body's own
 //    uncorrected field: correcting it too fed the light body's edge particles a spurious strain
