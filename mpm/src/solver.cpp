@@ -2939,7 +2939,9 @@ void Solver::check_health() {
     o << ": ";
     particle(o, k);
     o << " at |v| = " << v << " m/s, v dt = " << v * dt << " m > h = " << grid.h
-      << " m; the run is unstable (reduce time.cfl or time.dt)";
+      << " m; the run is unstable (reduce time.cfl or time.dt";
+    if (opt.scheme == Scheme::USL) o << "; " << kUslSliverHint;
+    o << ")";
     throw std::runtime_error(o.str());
   }
   if (collapsed > 0) {
@@ -2991,6 +2993,7 @@ void Solver::check_health() {
         << ", external work " << energy.external_work << ") ";
       where(o);
       o << "; the run is unstable (reduce time.cfl or time.dt";
+      if (opt.scheme == Scheme::USL) o << "; " << kUslSliverHint;
       if (pml.active()) o << "; " << kPmlGrowthHint;
       o << ")";
       throw std::runtime_error(o.str());

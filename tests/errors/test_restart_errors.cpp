@@ -251,6 +251,45 @@ TEST(RestartErrors, FemRunThatBlowsUpStops) {
   EXPECT_FALSE(fs::exists(out / "summary.json"));
   EXPECT_NE(read_file(out / "RUN_INCOMPLETE").find("the FEM run is unstable"), std::string::npos);
 }
+
+// USL and a node that holds a sliver of mass (docs/physics.md section 9.3): a steel half-space at
+// 4 ppc, free, under a 100 MPa line load, its grid 0.3 of a cell lower than the body's, so that
+// the top particles lie 0.05 h past a grid line and the row above holds 5 % of their weight.
+// Under USL at CFL 0.5 the run stops on the energy check within 20 steps, and the error names
+// USL's sliver node and MUSL; at CFL 0.3, and under MUSL at 0.5, the same case runs.
+TEST(RestartErrors, UslSliverNodeBlowUpNamesTheScheme) {
+  if (!have_cli()) GTEST_SKIP() << "CLI binary not built";
+  json c = json::parse(R"({
+    "grid": {"origin": [-0.0006, -0.0006], "size": [0.062, 0.032], "cell": 0.002},
+    "time": {"end": 4e-6, "cfl": 0.5},
+    "scheme": {"update": "USL"},
+    "materials": {"steel": {"model": "elastic", "young": 200e9, "poisson": 0.3, "density": 7850}},
+    "bodies": [{"name": "ground", "material": "steel", "box": [0, 0, 0.06, 0.03],
+                "particles_per_cell": 4}],
+    "boundaries": [{"type": "traction", "body": "ground", "side": "top", "interval": [0.028, 0.032],
+                    "normal": -1e8,
+                    "time": {"shape": "sin2", "start": 0, "duration": 4e-6, "ramp": 2e-6}}],
+    "output": {"snapshots": 0, "progress": false, "history_every": 10}
+  })");
+  const std::string f = write_case("usl_sliver", c);
+  const fs::path out = scratch() / "usl_sliver_out";
+  const Cli r = cli("run " + f + " --out " + out.string(), "usl_sliver");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("exceeds 10 times the energy put in"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("under USL a node that holds a sliver of a particle's mass"),
+            std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_NE(read_file(out / "RUN_INCOMPLETE").find("under USL"), std::string::npos);
+  c["time"]["cfl"] = 0.3;
+  const Cli slow = cli("run " + write_case("usl_sliver_03", c) + " --out " +
+                           (scratch() / "usl_sliver_03").string(), "usl_sliver_03");
+  EXPECT_EQ(slow.code, 0) << slow.err;
+  c["time"]["cfl"] = 0.5;
+  c["scheme"]["update"] = "MUSL";
+  const Cli musl = cli("run " + write_case("usl_sliver_musl", c) + " --out " +
+                           (scratch() / "usl_sliver_musl").string(), "usl_sliver_musl");
+  EXPECT_EQ(musl.code, 0) << musl.err;
+}
 }  // namespace
 }  // namespace smpm
 

@@ -137,6 +137,12 @@ struct PmlBand {
 inline constexpr double kPmlDefaultR0 = 5e-3;
 
 // What the energy checks of both methods add when a run with a PML blows up.
+// What an unstable USL run adds to its error: the step limit of a node holding a sliver of mass.
+inline constexpr const char* kUslSliverHint =
+    "under USL a node that holds a sliver of a particle's mass (a free surface just past a grid "
+    "line) strains the particles with its own updated velocity and needs a far smaller step; "
+    "\"MUSL\" strains with the particles' re-mapped velocity and does not, docs/physics.md "
+    "section 9.3";
 inline constexpr const char* kPmlGrowthHint =
     "a pml between two free surfaces needs \"alpha\" >= 0.04 sqrt(d0 c_d / h) or \"parallel\", "
     "docs/physics.md section 9.3";
