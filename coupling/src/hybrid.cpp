@@ -144,7 +144,6 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
   gy0_ = g.y0;
   gnx_ = g.nx;
   gny_ = g.ny;
-  if (const long k = particle_in_fe_cell(true); k >= 0) report_particle_in_fe_cell(k, true);
   std::vector<double> cell_vol(fe_cell_.size(), 0.0), cell_big(fe_cell_.size(), 0.0);
   const Particles& P = mpm_.p;
   for (std::size_t k = 0; k < P.size(); ++k) {
@@ -167,24 +166,28 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
       }
     }
 
-  // An FE node on an occupied MPM cell must be a grid node.
+  // An FE node on an occupied MPM cell, or within a cell of one, must be a grid node (the
+  // elements that touch the particles are grid cells, so their nodes and the next row's are).
   for (std::size_t e = 0; e < nfe; ++e) {
     if (grid_of_fe_[e] >= 0) continue;
     const double fx = (X[e] - g.x0) / h, fy = (Y[e] - g.y0) / h;
     const long i = static_cast<long>(std::floor(fx)), j = static_cast<long>(std::floor(fy));
-    for (long dj = -1; dj <= 0; ++dj)
-      for (long di = -1; di <= 0; ++di) {
-        const long ci = i + di, cj = j + dj;
-        if (ci < 0 || cj < 0 || ci >= g.nx || cj >= g.ny) continue;
-        // The node lies in the closed cell (ci, cj)?
-        if (fx < ci - 1e-6 || fx > ci + 1 + 1e-6 || fy < cj - 1e-6 || fy > cj + 1 + 1e-6) continue;
-        if (cell_vol[cj * g.nx + ci] > 0)
-          throw HybridError("hybrid: FE node " + std::to_string(e) + " at " + pt(X[e], Y[e]) +
-                            " lies on the MPM cell (" + std::to_string(ci) + ", " +
-                            std::to_string(cj) + ") but not on a grid node: the FE nodes on the "
-                            "interface must coincide with grid nodes (same spacing h = " +
-                            std::to_string(h) + " m, same origin)");
-      }
+    for (int near = 0; near <= 1; ++near)
+      for (long dj = -1 - near; dj <= near; ++dj)
+        for (long di = -1 - near; di <= near; ++di) {
+          const long ci = i + di, cj = j + dj;
+          if (ci < 0 || cj < 0 || ci >= g.nx || cj >= g.ny) continue;
+          // The node lies in the closed cell (ci, cj), or (near) within a cell of it?
+          const double r = near + 1e-6;
+          if (fx < ci - r || fx > ci + 1 + r || fy < cj - r || fy > cj + 1 + r) continue;
+          if (cell_vol[cj * g.nx + ci] > 0)
+            throw HybridError("hybrid: FE node " + std::to_string(e) + " at " + pt(X[e], Y[e]) +
+                              (near ? " lies within a cell of" : " lies on") + " the MPM cell (" +
+                              std::to_string(ci) + ", " + std::to_string(cj) +
+                              "), which holds particles, but not on a grid node: the FE nodes on "
+                              "the interface must coincide with grid nodes (same spacing h = " +
+                              std::to_string(h) + " m, same origin)");
+        }
   }
   // An FE cell touching the MPM region must be exactly one grid cell.
   for (std::size_t c = 0; c < ncell; ++c) {
@@ -198,6 +201,11 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
                           " m with nodes on grid nodes");
     }
   }
+
+  // After the mesh's alignment with the grid: on a grid whose origin is off the mesh's nodes the
+  // FE cells are marked on grid cells the particles' edge cells straddle, and the alignment is
+  // what is wrong.
+  if (const long k = particle_in_fe_cell(true); k >= 0) report_particle_in_fe_cell(k, true);
 
   // Shared nodes.
   const auto& mask = fe_.constraint_mask();

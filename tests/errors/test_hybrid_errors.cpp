@@ -10,13 +10,15 @@ using namespace smpm::hybrid_testing;
 
 namespace {
 
-// Particles on [0, 20h] x [0, 4h] (grid from -2h to 32h), no loads unless asked.
-std::unique_ptr<Solver> particles(double x1_cells = 20, double v0 = 0, bool top_load = false) {
+// Particles on [0, 20h] x [0, 4h] (grid from -2h to 32h), no loads unless asked; the grid moved
+// left and down by `shift` cells, `side` particles per cell side.
+std::unique_ptr<Solver> particles(double x1_cells = 20, double v0 = 0, bool top_load = false,
+                                  double shift = 0, int side = 1) {
   const double h = 1e-3, H = 4 * h;
   auto s = std::make_unique<Solver>();
   s->materials.push_back(smpm::testing::tungsten());
-  s->grid.init(-2 * h, 0.0, h, 34, 4);
-  s->seed_rectangle(0, 0, x1_cells * h, H, 1, 0, 0, v0, 0);
+  s->grid.init((-2 - shift) * h, -shift * h, h, 34, shift > 0 ? 5 : 4);
+  s->seed_rectangle(0, 0, x1_cells * h, H, side, 0, 0, v0, 0);
   if (top_load) {
     TractionLoad tl;
     tl.layer = s->select_layer("top", 0, x1_cells * h, H, 0, H, 0, 1, h);
@@ -97,6 +99,17 @@ TEST(HybridErrors, MeshOverlapsTheParticles) {
   auto f = elements(19e-3, 1e-3);
   const std::string e = error_of([&] { Hybrid hy(*s, *f); });
   EXPECT_NE(e.find("inside an FE cell at setup"), std::string::npos) << e;
+}
+
+// A grid whose origin is off the mesh's nodes (0.3 of a cell) is named as such, at 1 and 4 ppc,
+// not as particles inside the FE cells that the misaligned grid cells mark.
+TEST(HybridErrors, GridOriginOffTheMesh) {
+  for (int side : {1, 2}) {
+    auto s = particles(20, 0, false, 0.3, side);
+    auto f = elements(20e-3, 1e-3);
+    const std::string e = error_of([&] { Hybrid hy(*s, *f); });
+    EXPECT_NE(e.find("not on a grid node"), std::string::npos) << side << ": " << e;
+  }
 }
 
 TEST(HybridErrors, MeshDoesNotTouchTheParticles) {
