@@ -2958,7 +2958,9 @@ void Solver::check_health() {
       o << " has J = V/V0 = " << p.vol[k] / (p.mass[k] * inv_rho(p.group[k]));
     }
     o << " (" << n << " particle(s) with J < 0); the run is unstable or the deformation "
-         "too large for the grid (reduce time.cfl or time.dt, refine the grid)";
+         "too large for the grid (reduce time.cfl or time.dt, refine the grid";
+    if (opt.scheme == Scheme::USL) o << "; " << kUslSliverHint;
+    o << ")";
     throw std::runtime_error(o.str());
   }
   if (stretched > 0) {
