@@ -120,6 +120,25 @@ TEST(CaseLoad, UslWithWiderShapesGetsANote) {
   EXPECT_FALSE(has_note(smpm::load_case(file.string(), {"scheme.update=USL"})));
 }
 
+// Multi-field contact with bilinear shapes at 1 ppc gets a note (docs/physics.md section 4: a
+// contact face off the grid lines meets the other body through a sliver of its particles); at
+// 4 ppc, with GIMP or with a single field it does not.
+TEST(CaseLoad, MultiFieldContactAtOnePpcGetsANote) {
+  const fs::path file = write_file("valid_multi_note.json", kValid);
+  auto has_note = [](const smpm::Case& c) {
+    for (const std::string& n : c.notes)
+      if (n.find("note: contact.type \"multi\" with scheme.shape \"bilinear\"") != std::string::npos)
+        return true;
+    return false;
+  };
+  const std::string multi = "contact={\"type\": \"multi\"}", one = "bodies.0.particles_per_cell=1",
+                    wide = "boundaries.1.width=0.001";  // the top row at 1 ppc
+  EXPECT_TRUE(has_note(smpm::load_case(file.string(), {multi, one, wide})));
+  EXPECT_FALSE(has_note(smpm::load_case(file.string(), {multi})));  // 4 ppc
+  EXPECT_FALSE(has_note(smpm::load_case(file.string(), {multi, one, wide, "scheme.shape=gimp"})));
+  EXPECT_FALSE(has_note(smpm::load_case(file.string(), {one, wide})));
+}
+
 // A kelvin_voigt boundary is the silent layer with springs k = alpha rho c^2 / delta per particle.
 TEST(CaseLoad, KelvinVoigtBoundary) {
   const fs::path file = write_file("valid_kv.json", kValid);
