@@ -760,13 +760,13 @@ class Builder {
     if (s_->contact.multi() && s_->opt.shape == ShapeKind::Bilinear)
       for (const BodySpec& b : bodies_)
         if (b.ppc == 1) {
-          c.notes.push_back("note: contact.type \"multi\" with scheme.shape \"bilinear\" and body \"" +
-                            b.name + "\" at 1 particle per cell: where two bodies meet off the grid "
-                            "lines the contact acts through a sliver of one body's particles (the "
-                            "1D impact with its contact face 0.25 of a cell off a grid line: 0.82 of "
-                            "the pressure, rebound 0.43 of the closed form, 43 % of the energy lost; "
-                            "on a grid line within 1 %; docs/physics.md section 4); seed 4 particles "
-                            "per cell, or use scheme.shape \"gimp\"");
+          c.notes.push_back(
+              "note: contact.type \"multi\" with scheme.shape \"bilinear\" and body \"" + b.name +
+              "\" at 1 particle per cell: where two bodies meet off the grid lines the contact "
+              "acts through a sliver of one body's particles (the 1D impact with its contact face "
+              "0.25 of a cell off a grid line: 0.82 of the pressure, rebound 0.43 of the closed "
+              "form, 43 % of the energy lost; on a grid line within 1 %; docs/physics.md section "
+              "4); seed 4 particles per cell, or use scheme.shape \"gimp\"");
           break;
         }
     // The updated edge velocity was measured stable up to CFL 0.85 under MUSL, 0.9 under USF

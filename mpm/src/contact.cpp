@@ -77,7 +77,8 @@ double centroid_offset(ShapeKind k, double d, double l, double lp) {
 // body's nodal centroid behind it (units of h), particles of size l (units of h).
 double node_outside(ShapeKind k, double o, double l) {
   if (!(l > 0)) return o;
-  l = std::max(l, 1.0 / 64);  // finer layers than 64 per cell: the continuum's offset, in fewer terms
+  // Layers finer than 64 per cell: the continuum's offset already, in fewer terms.
+  l = std::max(l, 1.0 / 64);
   const double lp = std::min(0.5, 0.5 * l);
   const double R = support_1d(k, lp);
   double lo = -R, hi = R - 0.5 * l;  // the first layer at the support's end
