@@ -281,9 +281,10 @@ void Contact::correct(Solver& s, Field& vx, Field& vy, bool count) {
     const double NN = std::hypot(Nx, Ny);
     if (!(NN > 0)) continue;
     Nx /= NN; Ny /= NN;
-    // Which bodies touch h here: the gap along n between the nodal centroids of the two bodies'
-    // particles, less how far each one's centroid lies behind its surface (reach), must be
-    // closed. (Sharing a node only means the bodies are less than about a cell apart.)
+    // Which bodies touch h here: how far the node lies outside h's surface along n plus how far
+    // it lies outside the other body's along -n (each from that body's nodal centroid, through
+    // node_outside) is the gap, which must be closed. (Sharing a node only means the bodies are
+    // less than about a cell apart.)
     const double mh = m_[hb][i];
     const double xh = xm_[hb][i] / mh, yh = ym_[hb][i] / mh;
     const double xi = g.x0 + static_cast<double>(i % g.nnx) * g.h;

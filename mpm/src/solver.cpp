@@ -2924,6 +2924,9 @@ void Solver::check_health() {
   step_kinetic_ = 0;
   step_speed2_ = 0;
   auto where = [&](std::ostringstream& o) { o << "at step " << steps << " (t = " << t << " s)"; };
+  auto usl_hint = [&](std::ostringstream& o) {
+    if (opt.scheme == Scheme::USL) o << "; " << kUslSliverHint;
+  };
   auto particle = [&](std::ostringstream& o, std::size_t k) {
     o << "particle " << p.id[k] << " of body " << p.body[k] << " at (" << p.x[k] << ", " << p.y[k]
       << ")";
@@ -2940,7 +2943,7 @@ void Solver::check_health() {
     particle(o, k);
     o << " at |v| = " << v << " m/s, v dt = " << v * dt << " m > h = " << grid.h
       << " m; the run is unstable (reduce time.cfl or time.dt";
-    if (opt.scheme == Scheme::USL) o << "; " << kUslSliverHint;
+    usl_hint(o);
     o << ")";
     throw std::runtime_error(o.str());
   }
@@ -2959,7 +2962,7 @@ void Solver::check_health() {
     }
     o << " (" << n << " particle(s) with J < 0); the run is unstable or the deformation "
          "too large for the grid (reduce time.cfl or time.dt, refine the grid";
-    if (opt.scheme == Scheme::USL) o << "; " << kUslSliverHint;
+    usl_hint(o);
     o << ")";
     throw std::runtime_error(o.str());
   }
@@ -2995,7 +2998,7 @@ void Solver::check_health() {
         << ", external work " << energy.external_work << ") ";
       where(o);
       o << "; the run is unstable (reduce time.cfl or time.dt";
-      if (opt.scheme == Scheme::USL) o << "; " << kUslSliverHint;
+      usl_hint(o);
       if (pml.active()) o << "; " << kPmlGrowthHint;
       o << ")";
       throw std::runtime_error(o.str());
