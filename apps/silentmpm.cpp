@@ -240,7 +240,8 @@ int run_main(int argc, char** argv) {
                   static_cast<long>(std::ceil(c.t_end / s.dt - 1e-9)));
       const std::string mc = s.opt.mass_correction > 0
                                  ? ", mass correction " + std::to_string(s.opt.mass_correction) +
-                                       " term(s)"
+                                       " term(s)" +
+                                       (s.opt.mass_correction_symmetric ? " (symmetric)" : "")
                                  : "";
       std::printf("  scheme %s, shape %s, flip %g%s; %zu traction(s), %zu silent layer(s), "
                   "%zu constraint(s), %zu probe(s)\n", smpm::scheme_name(s.opt.scheme),

@@ -852,6 +852,10 @@ class Builder {
     o.allow({"type", "friction"});
     const std::string type = o.choice("type", {"single", "multi"}, "single");
     s_->contact.type = type == "multi" ? ContactType::Multi : ContactType::Single;
+    if (type == "multi" && s_->opt.mass_correction > 0 && s_->opt.mass_correction_symmetric)
+      o.fail("type", "multi-field contact corrects each body's field on its own, which "
+                     "scheme.mass_correction_form \"symmetric\" does not do yet; use "
+                     "\"increment\"");
     if (o.has("friction") && type != "multi")
       o.fail("friction", "friction needs \"type\": \"multi\" (a single velocity field has "
                          "no slip)");
@@ -864,7 +868,7 @@ class Builder {
   }
 
   void parse_scheme(Obj s) {
-    s.allow({"update", "flip", "threads", "shape", "mass_correction"});
+    s.allow({"update", "flip", "threads", "shape", "mass_correction", "mass_correction_form"});
     const std::string u = s.choice("update", {"USF", "USL", "MUSL"}, "MUSL");
     s_->opt.scheme = u == "USF" ? Scheme::USF : u == "USL" ? Scheme::USL : Scheme::MUSL;
     const std::string sh = s.choice("shape", {"bilinear", "gimp", "bspline"}, "bilinear");
@@ -881,6 +885,15 @@ class Builder {
     s.ge("mass_correction", static_cast<double>(mc), 0);
     s.le("mass_correction", static_cast<double>(mc), 8);
     s_->opt.mass_correction = static_cast<int>(mc);
+    // Its form: the series of R^-1 on the increment, or of R^-1/2 on the increment and on the
+    // strain's velocity, whose energy account closes as the lumped mass's does.
+    const std::string form = s.choice("mass_correction_form", {"increment", "symmetric"},
+                                      "increment");
+    s_->opt.mass_correction_symmetric = form == "symmetric";
+    if (form == "symmetric" && s_->opt.scheme == Scheme::USL)
+      s.fail("mass_correction_form", "\"symmetric\" needs scheme.update \"MUSL\" or \"USF\" "
+                                     "(USL strains the particles with v+ itself, which keeps "
+                                     "the lumped increment); use \"increment\" under USL");
     const long th = s.integer("threads", 0);
     s.ge("threads", static_cast<double>(th), 0);
     s.le("threads", static_cast<double>(th), 4096);
@@ -1509,6 +1522,12 @@ class Builder {
     // one; default) or the updated one the dashpots produced (USF: the last step's).
     const std::string edge_velocity =
         o.choice("edge_velocity", {"remapped", "updated", "delayed"}, "remapped");
+    if (edge_velocity != "remapped" && s_->opt.mass_correction > 0 &&
+        s_->opt.mass_correction_symmetric)
+      o.fail("edge_velocity", "\"" + edge_velocity + "\" is not available with "
+                              "scheme.mass_correction_form \"symmetric\" (whose strain velocity is "
+                              "the corrected re-mapped one); use \"remapped\" or the form "
+                              "\"increment\"");
     if (edge_velocity == "delayed") {
       auto need = [&](bool ok, const std::string& why) {
         if (!ok) o.fail("edge_velocity", "\"delayed\" " + why);

@@ -287,6 +287,8 @@ void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {
   j["shape"] = shape_name(s.opt.shape);
   j["flip"] = s.opt.flip;
   j["mass_correction"] = s.opt.mass_correction;
+  if (s.opt.mass_correction > 0)
+    j["mass_correction_form"] = s.opt.mass_correction_symmetric ? "symmetric" : "increment";
   j["grid"] = {{"origin", {s.grid.x0, s.grid.y0}}, {"cells", {s.grid.nx, s.grid.ny}}, {"cell", s.grid.h}};
 }
 

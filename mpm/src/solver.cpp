@@ -200,6 +200,10 @@ void Solver::finalize() {
   if (opt.mass_correction < 0 || opt.mass_correction > 8)
     throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
                                 std::to_string(opt.mass_correction));
+  if (symmetric() && opt.scheme == Scheme::USL)
+    throw std::invalid_argument("mass_correction: the symmetric form needs MUSL or USF");
+  if (symmetric() && contact.multi())
+    throw std::invalid_argument("mass_correction: the symmetric form with multi-field contact");
   for (const Material& m : materials)
     if (m.model == Model::J2Film && !p.has_film()) p.enable_film();
   nstrips_ = 2 * nthreads_;
@@ -991,7 +995,8 @@ void Solver::pml_loads() {
   }
   pml_shapes<S>();
   // USF strains the particles with the start-of-step velocity, before the forces.
-  if (opt.scheme == Scheme::USF) pml_advance<S>(grid.vx, grid.vy);
+  if (opt.scheme == Scheme::USF)
+    pml_advance<S>(symmetric() ? sym_vx_ : grid.vx, symmetric() ? sym_vy_ : grid.vy);
   constexpr int K = S::kNodes;
   const bool nodal = !pml_damps_particles();
   if (nodal) has_nodal_dashpot_ = true;
@@ -2093,6 +2098,7 @@ void Solver::consistent_dashpots() {
   double* oy = ox + nsp;
   // Each slot its own: in parallel, the same values.
   const long nsl = static_cast<long>(ns);
+  const bool sym = symmetric();
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nsl >= 256)
   for (long k = 0; k < nsl; ++k) {
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
@@ -2115,7 +2121,11 @@ void Solver::consistent_dashpots() {
     } else if (free_x != 0) {
       pxx = 1 / A;  // y held
     }
-    const double rx = r[kDnVx] + 0.5 * c[0] / mi, ry = r[kDnVy] + 0.5 * c[1] / mi;
+    // (The symmetric form: the corrected start velocity, the one the stress and the boundary
+    // work take; the increment's part through R, not R^-1/2 R R^-1/2.)
+    const double vx0 = sym ? sym_vx_[cm_nodes_[k]] : r[kDnVx];
+    const double vy0 = sym ? sym_vy_[cm_nodes_[k]] : r[kDnVy];
+    const double rx = vx0 + 0.5 * c[0] / mi, ry = vy0 + 0.5 * c[1] / mi;
     // A component the delayed closure holds keeps the mean of its start and its closure's
     // velocity (its Q row is zero: pxx = pxy = 0 there).
     n[0] = (fi & kDnHeldX) ? 0.5 * (r[kDnVx] + r[kDnUx]) : pxx * rx + pxy * ry;
@@ -2284,9 +2294,13 @@ void Solver::boundary_work(bool remapped) {
   // closure made of it (delay_strain_velocities); the power takes the particles' own, which the
   // kinetic energy follows, that value less the change.
   const bool strain_closed = remapped && !delay_slot_.empty() && opt.scheme == Scheme::MUSL;
+  // (The symmetric form: both ends of the step corrected, the particles' velocities as the
+  // corrected field sees them.)
+  const double* sx0 = symmetric() ? sym_vx_.data() : grid.vx.data();
+  const double* sy0 = symmetric() ? sym_vy_.data() : grid.vy.data();
   auto wbar = [&](long i, double& ax, double& ay) {  // the power's velocity
-    ax = 0.5 * (grid.vx[i] + ux[i]);
-    ay = 0.5 * (grid.vy[i] + uy[i]);
+    ax = 0.5 * (sx0[i] + ux[i]);
+    ay = 0.5 * (sy0[i] + uy[i]);
     if (strain_closed)
       if (const double* rec = delay_record(i)) {  // (the change is zero where it did not act)
         ax -= 0.5 * rec[kDelayDgx];
@@ -2337,7 +2351,7 @@ void Solver::boundary_work(bool remapped) {
     const long i0 = rows ? 0 : own_[0], i1 = rows ? grid.nnx - 1 : own_[1];
     const long nnx = grid.nnx;
     const double* m = grid.m.data() + n0;
-    const double* v0x = grid.vx.data() + n0; const double* v0y = grid.vy.data() + n0;
+    const double* v0x = sx0 + n0; const double* v0y = sy0 + n0;
     const double* wx = ux.data() + n0; const double* wy = uy.data() + n0;
     double w = 0;
     if (rows) {
@@ -2605,7 +2619,11 @@ void Solver::correct_field(const VelocityField& F, double* ex, double* ey) {
     ex = ux;
     ey = uy;
   }
+  // The series' coefficients: 1 (R^-1), or those of (1 - x)^-1/2 (the symmetric form).
+  const bool half = symmetric();
+  double c = 1;
   for (int term = 0; term < opt.mass_correction; ++term) {
+    if (half) c *= (2.0 * term + 1) / (2.0 * term + 2);
     scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int) {
       kernels::consistent_mass_product<S>(grid, p, b, e, inv_rho(g), tx, ty, ax, ay);
     });
@@ -2614,16 +2632,79 @@ void Solver::correct_field(const VelocityField& F, double* ex, double* ey) {
       dist_->sum_halo(sums, 2, nullptr);
     }
     call([&](StepHooks& h) { h.add_mass_product(*this, tx, ty, ax, ay); });
+    if (!half) {
+      field_nodes(F, [=](long i) {
+        const bool heavy = m[i] > floor;
+        tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
+        ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
+        ex[i] += tx[i];
+        ey[i] += ty[i];
+        ax[i] = 0;
+        ay[i] = 0;
+      });
+      continue;
+    }
     field_nodes(F, [=](long i) {
       const bool heavy = m[i] > floor;
       tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
       ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
-      ex[i] += tx[i];
-      ey[i] += ty[i];
+      ex[i] += c * tx[i];
+      ey[i] += c * ty[i];
       ax[i] = 0;
       ay[i] = 0;
     });
   }
+}
+
+// The symmetric form of the correction (docs/physics.md section 1.1): the series of R^-1/2 on u,
+// in place, over the grid's own field (one field: no multi-field contact, no hybrid).
+template <class S>
+void Solver::symmetric_velocity(double* ux, double* uy) {
+  const VelocityField& F = fields_[0];
+  const std::size_t n = grid.nodes();
+  for (auto* v : {&mc_tx_, &mc_ty_, &mc_ax_, &mc_ay_}) v->resize(n);
+  double* tx = mc_tx_.data(); double* ty = mc_ty_.data();
+  double* ax = mc_ax_.data(); double* ay = mc_ay_.data();
+  const double* m = F.f.m;
+  const uint8_t* fix = grid.fix.data();
+  const double floor = mass_floor_;
+  field_nodes(F, [=](long i) {
+    const bool heavy = m[i] > floor;
+    tx[i] = heavy && !(fix[i] & 1) ? ux[i] : 0.0;
+    ty[i] = heavy && !(fix[i] & 2) ? uy[i] : 0.0;
+    ax[i] = 0;
+    ay[i] = 0;
+  });
+  double c = 1;
+  for (int term = 0; term < opt.mass_correction; ++term) {
+    c *= (2.0 * term + 1) / (2.0 * term + 2);
+    scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int) {
+      kernels::consistent_mass_product<S>(grid, p, b, e, inv_rho(g), tx, ty, ax, ay);
+    });
+    if (dist_) {
+      double* const sums[2] = {ax, ay};
+      dist_->sum_halo(sums, 2, nullptr);
+    }
+    field_nodes(F, [=](long i) {
+      const bool heavy = m[i] > floor;
+      tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
+      ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
+      ux[i] += c * tx[i];
+      uy[i] += c * ty[i];
+      ax[i] = 0;
+      ay[i] = 0;
+    });
+  }
+}
+
+// The start velocity's symmetric correction, at the step's start positions: the velocity the
+// boundary work takes at the start of the step (with the re-mapped one's, corrected too, at its
+// end), and USF's strain velocity.
+template <class S>
+void Solver::symmetric_start_velocity() {
+  sym_vx_.assign(grid.vx.begin(), grid.vx.end());
+  sym_vy_.assign(grid.vy.begin(), grid.vy.end());
+  symmetric_velocity<S>(sym_vx_.data(), sym_vy_.data());
 }
 
 void Solver::correct_body_increments() {
@@ -2689,8 +2770,9 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
   if (move) begin_moving_pass();
   for (VelocityField& F : fields_) {
     const NodalField& f = F.f;
-    const double* gx = start_field ? f.vx : (remapped_field ? f.qx : f.vnx);
-    const double* gy = start_field ? f.vy : (remapped_field ? f.qy : f.vny);
+    const bool sym = start_field && symmetric();
+    const double* gx = sym ? sym_vx_.data() : start_field ? f.vx : (remapped_field ? f.qx : f.vnx);
+    const double* gy = sym ? sym_vy_.data() : start_field ? f.vy : (remapped_field ? f.qy : f.vny);
     std::vector<double> diss(nstrips_, 0.0);
     parallel(F.ranges, [&](uint32_t b, uint32_t e, int g, int s) {
       if (b == e) return;
@@ -2845,18 +2927,24 @@ void Solver::step_with() {
       kernels::nodal_velocity(grid, NodeBox{0, grid.nnx - 1, 0, grid.nny - 1}, grid.m.data(),
                               grid.fix.data(), grid.px.data(), grid.py.data(), grid.vx.data(),
                               grid.vy.data(), mass_floor_, nthreads_);
+    if (symmetric()) symmetric_start_velocity<S>();
     update_stress<S>(false, true, false);
     p2g<S>(kForce);
   }
   apply_loads<S>();
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
+  // (MUSL: the start velocity's symmetric correction, for the dashpots' solve and the boundary
+  // work; USF made it before its stress update.)
+  if (symmetric() && sc == Scheme::MUSL) symmetric_start_velocity<S>();
   if (consistent_) consistent_dashpots<S>();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
   // After every dashpot's update; multi-field contact corrects its bodies' fields itself,
   // before its contact correction (correct_body_increments).
   if (opt.mass_correction > 0 && !contact.multi()) correct_increments<S>();
-  bool remapped_power = sc == Scheme::MUSL || (sc == Scheme::USF && usf_remapped_power());
+  // (The symmetric form books every power with the corrected re-mapped velocity.)
+  bool remapped_power =
+      sc == Scheme::MUSL || (sc == Scheme::USF && (usf_remapped_power() || symmetric()));
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
   if (!remapped_power) boundary_work<S>(false);
   call([&](StepHooks& h) { h.before_g2p(*this); });
@@ -2866,6 +2954,8 @@ void Solver::step_with() {
       g2p<S>(true, false);
       if (pml.active()) pml_damping<S>(true);
       remapped_velocities(true);
+      if (symmetric()) symmetric_velocity<S>(grid.qx.data(), grid.qy.data());
+      sym_field_ = symmetric();
       if (remapped_power) boundary_work<S>(true);
       update_stress<S>(true, false, true);
       break;
@@ -2881,6 +2971,8 @@ void Solver::step_with() {
       if (pml.active()) pml_damping<S>(remapped_power);
       if (remapped_power) {
         remapped_velocities(false);
+        if (symmetric()) symmetric_velocity<S>(grid.qx.data(), grid.qy.data());
+        sym_field_ = symmetric();
         boundary_work<S>(true);
       }
       if (usf_edges()) keep_edge_velocities();
@@ -3137,6 +3229,10 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
       std::copy_n(&sums[28 * q + 4], 24, &acc[q].f[0][0]);
     }
   }
+  // The symmetric form of the mass correction: the particles carry R^1/2 of the velocity field
+  // its stresses follow; the probes read that field, the last step's corrected re-mapped
+  // velocity (docs/physics.md section 1.1).
+  const bool corrected = sym_field_;
   for (std::size_t q = 0; q < np; ++q) {
     const Acc& A = acc[q];
     double v[6] = {0, 0, 0, 0, 0, 0}, wsum = 0;
@@ -3150,6 +3246,19 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
     s.valid = true;
     s.sxx = v[0] / wsum; s.syy = v[1] / wsum; s.szz = v[2] / wsum; s.sxy = v[3] / wsum;
     s.vx = v[4] / wsum; s.vy = v[5] / wsum;
+    // (A probe of one body's particles, under multi-field contact, reads them: the symmetric
+    // form has one field.)
+    if (corrected && (bodies.empty() || bodies[q] < 0)) {  // the corrected field, same weights
+      double ux = 0, uy = 0;
+      for (int a = 0; a < 4; ++a) {
+        if (A.m[a] <= 0) continue;
+        const long nd = static_cast<long>(A.cj + A.sf.dj[a]) * grid.nnx + A.ci + A.sf.di[a];
+        ux += A.sf.N[a] * grid.qx[nd];
+        uy += A.sf.N[a] * grid.qy[nd];
+      }
+      s.vx = ux / wsum;
+      s.vy = uy / wsum;
+    }
     s.j2 = j2_of(s.sxx, s.syy, s.szz, s.sxy);
   }
   return out;

@@ -206,6 +206,10 @@ std::vector<double> receive_doubles(int from, MPI_Comm comm) {
 Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
     : d_(std::make_unique<Impl>()) {
   Impl& d = *d_;
+  // (The symmetric form's probes read the corrected nodal velocity of one window.)
+  if (s.opt.mass_correction > 0 && s.opt.mass_correction_symmetric)
+    throw std::runtime_error("scheme.mass_correction_form \"symmetric\" runs on one process; "
+                             "run without mpirun, or use \"increment\"");
   d.comm = comm;
   MPI_Comm_rank(comm, &d.rank);
   MPI_Comm_size(comm, &d.size);

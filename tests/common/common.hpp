@@ -44,6 +44,7 @@ struct ColumnSpec {
   bool updated_edge = false;  // MUSL: strain with the updated velocity at the end's dashpot nodes
   bool delayed_edge = false;  // MUSL, USF: the delayed closure at the end's dashpot nodes
   int mass_correction = 0;    // MUSL, USF: terms of the consistent-mass correction
+  bool symmetric = false;     // its symmetric form (R^-1/2 on the increment and the strain)
   Seeding seeding = Seeding::Uniform;  // the particles at the sub-cells' centres or Gauss points
 };
 
@@ -101,6 +102,7 @@ inline std::unique_ptr<Solver> make_column(const ColumnSpec& c) {
   s->opt.threads = c.threads;
   s->opt.gravity_x = c.gravity;
   s->opt.mass_correction = c.mass_correction;
+  s->opt.mass_correction_symmetric = c.symmetric;
   s->dt = c.cfl * c.h / s->materials[0].cd;
   s->finalize();
   return s;

@@ -393,6 +393,33 @@ std::vector<Bad> bad_cases() {
                       {"side", "bottom"}, {"delta", 0.01}};
        },
        "boundaries[2]: the kelvin_voigt edge \"base\" lies on particles of 1 per cell"},
+      // Its symmetric form: MUSL or USF, one velocity field, the edges' re-mapped velocity.
+      {"mass_correction_form_unknown",
+       [](ojson& j) { j["scheme"]["mass_correction_form"] = "half"; },
+       "scheme.mass_correction_form: must be one of \"increment\", \"symmetric\", got "
+       "\"half\""},
+      {"mass_correction_symmetric_under_usl",
+       [](ojson& j) {
+         j["scheme"]["update"] = "USL";
+         j["scheme"]["mass_correction_form"] = "symmetric";
+       },
+       "scheme.mass_correction_form: \"symmetric\" needs scheme.update \"MUSL\" or \"USF\""},
+      {"mass_correction_symmetric_multi_contact",
+       [](ojson& j) {
+         j["scheme"]["mass_correction"] = 2;
+         j["scheme"]["mass_correction_form"] = "symmetric";
+         j["contact"] = {{"type", "multi"}};
+       },
+       "contact.type: multi-field contact corrects each body's field on its own, which "
+       "scheme.mass_correction_form \"symmetric\" does not do yet; use \"increment\""},
+      {"mass_correction_symmetric_updated_edge",
+       [](ojson& j) {
+         j["scheme"]["mass_correction"] = 1;
+         j["scheme"]["mass_correction_form"] = "symmetric";
+         bnd(j, 2)["edge_velocity"] = "updated";
+       },
+       "boundaries[2].edge_velocity: \"updated\" is not available with "
+       "scheme.mass_correction_form \"symmetric\""},
       // Gauss seeding: a box of whole cells, point particles.
       {"seeding_unknown", [](ojson& j) { j["bodies"][0]["seeding"] = "gauss_legendre"; },
        "bodies[0].seeding: must be one of \"uniform\", \"gauss\", got \"gauss_legendre\""},

@@ -145,6 +145,17 @@ TEST(HybridErrors, MassCorrectionAtOneParticlePerCell) {
   EXPECT_NE(e.find(want), std::string::npos) << e;
 }
 
+// The correction's symmetric form: the far field's nodes take the increment form only.
+TEST(HybridErrors, SymmetricMassCorrection) {
+  auto s = particles();
+  auto f = elements(20e-3, 1e-3);
+  s->opt.mass_correction = 2;
+  s->opt.mass_correction_symmetric = true;
+  const std::string e = error_of([&] { Hybrid hy(*s, *f); });
+  EXPECT_NE(e.find("hybrid: scheme.mass_correction_form \"symmetric\" is not supported with an "
+                   "FEM region"), std::string::npos) << e;
+}
+
 TEST(HybridErrors, MpmLoadOnAnInterfaceNode) {
   auto s = particles(20, 0, true);
   auto f = elements(20e-3, 1e-3);

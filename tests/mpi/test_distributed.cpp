@@ -301,6 +301,22 @@ TEST(Ranks, MassCorrectionAgreesWithOneProcess) {
   }
 }
 
+// The correction's symmetric form runs on one process (its probes read the corrected nodal
+// velocity of one window): refused before the ranks split the grid.
+TEST(Ranks, SymmetricMassCorrectionIsRefused) {
+  PlateSpec c;
+  c.mass_correction = 1;
+  auto s = make_plate(c);
+  s->opt.mass_correction_symmetric = true;
+  try {
+    Distributed d(*s, MPI_COMM_WORLD, 1);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("\"symmetric\" runs on one process"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Ranks, WiderStencilsAgreeWithOneProcess) {
   for (ShapeKind sh : {ShapeKind::UGimp, ShapeKind::BSpline2}) {
     PlateSpec c;

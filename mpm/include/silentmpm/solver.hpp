@@ -10,6 +10,7 @@
 //   grid update    v+ = v + dt f / m (semi-implicit on nodes with a dashpot block), constraints;
 //                  a non-finite velocity stops the run here                -> after_grid_update
 //   [mass correction of the increment (opt.mass_correction)                 add_mass_product]
+//   [symmetric form: also the start velocity's, for the boundary work (USF: before the stress)]
 //   boundary work  work of tractions and gravity, energy absorbed by dashpots and bands
 //                                                                           -> before_g2p
 //   g2p            particle velocities (FLIP/PIC); MUSL re-maps the momenta -> after_remap
@@ -63,6 +64,10 @@ struct SolverOptions {
   // velocity field (correct_increments; docs/physics.md section 1.1). 0 keeps the lumped mass's
   // increment.
   int mass_correction = 0;
+  // Its form: false, the series of R^-1 on the increment; true, the symmetric form, the series
+  // of R^-1/2 on the increment and on the velocity that strains the particles (MUSL and USF;
+  // docs/physics.md section 1.1).
+  bool mass_correction_symmetric = false;
 };
 
 struct ProbeSample {
@@ -513,6 +518,17 @@ class Solver {
   // increment (docs/physics.md section 1.1). Held components and void nodes take none.
   template <class S> void correct_increments();
   template <class S> void correct_field(const VelocityField& F, double* ex, double* ey);
+  // The symmetric form (opt.mass_correction_symmetric): u <- sum_{j=0..k} c_j (I - R)^j u on the
+  // grid's own field, c_j the coefficients of (1 - x)^-1/2's series (1, 1/2, 3/8, ...); held
+  // components and void nodes take none. sym_vx_, sym_vy_: the start velocity so corrected, the
+  // velocity the boundary work takes at the step's start (USF: the one the stress takes).
+  template <class S> void symmetric_velocity(double* ux, double* uy);
+  template <class S> void symmetric_start_velocity();
+  std::vector<double> sym_vx_, sym_vy_;
+  // grid.qx, grid.qy hold the corrected re-mapped velocity of the last step (the probes' field;
+  // not after a restart until a step has been taken).
+  bool sym_field_ = false;
+  bool symmetric() const { return opt.mass_correction > 0 && opt.mass_correction_symmetric; }
   template <class Fn> void field_nodes(const VelocityField& F, Fn&& fn);
   std::vector<double> mc_tx_, mc_ty_, mc_ax_, mc_ay_;  // its term and product (per node)
   // USL: the correction's extra increment (per node, one block of nodes per field).
@@ -527,6 +543,7 @@ class Solver {
   // The re-mapped momenta summed over the halo, the hooks' share added (after_remap), made
   // velocities q / m; updated_edges: v+ at the updated layers' dashpot nodes (MUSL).
   void remapped_velocities(bool updated_edges);
+  // (start_field with the symmetric form: the corrected start velocity sym_vx_, sym_vy_.)
   template <class S> void update_stress(bool remapped_field, bool start_field, bool move);
   void begin_moving_pass();
   void merge_rows(int strip, const RowSpan& r);
