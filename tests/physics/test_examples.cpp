@@ -189,7 +189,7 @@ TEST(Examples, HalfSpacePmlAgainstTheExtendedDomain) {
 // 0.3 of a cell below and left of the body (a row of nodes beyond the top and right faces then
 // holds a sliver), MUSL and USF, bilinear and B-spline shapes. Measured, |imbalance| / work:
 // increment 6.0-6.3 % (bilinear) and 25 % (B-spline) on the grid, 21-22 % and 25 % off it;
-// symmetric 0.34-0.87 %, 0.50-0.85 % (no correction: 0.45-1.13 %). Bounds: symmetric within
+// symmetric 0.34-0.85 % and 0.23-0.87 % (no correction: 0.45-1.13 %). Bounds: symmetric within
 // 1.5 %, and at most a fifth of the increment form's. Then the PML half-space at the Gauss
 // points with two terms against FE at the same 2 mm cells (the probes read the corrected field):
 // symmetric 2.4-3.5 % at the surface and 0.8-1.2 % at depth (the increment form 2.6-3.7 % and
