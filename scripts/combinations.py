@@ -8,10 +8,12 @@ flagged all the same, with the scheme named), and a flagged run needs reading.
 
     scripts/combinations.py [--bin build/silentmpm] [--out DIR] [--cases column,pulse,...]
                             [--imbalance 0.01] [--threads 1] [--offset F]
+                            [--form increment|symmetric]
 
 --offset F moves every case's grid down and left by F of a cell (and grows it by one cell), so
 that the bodies' edges and faces lie off the grid lines: what a gmsh geometry gives. Cases whose
-edges must lie on grid lines are refused with their one line.
+edges must lie on grid lines are refused with their one line. --form sets the mass correction's
+form (scheme.mass_correction_form) of the runs with terms.
 
 Snapshots are switched off (a full sweep with them writes tens of gigabytes). About 13 minutes
 (432 runs) on 2 cores; `--cases` names a subset (see CASES below).
@@ -71,6 +73,7 @@ def main():
     ap.add_argument("--imbalance", type=float, default=0.01)
     ap.add_argument("--threads", default="1")
     ap.add_argument("--offset", type=float, default=0.0)
+    ap.add_argument("--form", choices=("increment", "symmetric"), default="increment")
     a = ap.parse_args()
     if not 0 <= a.offset < 1:
         sys.exit(f"combinations: --offset must lie in [0, 1), got {a.offset}")
@@ -97,6 +100,8 @@ def main():
             out = os.path.join(a.out, tag)
             sets = base + moved + [f"scheme.update={scheme}", f"scheme.shape={shape}",
                            f"scheme.mass_correction={terms}", "output.snapshots=0"]
+            if terms:
+                sets.append(f"scheme.mass_correction_form={a.form}")
             sets += [f"bodies.{i}.particles_per_cell={ppc}" for i in range(bodies)]
             cmd = [a.bin, "run", path, "--out", out, "--threads", a.threads, "--quiet"]
             for s in sets:
