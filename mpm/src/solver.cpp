@@ -2619,8 +2619,19 @@ void Solver::correct_field(const VelocityField& F, double* ex, double* ey) {
     ex = ux;
     ey = uy;
   }
-  // The series' coefficients: 1 (R^-1), or those of (1 - x)^-1/2 (the symmetric form).
-  const bool half = symmetric();
+  series_terms<S>(F, ex, ey, symmetric());
+}
+
+// The terms of the series on the field's nodes, from the term t = (mc_tx_, mc_ty_) each node
+// holds (its zeroth) into (ex, ey): t <- (I - R) t, then e += c_j t, with c_j = 1 (R^-1), or the
+// coefficients of (1 - x)^-1/2 (`half`: R^-1/2; multiplying by 1 changes no bit of the sum).
+template <class S>
+void Solver::series_terms(const VelocityField& F, double* ex, double* ey, bool half) {
+  double* tx = mc_tx_.data(); double* ty = mc_ty_.data();
+  double* ax = mc_ax_.data(); double* ay = mc_ay_.data();
+  const double* m = F.f.m;
+  const uint8_t* fix = grid.fix.data();
+  const double floor = mass_floor_;
   double c = 1;
   for (int term = 0; term < opt.mass_correction; ++term) {
     if (half) c *= (2.0 * term + 1) / (2.0 * term + 2);
@@ -2632,18 +2643,6 @@ void Solver::correct_field(const VelocityField& F, double* ex, double* ey) {
       dist_->sum_halo(sums, 2, nullptr);
     }
     call([&](StepHooks& h) { h.add_mass_product(*this, tx, ty, ax, ay); });
-    if (!half) {
-      field_nodes(F, [=](long i) {
-        const bool heavy = m[i] > floor;
-        tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
-        ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
-        ex[i] += tx[i];
-        ey[i] += ty[i];
-        ax[i] = 0;
-        ay[i] = 0;
-      });
-      continue;
-    }
     field_nodes(F, [=](long i) {
       const bool heavy = m[i] > floor;
       tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
@@ -2675,26 +2674,7 @@ void Solver::symmetric_velocity(double* ux, double* uy) {
     ax[i] = 0;
     ay[i] = 0;
   });
-  double c = 1;
-  for (int term = 0; term < opt.mass_correction; ++term) {
-    c *= (2.0 * term + 1) / (2.0 * term + 2);
-    scatter(F.ranges, [&](uint32_t b, uint32_t e, int g, int) {
-      kernels::consistent_mass_product<S>(grid, p, b, e, inv_rho(g), tx, ty, ax, ay);
-    });
-    if (dist_) {
-      double* const sums[2] = {ax, ay};
-      dist_->sum_halo(sums, 2, nullptr);
-    }
-    field_nodes(F, [=](long i) {
-      const bool heavy = m[i] > floor;
-      tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
-      ty[i] = heavy && !(fix[i] & 2) ? ty[i] - ay[i] / m[i] : 0.0;
-      ux[i] += c * tx[i];
-      uy[i] += c * ty[i];
-      ax[i] = 0;
-      ay[i] = 0;
-    });
-  }
+  series_terms<S>(F, ux, uy, true);
 }
 
 // The start velocity's symmetric correction, at the step's start positions: the velocity the

@@ -208,7 +208,8 @@ TEST(Examples, SymmetricMassCorrectionClosesTheAccount) {
   auto account = [](const smpm::History& h) {
     return std::abs(h.column("energy.imbalance").back()) / h.column("energy.external_work").back();
   };
-  const std::string moved = " --set 'grid.origin=[-0.0006,-0.0006]' --set 'grid.size=[0.202,0.104]'";
+  const std::string moved =
+      " --set 'grid.origin=[-0.0006,-0.0006]' --set 'grid.size=[0.202,0.104]'";
   for (const bool off : {false, true})
     for (const std::string scheme : {"MUSL", "USF"})
       for (const std::string shape : {"bilinear", "bspline"}) {
