@@ -11,6 +11,8 @@ the 80 us of the run:
   * FE, 2 mm and 1 mm;
   * MPM with the particles at the sub-cells' centres (the default), with one and two terms of
     scheme.mass_correction, and at the cells' Gauss points ("seeding": "gauss") with two terms;
+    two terms in the symmetric form (scheme.mass_correction_form), at the centres and the Gauss
+    points;
     each with 2 mm and 1 mm cells;
   * the hybrid examples/half-space-hybrid.json (particles in a 60 x 30 mm window under the load,
     the FE twin's elements around it), 2 mm cells: the default window, two terms of the
@@ -48,6 +50,11 @@ MPM_RUNS = {
     "corrected_2": (["scheme.mass_correction=2"], "MPM, mass correction 2"),
     "gauss_2": (["bodies.0.seeding=gauss", "scheme.mass_correction=2"],
                 "MPM, Gauss points, mass correction 2"),
+    "symmetric_2": (["scheme.mass_correction=2", "scheme.mass_correction_form=symmetric"],
+                    "MPM, mass correction 2, symmetric form"),
+    "gauss_symmetric_2": (["bodies.0.seeding=gauss", "scheme.mass_correction=2",
+                           "scheme.mass_correction_form=symmetric"],
+                          "MPM, Gauss points, mass correction 2, symmetric form"),
 }
 
 HYBRID_RUNS = {
