@@ -1185,7 +1185,9 @@ TEST(Shapes, LoadShareOnASliverNodeFollowsItsMass) {
     std::printf("%d terms: kinetic / elastic %.3f, |imbalance| / work %.2e\n", mc, ratio, imb);
     EXPECT_GT(s->energy.absorbed, 0.99 * s->energy.external_work);
     EXPECT_LT(ratio, mc ? 1.5 : 1.2) << mc << " terms";
-    if (mc) EXPECT_LT(imb, 2e-4);
+    if (mc) {
+      EXPECT_LT(imb, 2e-4);
+    }
   }
 }
 

@@ -518,11 +518,13 @@ class Solver {
   // increment (docs/physics.md section 1.1). Held components and void nodes take none.
   template <class S> void correct_increments();
   template <class S> void correct_field(const VelocityField& F, double* ex, double* ey);
+  // Both forms' terms from the zeroth in mc_tx_, mc_ty_ into (ex, ey); `half`: the symmetric
+  // form's coefficients.
+  template <class S> void series_terms(const VelocityField& F, double* ex, double* ey, bool half);
   // The symmetric form (opt.mass_correction_symmetric): u <- sum_{j=0..k} c_j (I - R)^j u on the
   // grid's own field, c_j the coefficients of (1 - x)^-1/2's series (1, 1/2, 3/8, ...); held
   // components and void nodes take none. sym_vx_, sym_vy_: the start velocity so corrected, the
   // velocity the boundary work takes at the step's start (USF: the one the stress takes).
-  template <class S> void series_terms(const VelocityField& F, double* ex, double* ey, bool half);
   template <class S> void symmetric_velocity(double* ux, double* uy);
   template <class S> void symmetric_start_velocity();
   std::vector<double> sym_vx_, sym_vy_;
