@@ -852,7 +852,7 @@ class Builder {
     o.allow({"type", "friction"});
     const std::string type = o.choice("type", {"single", "multi"}, "single");
     s_->contact.type = type == "multi" ? ContactType::Multi : ContactType::Single;
-    if (type == "multi" && s_->opt.mass_correction > 0 && s_->opt.mass_correction_symmetric)
+    if (type == "multi" && s_->symmetric_correction())
       o.fail("type", "multi-field contact corrects each body's field on its own, which "
                      "scheme.mass_correction_form \"symmetric\" does not do yet; use "
                      "\"increment\"");
@@ -1522,8 +1522,7 @@ class Builder {
     // one; default) or the updated one the dashpots produced (USF: the last step's).
     const std::string edge_velocity =
         o.choice("edge_velocity", {"remapped", "updated", "delayed"}, "remapped");
-    if (edge_velocity != "remapped" && s_->opt.mass_correction > 0 &&
-        s_->opt.mass_correction_symmetric)
+    if (edge_velocity != "remapped" && s_->symmetric_correction())
       o.fail("edge_velocity", "\"" + edge_velocity + "\" is not available with "
                               "scheme.mass_correction_form \"symmetric\" (whose strain velocity is "
                               "the corrected re-mapped one); use \"remapped\" or the form "

@@ -472,7 +472,7 @@ void Hybrid::distribute(Decomposition& d) {
 // The mass correction needs 2 or more particles per cell side next to the interface, and its
 // increment form (checked at set-up and at every step, for a correction turned on later).
 void Hybrid::check_mass_correction(const Solver& S) const {
-  if (S.opt.mass_correction > 0 && S.opt.mass_correction_symmetric)
+  if (S.symmetric_correction())
     throw HybridError("scheme.mass_correction_form",
                       "\"symmetric\" is not supported with an FEM region (the far field's "
                       "nodes take the increment's form only); use \"increment\"");

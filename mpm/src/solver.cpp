@@ -200,9 +200,9 @@ void Solver::finalize() {
   if (opt.mass_correction < 0 || opt.mass_correction > 8)
     throw std::invalid_argument("mass_correction: terms must be 0 to 8, got " +
                                 std::to_string(opt.mass_correction));
-  if (symmetric() && opt.scheme == Scheme::USL)
+  if (symmetric_correction() && opt.scheme == Scheme::USL)
     throw std::invalid_argument("mass_correction: the symmetric form needs MUSL or USF");
-  if (symmetric() && contact.multi())
+  if (symmetric_correction() && contact.multi())
     throw std::invalid_argument("mass_correction: the symmetric form with multi-field contact");
   for (const Material& m : materials)
     if (m.model == Model::J2Film && !p.has_film()) p.enable_film();
@@ -995,8 +995,10 @@ void Solver::pml_loads() {
   }
   pml_shapes<S>();
   // USF strains the particles with the start-of-step velocity, before the forces.
-  if (opt.scheme == Scheme::USF)
-    pml_advance<S>(symmetric() ? sym_vx_ : grid.vx, symmetric() ? sym_vy_ : grid.vy);
+  if (opt.scheme == Scheme::USF) {
+    const bool sym = symmetric_correction();
+    pml_advance<S>(sym ? sym_vx_ : grid.vx, sym ? sym_vy_ : grid.vy);
+  }
   constexpr int K = S::kNodes;
   const bool nodal = !pml_damps_particles();
   if (nodal) has_nodal_dashpot_ = true;
@@ -2098,7 +2100,7 @@ void Solver::consistent_dashpots() {
   double* oy = ox + nsp;
   // Each slot its own: in parallel, the same values.
   const long nsl = static_cast<long>(ns);
-  const bool sym = symmetric();
+  const bool sym = symmetric_correction();
 #pragma omp parallel for schedule(static) num_threads(nthreads_) if (nsl >= 256)
   for (long k = 0; k < nsl; ++k) {
     const double* r = dn_rec_.data() + kDn * cm_dk_[k];
@@ -2296,8 +2298,8 @@ void Solver::boundary_work(bool remapped) {
   const bool strain_closed = remapped && !delay_slot_.empty() && opt.scheme == Scheme::MUSL;
   // (The symmetric form: both ends of the step corrected, the particles' velocities as the
   // corrected field sees them.)
-  const double* sx0 = symmetric() ? sym_vx_.data() : grid.vx.data();
-  const double* sy0 = symmetric() ? sym_vy_.data() : grid.vy.data();
+  const double* sx0 = symmetric_correction() ? sym_vx_.data() : grid.vx.data();
+  const double* sy0 = symmetric_correction() ? sym_vy_.data() : grid.vy.data();
   auto wbar = [&](long i, double& ax, double& ay) {  // the power's velocity
     ax = 0.5 * (sx0[i] + ux[i]);
     ay = 0.5 * (sy0[i] + uy[i]);
@@ -2619,7 +2621,7 @@ void Solver::correct_field(const VelocityField& F, double* ex, double* ey) {
     ex = ux;
     ey = uy;
   }
-  series_terms<S>(F, ex, ey, symmetric());
+  series_terms<S>(F, ex, ey, symmetric_correction());
 }
 
 // The terms of the series on the field's nodes, from the term t = (mc_tx_, mc_ty_) each node
@@ -2750,7 +2752,7 @@ void Solver::update_stress(bool remapped_field, bool start_field, bool move) {
   if (move) begin_moving_pass();
   for (VelocityField& F : fields_) {
     const NodalField& f = F.f;
-    const bool sym = start_field && symmetric();
+    const bool sym = start_field && symmetric_correction();
     const double* gx = sym ? sym_vx_.data() : start_field ? f.vx : (remapped_field ? f.qx : f.vnx);
     const double* gy = sym ? sym_vy_.data() : start_field ? f.vy : (remapped_field ? f.qy : f.vny);
     std::vector<double> diss(nstrips_, 0.0);
@@ -2907,7 +2909,7 @@ void Solver::step_with() {
       kernels::nodal_velocity(grid, NodeBox{0, grid.nnx - 1, 0, grid.nny - 1}, grid.m.data(),
                               grid.fix.data(), grid.px.data(), grid.py.data(), grid.vx.data(),
                               grid.vy.data(), mass_floor_, nthreads_);
-    if (symmetric()) symmetric_start_velocity<S>();
+    if (symmetric_correction()) symmetric_start_velocity<S>();
     update_stress<S>(false, true, false);
     p2g<S>(kForce);
   }
@@ -2916,7 +2918,7 @@ void Solver::step_with() {
   grid_update();
   // (MUSL: the start velocity's symmetric correction, for the dashpots' solve and the boundary
   // work; USF made it before its stress update.)
-  if (symmetric() && sc == Scheme::MUSL) symmetric_start_velocity<S>();
+  if (symmetric_correction() && sc == Scheme::MUSL) symmetric_start_velocity<S>();
   if (consistent_) consistent_dashpots<S>();
   call([&](StepHooks& h) { h.after_grid_update(*this); });
   // After every dashpot's update; multi-field contact corrects its bodies' fields itself,
@@ -2924,7 +2926,7 @@ void Solver::step_with() {
   if (opt.mass_correction > 0 && !contact.multi()) correct_increments<S>();
   // (The symmetric form books every power with the corrected re-mapped velocity.)
   bool remapped_power =
-      sc == Scheme::MUSL || (sc == Scheme::USF && (usf_remapped_power() || symmetric()));
+      sc == Scheme::MUSL || (sc == Scheme::USF && (usf_remapped_power() || symmetric_correction()));
   call([&](StepHooks& h) { remapped_power = remapped_power && h.remapped_power(); });
   if (!remapped_power) boundary_work<S>(false);
   call([&](StepHooks& h) { h.before_g2p(*this); });
@@ -2934,8 +2936,8 @@ void Solver::step_with() {
       g2p<S>(true, false);
       if (pml.active()) pml_damping<S>(true);
       remapped_velocities(true);
-      if (symmetric()) symmetric_velocity<S>(grid.qx.data(), grid.qy.data());
-      sym_field_ = symmetric();
+      if (symmetric_correction()) symmetric_velocity<S>(grid.qx.data(), grid.qy.data());
+      sym_field_ = symmetric_correction();
       if (remapped_power) boundary_work<S>(true);
       update_stress<S>(true, false, true);
       break;
@@ -2951,8 +2953,8 @@ void Solver::step_with() {
       if (pml.active()) pml_damping<S>(remapped_power);
       if (remapped_power) {
         remapped_velocities(false);
-        if (symmetric()) symmetric_velocity<S>(grid.qx.data(), grid.qy.data());
-        sym_field_ = symmetric();
+        if (symmetric_correction()) symmetric_velocity<S>(grid.qx.data(), grid.qy.data());
+        sym_field_ = symmetric_correction();
         boundary_work<S>(true);
       }
       if (usf_edges()) keep_edge_velocities();
@@ -3212,7 +3214,6 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
   // The symmetric form of the mass correction: the particles carry R^1/2 of the velocity field
   // its stresses follow; the probes read that field, the last step's corrected re-mapped
   // velocity (docs/physics.md section 1.1).
-  const bool corrected = sym_field_;
   for (std::size_t q = 0; q < np; ++q) {
     const Acc& A = acc[q];
     double v[6] = {0, 0, 0, 0, 0, 0}, wsum = 0;
@@ -3228,7 +3229,7 @@ std::vector<ProbeSample> Solver::sample(const std::vector<std::array<double, 2>>
     s.vx = v[4] / wsum; s.vy = v[5] / wsum;
     // (A probe of one body's particles, under multi-field contact, reads them: the symmetric
     // form has one field.)
-    if (corrected && (bodies.empty() || bodies[q] < 0)) {  // the corrected field, same weights
+    if (sym_field_ && (bodies.empty() || bodies[q] < 0)) {  // the corrected field, same weights
       double ux = 0, uy = 0;
       for (int a = 0; a < 4; ++a) {
         if (A.m[a] <= 0) continue;

@@ -207,7 +207,7 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
     : d_(std::make_unique<Impl>()) {
   Impl& d = *d_;
   // (The symmetric form's probes read the corrected nodal velocity of one window.)
-  if (s.opt.mass_correction > 0 && s.opt.mass_correction_symmetric)
+  if (s.symmetric_correction())
     throw std::runtime_error("scheme.mass_correction_form \"symmetric\" runs on one process; "
                              "run without mpirun, or use \"increment\"");
   d.comm = comm;

@@ -248,6 +248,11 @@ class Solver {
   void sort_particles();
   // The energy account over every rank (this rank's own without a decomposition).
   Energies total_energy() const;
+  // Whether the mass correction acts in its symmetric form (opt.mass_correction_symmetric, with
+  // terms).
+  bool symmetric_correction() const {
+    return opt.mass_correction > 0 && opt.mass_correction_symmetric;
+  }
   // Whether node i of this solver's grid is this rank's own (every node without a decomposition).
   bool owns_node(long i) const {
     if (own_[1] < own_[0]) return true;
@@ -531,7 +536,6 @@ class Solver {
   // grid.qx, grid.qy hold the corrected re-mapped velocity of the last step (the probes' field;
   // not after a restart until a step has been taken).
   bool sym_field_ = false;
-  bool symmetric() const { return opt.mass_correction > 0 && opt.mass_correction_symmetric; }
   template <class Fn> void field_nodes(const VelocityField& F, Fn&& fn);
   std::vector<double> mc_tx_, mc_ty_, mc_ax_, mc_ay_;  // its term and product (per node)
   // USL: the correction's extra increment (per node, one block of nodes per field).
