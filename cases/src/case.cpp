@@ -856,6 +856,9 @@ class Builder {
       o.fail("type", "multi-field contact corrects each body's field on its own, which "
                      "scheme.mass_correction_form \"symmetric\" does not do yet; use "
                      "\"increment\"");
+    if (type == "multi" && s_->opt.light_node_ratio > 0)
+      o.fail("type", "multi-field contact keeps each body's own field, which "
+                     "scheme.light_nodes \"extend\" does not extend yet; use \"keep\"");
     if (o.has("friction") && type != "multi")
       o.fail("friction", "friction needs \"type\": \"multi\" (a single velocity field has "
                          "no slip)");
@@ -868,7 +871,8 @@ class Builder {
   }
 
   void parse_scheme(Obj s) {
-    s.allow({"update", "flip", "threads", "shape", "mass_correction", "mass_correction_form"});
+    s.allow({"update", "flip", "threads", "shape", "mass_correction", "mass_correction_form",
+             "light_nodes", "light_node_ratio"});
     const std::string u = s.choice("update", {"USF", "USL", "MUSL"}, "MUSL");
     s_->opt.scheme = u == "USF" ? Scheme::USF : u == "USL" ? Scheme::USL : Scheme::MUSL;
     const std::string sh = s.choice("shape", {"bilinear", "gimp", "bspline"}, "bilinear");
@@ -894,6 +898,15 @@ class Builder {
       s.fail("mass_correction_form", "\"symmetric\" needs scheme.update \"MUSL\" or \"USF\" "
                                      "(USL strains the particles with v+ itself, which keeps "
                                      "the lumped increment); use \"increment\" under USL");
+    // Light nodes beyond a body's faces: their own velocity, or the heavy nodes' extended to
+    // them (docs/physics.md section 8.7).
+    const std::string ln = s.choice("light_nodes", {"keep", "extend"}, "keep");
+    if (s.has("light_node_ratio") && ln != "extend")
+      s.fail("light_node_ratio", "needs \"light_nodes\": \"extend\"");
+    const double lr = s.num("light_node_ratio", 0.15);
+    s.gt("light_node_ratio", lr, 0);
+    s.le("light_node_ratio", lr, 0.25);
+    s_->opt.light_node_ratio = ln == "extend" ? lr : 0.0;
     const long th = s.integer("threads", 0);
     s.ge("threads", static_cast<double>(th), 0);
     s.le("threads", static_cast<double>(th), 4096);

@@ -289,6 +289,9 @@ void put_mpm_scheme(nlohmann::ordered_json& j, const Solver& s) {
   j["mass_correction"] = s.opt.mass_correction;
   if (s.opt.mass_correction > 0)
     j["mass_correction_form"] = s.opt.mass_correction_symmetric ? "symmetric" : "increment";
+  if (s.opt.light_node_ratio > 0)  // the light nodes' extension, and how many the last step had
+    j["light_nodes"] = {{"ratio", s.opt.light_node_ratio},
+                        {"extended", s.light_nodes.count()}};
   j["grid"] = {{"origin", {s.grid.x0, s.grid.y0}}, {"cells", {s.grid.nx, s.grid.ny}}, {"cell", s.grid.h}};
 }
 

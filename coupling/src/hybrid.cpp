@@ -274,6 +274,10 @@ Hybrid::Hybrid(Solver& mpm, fem::Solver& fe) : mpm_(mpm), fe_(fe) {
       }
     }
   check_mass_correction(mpm_);
+  if (mpm_.opt.light_node_ratio > 0)
+    throw HybridError("scheme.light_nodes",
+                      "\"extend\" is not supported with an FEM region (the window's edge "
+                      "nodes are the far field's); use \"keep\"");
 
   // No MPM traction on an interface node.
   {

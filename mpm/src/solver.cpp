@@ -204,6 +204,11 @@ void Solver::finalize() {
     throw std::invalid_argument("mass_correction: the symmetric form needs MUSL or USF");
   if (symmetric_correction() && contact.multi())
     throw std::invalid_argument("mass_correction: the symmetric form with multi-field contact");
+  if (opt.light_node_ratio < 0 || opt.light_node_ratio > 0.25)
+    throw std::invalid_argument("light_node_ratio: must be 0 (off) or in (0, 0.25], got " +
+                                std::to_string(opt.light_node_ratio));
+  if (opt.light_node_ratio > 0 && contact.multi())
+    throw std::invalid_argument("light_nodes: the extension with multi-field contact");
   for (const Material& m : materials)
     if (m.model == Model::J2Film && !p.has_film()) p.enable_film();
   nstrips_ = 2 * nthreads_;
@@ -212,6 +217,7 @@ void Solver::finalize() {
   double mmin = std::numeric_limits<double>::infinity();
   for (double m : p.mass) mmin = std::min(mmin, m);
   mass_floor_ = p.size() ? opt.mass_tolerance * mmin : 0.0;
+  light_nodes.ratio = opt.light_node_ratio;
   std::fill(grid.fix.begin(), grid.fix.end(), 0);
   for (const auto& c : constraints)
     for (uint32_t n : c.nodes) grid.fix[n] |= c.mask;
@@ -866,17 +872,25 @@ void Solver::remapped_velocities(bool updated_edges) {
     dist_->sum_halo(q.data(), static_cast<int>(q.size()), nullptr);
   }
   call([&](StepHooks& h) { h.after_remap(*this); });
+  if (light_nodes.active()) {
+    light_nodes.fold(grid.qx.data());
+    light_nodes.fold(grid.qy.data());
+  }
   for (const VelocityField& F : fields_)
     kernels::nodal_velocity(grid, F.box, F.f.m, grid.fix.data(), F.f.qx, F.f.qy, F.f.qx, F.f.qy,
                             mass_floor_, nthreads_);
   if (updated_edges && !delay_rho_.empty())
     delay_strain_velocities(grid.qx.data(), grid.qy.data(), true);
-  if (!updated_edges || updated_weight_.empty()) return;
-  for (const long i : dashpot_nodes_) {
-    if (takes_updated(i, updated_weight_[i])) {
-      grid.qx[i] = grid.vnx[i];
-      grid.qy[i] = grid.vny[i];
+  if (updated_edges && !updated_weight_.empty())
+    for (const long i : dashpot_nodes_) {
+      if (takes_updated(i, updated_weight_[i])) {
+        grid.qx[i] = grid.vnx[i];
+        grid.qy[i] = grid.vny[i];
+      }
     }
+  if (light_nodes.active()) {
+    light_nodes.extend(grid.qx.data());
+    light_nodes.extend(grid.qy.data());
   }
 }
 
@@ -2645,6 +2659,7 @@ void Solver::series_terms(const VelocityField& F, double* ex, double* ey, bool h
       dist_->sum_halo(sums, 2, nullptr);
     }
     call([&](StepHooks& h) { h.add_mass_product(*this, tx, ty, ax, ay); });
+    if (light_nodes.active()) light_nodes.fold_product(m, fix, floor, tx, ty, ax, ay);
     field_nodes(F, [=](long i) {
       const bool heavy = m[i] > floor;
       tx[i] = heavy && !(fix[i] & 1) ? tx[i] - ax[i] / m[i] : 0.0;
@@ -2899,6 +2914,7 @@ void Solver::step_with() {
   // Split over ranks: the shared nodes' masses and momenta are summed before anything reads them
   // (the boundary layers' weights read the nodal mass); their forces once the loads are in.
   if (dist_) sum_halo(true, false);
+  if (light_nodes.active()) light_nodes.classify_and_fold(grid, mass_floor_, layer_nodes<S>());
   call([&](StepHooks& h) { h.after_momentum(*this); });
   if (sc == Scheme::USF) {
     start_velocities();
@@ -2909,17 +2925,28 @@ void Solver::step_with() {
       kernels::nodal_velocity(grid, NodeBox{0, grid.nnx - 1, 0, grid.nny - 1}, grid.m.data(),
                               grid.fix.data(), grid.px.data(), grid.py.data(), grid.vx.data(),
                               grid.vy.data(), mass_floor_, nthreads_);
+    if (light_nodes.active()) {
+      light_nodes.extend(grid.vx.data());
+      light_nodes.extend(grid.vy.data());
+    }
     if (symmetric_correction()) symmetric_start_velocity<S>();
     update_stress<S>(false, true, false);
     p2g<S>(kForce);
   }
   apply_loads<S>();
+  if (light_nodes.active())
+    light_nodes.fold_forces(grid, gravity_in_update() ? 0.0 : opt.gravity_x,
+                            gravity_in_update() ? 0.0 : opt.gravity_y);
   call([&](StepHooks& h) { h.after_forces(*this); });
   grid_update();
+  if (light_nodes.active()) extend_updated(true);
   // (MUSL: the start velocity's symmetric correction, for the dashpots' solve and the boundary
   // work; USF made it before its stress update.)
   if (symmetric_correction() && sc == Scheme::MUSL) symmetric_start_velocity<S>();
-  if (consistent_) consistent_dashpots<S>();
+  if (consistent_) {
+    consistent_dashpots<S>();
+    if (light_nodes.active()) extend_updated(false);
+  }
   call([&](StepHooks& h) { h.after_grid_update(*this); });
   // After every dashpot's update; multi-field contact corrects its bodies' fields itself,
   // before its contact correction (correct_body_increments).
@@ -2967,6 +2994,33 @@ void Solver::step_with() {
   if (dist_ && dist_->migrate(*this)) sort_particles();
   call([&](StepHooks& h) { h.end_of_step(*this); });
   if (store_mode() < 0) time_stores(omp_get_wtime() - start);
+}
+
+// The nodes the silent and Kelvin-Voigt layers' and the damping bands' entries weigh this step
+// (apply_loads gives them dashpot blocks, and the light nodes' extension leaves them alone).
+template <class S>
+const std::vector<char>& Solver::layer_nodes() {
+  layer_mask_.assign(grid.nodes(), 0);
+  const auto none = [](long) { return false; };
+  auto mark = [&](const BoundaryLayer& L, Anchor anchor) {
+    layer_weights<S>(L, anchor, mask_nodes_, mask_N_, none);
+    for (std::size_t e = 0; e < mask_nodes_.size(); ++e)
+      if (mask_N_[e] != 0) layer_mask_[mask_nodes_[e]] = 1;
+  };
+  for (const auto& sl : silents) mark(sl.layer, sl.anchor);
+  for (const auto& dl : dampers) mark(dl.layer, Anchor::Particle);
+  return layer_mask_;
+}
+
+// The light nodes' velocities extended from the heavy nodes' (light_nodes.hpp): the start
+// velocity too when `start`.
+void Solver::extend_updated(bool start) {
+  if (start) {
+    light_nodes.extend(grid.vx.data());
+    light_nodes.extend(grid.vy.data());
+  }
+  light_nodes.extend(grid.vnx.data());
+  light_nodes.extend(grid.vny.data());
 }
 
 // Health checks at the end of a step, from reductions the step's own passes made (no extra pass

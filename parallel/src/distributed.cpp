@@ -210,6 +210,10 @@ Distributed::Distributed(Solver& s, MPI_Comm comm, int across, bool scatter)
   if (s.symmetric_correction())
     throw std::runtime_error("scheme.mass_correction_form \"symmetric\" runs on one process; "
                              "run without mpirun, or use \"increment\"");
+  // (A light node and the nodes its extension reads may lie in two windows.)
+  if (s.opt.light_node_ratio > 0)
+    throw std::runtime_error("scheme.light_nodes \"extend\" runs on one process; "
+                             "run without mpirun, or use \"keep\"");
   d.comm = comm;
   MPI_Comm_rank(comm, &d.rank);
   MPI_Comm_size(comm, &d.size);

@@ -38,6 +38,7 @@
 #include "silentmpm/energies.hpp"
 #include "silentmpm/grid.hpp"
 #include "silentmpm/kernels.hpp"
+#include "silentmpm/light_nodes.hpp"
 #include "silentmpm/material.hpp"
 #include "silentmpm/particles.hpp"
 #include "silentmpm/shape.hpp"
@@ -68,6 +69,10 @@ struct SolverOptions {
   // of R^-1/2 on the increment and on the velocity that strains the particles (MUSL and USF;
   // docs/physics.md section 1.1).
   bool mass_correction_symmetric = false;
+  // Light nodes (light_nodes.hpp): 0 keeps every node's own velocity; a ratio in (0, 0.5]
+  // extends the velocity of the heavy nodes to a node that much lighter than them at a body's
+  // edge (docs/physics.md section 8.7).
+  double light_node_ratio = 0;
 };
 
 struct ProbeSample {
@@ -111,6 +116,7 @@ class Solver {
   long steps = 0;
   Energies energy;
   Contact contact;  // contact of bodies: single velocity field (default) or one per body
+  LightNodes light_nodes;  // the light nodes' extension (opt.light_node_ratio)
 
   // --- setup -------------------------------------------------------------------------------
   // A rank's skeleton (several MPI ranks; docs/parallel.md "Set-up"): seeding counts the
@@ -556,6 +562,11 @@ class Solver {
   void merge_rows(int strip, const RowSpan& r);
   void check_outside();
   [[noreturn]] void fail_nonfinite() const;
+  template <class S> const std::vector<char>& layer_nodes();
+  std::vector<char> layer_mask_;       // layer_nodes: the mask and its scratch
+  std::vector<long> mask_nodes_;
+  std::vector<double> mask_N_;
+  void extend_updated(bool start);  // the light nodes' v+ (and v) from the heavy ones'
   void check_health();
   long outside_ = -1;  // index of a particle that left the grid in the last pass
   bool has_springs_ = false;  // a silent boundary carries Kelvin-Voigt springs (finalize)
