@@ -243,9 +243,12 @@ int run_main(int argc, char** argv) {
                                        " term(s)" +
                                        (s.opt.mass_correction_symmetric ? " (symmetric)" : "")
                                  : "";
-      std::printf("  scheme %s, shape %s, flip %g%s; %zu traction(s), %zu silent layer(s), "
+      char ln[64] = "";
+      if (s.opt.light_node_ratio > 0)
+        std::snprintf(ln, sizeof ln, ", light nodes extended (ratio %g)", s.opt.light_node_ratio);
+      std::printf("  scheme %s, shape %s, flip %g%s%s; %zu traction(s), %zu silent layer(s), "
                   "%zu constraint(s), %zu probe(s)\n", smpm::scheme_name(s.opt.scheme),
-                  smpm::shape_name(s.opt.shape), s.opt.flip, mc.c_str(), s.tractions.size(),
+                  smpm::shape_name(s.opt.shape), s.opt.flip, mc.c_str(), ln, s.tractions.size(),
                   s.silents.size(), s.constraints.size(), c.probes.size());
       for (const auto& n : c.notes) std::printf("  %s\n", n.c_str());
       return 0;

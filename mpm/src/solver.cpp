@@ -2914,7 +2914,8 @@ void Solver::step_with() {
   // Split over ranks: the shared nodes' masses and momenta are summed before anything reads them
   // (the boundary layers' weights read the nodal mass); their forces once the loads are in.
   if (dist_) sum_halo(true, false);
-  if (light_nodes.active()) light_nodes.classify_and_fold(grid, mass_floor_, layer_nodes<S>());
+  if (light_nodes.active() && light_nodes.candidates(grid, mass_floor_))
+    light_nodes.classify_and_fold(grid, layer_nodes<S>());
   call([&](StepHooks& h) { h.after_momentum(*this); });
   if (sc == Scheme::USF) {
     start_velocities();

@@ -420,6 +420,31 @@ std::vector<Bad> bad_cases() {
        },
        "boundaries[2].edge_velocity: \"updated\" is not available with "
        "scheme.mass_correction_form \"symmetric\""},
+      // Light nodes: "keep" or "extend", a ratio in (0, 0.25] with "extend", one velocity field.
+      {"light_nodes_unknown", [](ojson& j) { j["scheme"]["light_nodes"] = "merge"; },
+       "scheme.light_nodes: must be one of \"keep\", \"extend\", got \"merge\""},
+      {"light_node_ratio_without_extend",
+       [](ojson& j) { j["scheme"]["light_node_ratio"] = 0.1; },
+       "scheme.light_node_ratio: needs \"light_nodes\": \"extend\""},
+      {"light_node_ratio_too_large",
+       [](ojson& j) {
+         j["scheme"]["light_nodes"] = "extend";
+         j["scheme"]["light_node_ratio"] = 0.3;
+       },
+       "scheme.light_node_ratio: must be <= 0.25, got 0.3"},
+      {"light_node_ratio_zero",
+       [](ojson& j) {
+         j["scheme"]["light_nodes"] = "extend";
+         j["scheme"]["light_node_ratio"] = 0;
+       },
+       "scheme.light_node_ratio: must be > 0, got 0"},
+      {"light_nodes_multi_contact",
+       [](ojson& j) {
+         j["scheme"]["light_nodes"] = "extend";
+         j["contact"] = {{"type", "multi"}};
+       },
+       "contact.type: multi-field contact keeps each body's own field, which "
+       "scheme.light_nodes \"extend\" does not extend yet; use \"keep\""},
       // Gauss seeding: a box of whole cells, point particles.
       {"seeding_unknown", [](ojson& j) { j["bodies"][0]["seeding"] = "gauss_legendre"; },
        "bodies[0].seeding: must be one of \"uniform\", \"gauss\", got \"gauss_legendre\""},

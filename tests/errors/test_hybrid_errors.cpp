@@ -156,6 +156,16 @@ TEST(HybridErrors, SymmetricMassCorrection) {
                    "FEM region"), std::string::npos) << e;
 }
 
+// The light nodes' extension: the window's edge nodes are the far field's.
+TEST(HybridErrors, LightNodes) {
+  auto s = particles();
+  auto f = elements(20e-3, 1e-3);
+  s->opt.light_node_ratio = 0.15;
+  const std::string e = error_of([&] { Hybrid hy(*s, *f); });
+  EXPECT_NE(e.find("hybrid: scheme.light_nodes \"extend\" is not supported with an FEM region"),
+            std::string::npos) << e;
+}
+
 TEST(HybridErrors, MpmLoadOnAnInterfaceNode) {
   auto s = particles(20, 0, true);
   auto f = elements(20e-3, 1e-3);

@@ -317,6 +317,21 @@ TEST(Ranks, SymmetricMassCorrectionIsRefused) {
   }
 }
 
+// The light nodes' extension runs on one process (a light node and the nodes it reads may lie
+// in two windows): refused before the ranks split the grid.
+TEST(Ranks, LightNodesAreRefused) {
+  PlateSpec c;
+  auto s = make_plate(c);
+  s->opt.light_node_ratio = 0.15;
+  try {
+    Distributed d(*s, MPI_COMM_WORLD, 1);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("\"extend\" runs on one process"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Ranks, WiderStencilsAgreeWithOneProcess) {
   for (ShapeKind sh : {ShapeKind::UGimp, ShapeKind::BSpline2}) {
     PlateSpec c;

@@ -207,6 +207,8 @@ TEST(MpiCli, RefusesWhatRanksCannotShareYet) {
       {kCase + kShort + " --set bodies.0.particles_per_cell=4 --set scheme.mass_correction=1"
                         " --set scheme.mass_correction_form=symmetric",
        "scheme.mass_correction_form \"symmetric\" runs on one process"},
+      {kCase + kShort + " --set scheme.light_nodes=extend",
+       "scheme.light_nodes \"extend\" runs on one process"},
       {kFem + " --set fem.size=0.04", "FEM: fewer cells (1) than MPI ranks (2)"},
       // The far field is set up from rank 0: its checks are rank 0's, and every rank's error.
       {kFem + " --set probes.1.at=[0.5,0.5]", "outside the FEM mesh"},

@@ -364,6 +364,42 @@ TEST(SilentStability, SymmetricMassCorrectionLongRunsDecay) {
   mass_correction_squares(true, 0.2);
 }
 
+// The squares with the grid 0.3 of a cell below them (their top particles 0.05 h past a grid
+// line) and the light nodes extended (scheme.light_nodes "extend"; docs/physics.md section
+// 8.7), MUSL and USF at CFL 0.9 to 15 ms (50 000 steps). Measured (as above): three sides, MUSL
+// 5.6e-5, 4.7e-5, 3.6e-8 (kept: 7.1e-5, 5.9e-5, 7.7e-8); USF 6.8e-5, 6.8e-5, 4.1e-8 (7.0e-5,
+// 5.5e-5, 7.2e-8); two sides, MUSL 1.3e-4, 1.5e-4, 1.2e-5 (1.4e-4, 1.5e-4, 1.3e-5); the accounts
+// 1.5e-5, 3.2e-6, 1.9e-5. Bounds: later at most 1.5 times the level at 2 ms; at 15 ms below
+// 2e-3 of it (three sides) or a fifth (two); the account within 1e-4.
+TEST(SilentStability, LightNodesLongRunsDecay) {
+  const fs::path out = fs::temp_directory_path() / ("smpm_lnsq_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  auto replaced = [](std::string c, const std::string& from, const std::string& to) {
+    const std::size_t at = c.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? c : c.replace(at, from.size(), to);
+  };
+  struct Variant {
+    const char* scheme;
+    bool two_sides;
+  };
+  for (const Variant v : {Variant{"MUSL", false}, Variant{"USF", false}, Variant{"MUSL", true}}) {
+    std::string c = square(v.scheme, "", 4, 0.9, v.two_sides, 0.015);
+    c = replaced(c, R"("origin": [0, 0], "size": [0.04, 0.042])",
+                 R"("origin": [0, -0.0006], "size": [0.04, 0.044])");
+    c = replaced(c, R"("threads": 1,)", R"("threads": 1, "light_nodes": "extend",)");
+    const EnergyLeft r = square_run(c, out / (std::string(v.scheme) + (v.two_sides ? "2" : "3")));
+    std::printf("  [%s, light nodes extended, %s sides] at 2 ms %.2e, largest later %.2e, at 15 "
+                "ms %.2e; imbalance %.1e\n", v.scheme, v.two_sides ? "two" : "three", r.at_ref,
+                r.later_max, r.last, r.imbalance);
+    EXPECT_LE(r.later_max, 1.5 * r.at_ref) << v.scheme << " " << v.two_sides;
+    EXPECT_LE(r.last, (v.two_sides ? 0.2 : 2e-3) * r.at_ref) << v.scheme << " " << v.two_sides;
+    EXPECT_LE(std::abs(r.imbalance), 1e-4) << v.scheme << " " << v.two_sides;
+  }
+  fs::remove_all(out);
+}
+
 // The smallest body where the lumped trapezoidal mean grew: a steel strip of 20 x 2 cells (1 ppc),
 // LK on its ends, its long sides free, a line load on the top. The step's linearised map (the
 // particles' velocities and stresses, positions held) had its largest eigenvalue at 1 + 1.1e-3

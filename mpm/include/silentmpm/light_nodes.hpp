@@ -21,9 +21,12 @@ class LightNodes {
   bool active() const { return ratio > 0; }
   std::size_t count() const { return links_.size(); }  // light nodes this step
 
-  // After the momentum p2g: find the light nodes (none where `layer` is set: the nodes the
-  // boundary layers weigh); their masses and momenta to the heavy nodes.
-  void classify_and_fold(Grid& g, double floor, const std::vector<char>& layer);
+  // After the momentum p2g: the nodes that may be light (heavier than the void's `floor`, at
+  // most `ratio` times the heaviest, unconstrained); false, and no light node, when none is.
+  bool candidates(const Grid& g, double floor);
+  // Then the light nodes among them (none where `layer` is set: the nodes the boundary layers
+  // weigh); their masses and momenta to the heavy nodes.
+  void classify_and_fold(Grid& g, const std::vector<char>& layer);
   // The loads are in: their forces, less gravity's share (gx, gy: the gravity that acted on
   // every node's own mass, the heavy nodes' already including the light nodes').
   void fold_forces(Grid& g, double gx, double gy) const;
@@ -43,7 +46,8 @@ class LightNodes {
     double w[4] = {0, 0, 0, 0};
   };
   std::vector<Link> links_;
-  std::vector<char> light_;
+  std::vector<long> cand_;
+  std::vector<char> light_, keep_;
 };
 
 }  // namespace smpm
