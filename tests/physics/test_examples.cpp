@@ -48,6 +48,23 @@ double mean_over(const smpm::History& h, const std::vector<double>& v, double t0
   return n ? s / n : NAN;
 }
 
+// `silentmpm run` of the source file `file` into out / dir, quiet and without snapshots, with
+// the overrides `set`: its history. A failed run fails the test with its error output (kept as
+// <prefix><dir>.err).
+smpm::History run_example(const fs::path& out, const std::string& prefix, const std::string& file,
+                          const std::string& dir, const std::string& set) {
+  const std::string tag = prefix + dir;
+  EXPECT_EQ(cli("run \"" + source_file(file) + "\" --out \"" + (out / dir).string() + "\"" +
+                    " -q --set output.snapshots=0" + set, tag), 0)
+      << read_file(scratch() / (tag + ".err"));
+  return smpm::read_history((out / dir / "history.csv").string());
+}
+
+// The energy account at the end of a run: |imbalance| over the external work.
+double account_of(const smpm::History& h) {
+  return std::abs(h.column("energy.imbalance").back()) / h.column("energy.external_work").back();
+}
+
 TEST(Examples, EveryGalleryCasePassesCheck) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const std::vector<std::string> cases = {
@@ -124,13 +141,8 @@ TEST(Examples, HalfSpaceEnergyBalanceCloses) {
 TEST(Examples, HalfSpacePmlAgainstTheExtendedDomain) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path out = scratch() / "example_half_space_pml";
-  const std::string lean = " -q --set output.snapshots=0";
   auto run_case = [&](const std::string& file, const std::string& dir, const std::string& set) {
-    const std::string tag = "hs_" + dir;
-    EXPECT_EQ(cli("run \"" + source_file(file) + "\" --out \"" + (out / dir).string() + "\"" +
-                      lean + set, tag), 0)
-        << read_file(scratch() / (tag + ".err"));
-    return smpm::read_history((out / dir / "history.csv").string());
+    return run_example(out, "hs_", file, dir, set);
   };
   const std::string lk_pulse = " --set time.end=8e-5 --set boundaries.0.time.duration=1.2e-5"
                                " --set boundaries.0.time.ramp=6e-6";
@@ -199,15 +211,9 @@ TEST(Examples, SymmetricMassCorrectionClosesTheAccount) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path out = scratch() / "example_symmetric_correction";
   auto run_case = [&](const std::string& file, const std::string& dir, const std::string& set) {
-    const std::string tag = "sym_" + dir;
-    EXPECT_EQ(cli("run \"" + source_file(file) + "\" --out \"" + (out / dir).string() + "\"" +
-                      " -q --set output.snapshots=0 --set scheme.mass_correction=2" + set, tag), 0)
-        << read_file(scratch() / (tag + ".err"));
-    return smpm::read_history((out / dir / "history.csv").string());
+    return run_example(out, "sym_", file, dir, " --set scheme.mass_correction=2" + set);
   };
-  auto account = [](const smpm::History& h) {
-    return std::abs(h.column("energy.imbalance").back()) / h.column("energy.external_work").back();
-  };
+  const auto account = account_of;
   const std::string moved =
       " --set 'grid.origin=[-0.0006,-0.0006]' --set 'grid.size=[0.202,0.104]'";
   for (const bool off : {false, true})
@@ -255,16 +261,9 @@ TEST(Examples, LightNodesStopTheSurfaceRinging) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path out = scratch() / "example_light_nodes";
   auto run_case = [&](const std::string& file, const std::string& dir, const std::string& set) {
-    const std::string tag = "light_" + dir;
-    EXPECT_EQ(cli("run \"" + source_file(file) + "\" --out \"" + (out / dir).string() + "\"" +
-                      " -q --set output.snapshots=0" + set, tag), 0)
-        << read_file(scratch() / (tag + ".err"));
-    return smpm::read_history((out / dir / "history.csv").string());
+    return run_example(out, "light_", file, dir, set);
   };
-  auto account = [](const smpm::History& h) {
-    return std::abs(h.column("energy.imbalance").back()) /
-           h.column("energy.external_work").back();
-  };
+  const auto account = account_of;
   auto late = [](const smpm::History& h) {  // rms of S20.vy over 40-80 us
     const std::vector<double>& v = h.column("S20.vy");
     double s = 0;
@@ -387,11 +386,7 @@ TEST(Examples, HalfSpaceHybridFollowsTheFarField) {
   if (!have_cli()) GTEST_SKIP() << "CLI binary not built: " << SMPM_CLI;
   const fs::path out = scratch() / "example_half_space_hybrid";
   auto run_case = [&](const std::string& file, const std::string& dir, const std::string& set) {
-    const std::string tag = "hsh_" + dir;
-    EXPECT_EQ(cli("run \"" + source_file(file) + "\" --out \"" + (out / dir).string() + "\"" +
-                      " -q --set output.snapshots=0" + set, tag), 0)
-        << read_file(scratch() / (tag + ".err"));
-    return smpm::read_history((out / dir / "history.csv").string());
+    return run_example(out, "hsh_", file, dir, set);
   };
   const smpm::History plain = run_case("examples/half-space-hybrid.json", "plain", "");
   const smpm::History gauss = run_case("examples/half-space-hybrid.json", "gauss",
