@@ -4,6 +4,8 @@
 //
 //   reset grid
 //   p2g            masses, momenta (USL, MUSL: and internal forces)         -> after_momentum
+//   [light nodes: found, their masses and momenta onto the heavy nodes (light_nodes.hpp); each
+//    velocity below extended to them, each force and re-mapped momentum folded likewise]
 //   [USF: nodal velocities, stress update, p2g of the internal forces]
 //   loads          tractions, silent-layer dashpots and Kelvin-Voigt springs of boundary
 //                  particles, damping bands, gravity                       -> after_forces
@@ -69,9 +71,9 @@ struct SolverOptions {
   // of R^-1/2 on the increment and on the velocity that strains the particles (MUSL and USF;
   // docs/physics.md section 1.1).
   bool mass_correction_symmetric = false;
-  // Light nodes (light_nodes.hpp): 0 keeps every node's own velocity; a ratio in (0, 0.5]
-  // extends the velocity of the heavy nodes to a node that much lighter than them at a body's
-  // edge (docs/physics.md section 8.7).
+  // Light nodes (light_nodes.hpp): 0 keeps every node's own velocity; a ratio in (0, 0.25]
+  // extends the velocity of the heavy nodes to a node that much lighter than them beyond a
+  // body's face (docs/physics.md section 8.7).
   double light_node_ratio = 0;
 };
 
