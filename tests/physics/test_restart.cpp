@@ -116,6 +116,24 @@ TEST(Restart, MpmPmlBitIdentical) {
   }
 }
 
+// Light nodes (scheme.light_nodes "extend", with two terms of the mass correction): found again
+// every step from the masses, no state of their own. examples/half-space-pml.json with the grid
+// 0.3 of a cell below its body, whose top node row is light.
+TEST(Restart, MpmLightNodesBitIdentical) {
+  json c = json::parse(read_file(fs::path(SMPM_SOURCE_DIR) / "examples" / "half-space-pml.json"));
+  c["grid"]["origin"] = {0, -0.0006};
+  c["grid"]["size"] = {0.2, 0.104};
+  c["scheme"]["light_nodes"] = "extend";
+  c["scheme"]["mass_correction"] = 2;
+  c["time"]["end"] = 3e-5;
+  c["output"]["snapshots"] = 0;
+  const long from = expect_restart_identical("mpm_light_nodes", c, "checkpoint_every", 100);
+  EXPECT_EQ(from, 100);
+  const json summary = json::parse(read_file(scratch() / "restart_mpm_light_nodes_b" /
+                                             "summary.json"));
+  EXPECT_NE(summary.dump().find("\"extended\":97"), std::string::npos) << summary.dump();
+}
+
 TEST(Restart, MpmMultiFieldContactWithFrictionBitIdentical) {
   json c = contact_testing::impact_case();
   c["scheme"]["update"] = "USL";
