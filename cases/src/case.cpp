@@ -714,6 +714,7 @@ class Builder {
 
     if (!skeleton_) note_particles_on_grid_lines(c);
     s_->finalize();
+    if (!skeleton_) note_light_nodes(c);
     // A point probe must see particles (of its body, when it names one): else it would record
     // zeros all run. (Points along a curve are checked against their bodies when placed.)
     for (std::size_t q = 0; q < c.probes.size() && !skeleton_; ++q) {
@@ -1141,6 +1142,19 @@ class Builder {
                           " particles lie on grid lines, where bilinear shape functions are "
                           "degenerate (docs/physics.md section 4): shift the body by a fraction "
                           "of a cell, or use scheme.shape \"gimp\" or \"bspline\"");
+  }
+
+  // A bilinear body whose face lies just past a grid line leaves the node row beyond it a sliver
+  // of mass, whose soft mode rings (docs/physics.md section 8.7). With scheme.light_nodes "keep"
+  // a note counts the nodes the default extension would take at the start.
+  void note_light_nodes(Case& c) const {
+    if (s_->opt.light_node_ratio > 0) return;
+    const std::size_t n = s_->light_nodes_at_start(0.15);
+    if (n > 0)
+      c.notes.push_back("note: " + std::to_string(n) + " grid nodes beyond the bodies' faces "
+                        "hold a sliver of their particles (a face just past a grid line), whose "
+                        "surface layer rings there (docs/physics.md section 8.7): "
+                        "scheme.light_nodes \"extend\" takes them out");
   }
 
   void seed() {

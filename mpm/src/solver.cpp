@@ -3013,6 +3013,39 @@ const std::vector<char>& Solver::layer_nodes() {
   return layer_mask_;
 }
 
+std::size_t Solver::light_nodes_at_start(double ratio) {
+  const std::size_t n = grid.nodes();
+  if (opt.shape != ShapeKind::Bilinear || contact.multi() || p.size() == 0 || dist_ ||
+      grid.m.size() != n || grid.px.size() != n || grid.py.size() != n)
+    return 0;
+  auto clear = [&] {
+    std::fill(grid.m.begin(), grid.m.end(), 0.0);
+    std::fill(grid.px.begin(), grid.px.end(), 0.0);
+    std::fill(grid.py.begin(), grid.py.end(), 0.0);
+  };
+  clear();
+  for (std::size_t k = 0; k < p.size(); ++k) {  // the lumped masses, m_i = sum_p m_p N_i(x_p)
+    const double fx = (p.x[k] - grid.x0) * grid.inv_h, fy = (p.y[k] - grid.y0) * grid.inv_h;
+    const long i = static_cast<long>(std::floor(fx)), j = static_cast<long>(std::floor(fy));
+    if (i < 0 || j < 0 || i >= grid.nx || j >= grid.ny) continue;
+    const double rx = fx - i, ry = fy - j, m = p.mass[k];
+    const long q = j * grid.nnx + i;
+    grid.m[q] += m * (1 - rx) * (1 - ry);
+    grid.m[q + 1] += m * rx * (1 - ry);
+    grid.m[q + grid.nnx] += m * (1 - rx) * ry;
+    grid.m[q + grid.nnx + 1] += m * rx * ry;
+  }
+  LightNodes found;
+  found.ratio = ratio;
+  std::size_t count = 0;
+  if (found.candidates(grid, mass_floor_)) {
+    found.classify_and_fold(grid, layer_nodes<Bilinear>());
+    count = found.count();
+  }
+  clear();
+  return count;
+}
+
 // The light nodes' velocities extended from the heavy nodes' (light_nodes.hpp): the start
 // velocity too when `start`.
 void Solver::extend_updated(bool start) {

@@ -307,6 +307,14 @@ TEST(Examples, LightNodesStopTheSurfaceRinging) {
   EXPECT_LE(account(ext2), 0.3 * account(kept2));
   const std::string summary = read_file(out / "extended" / "summary.json");
   EXPECT_NE(summary.find("\"extended\": 97"), std::string::npos) << summary;  // the top row
+  // `check` with the default "keep" counts them in a note (at the start: 99); none on the lines.
+  ASSERT_EQ(cli("check \"" + source_file(pml) + "\"" + below, "light_check"), 0);
+  EXPECT_NE(read_file(scratch() / "light_check.out").find("note: 99 grid nodes beyond the "
+                                                          "bodies' faces hold a sliver"),
+            std::string::npos) << read_file(scratch() / "light_check.out");
+  ASSERT_EQ(cli("check \"" + source_file(pml) + "\"", "light_check_lines"), 0);
+  EXPECT_EQ(read_file(scratch() / "light_check_lines.out").find("grid nodes beyond"),
+            std::string::npos);
   // On the grid lines: nothing to extend.
   run_case(pml, "on_lines", "");
   run_case(pml, "on_lines_extended", extend);

@@ -222,6 +222,10 @@ class Solver {
   static constexpr int kCmMaxIterations = 200;
   // Nodes lighter than this are void (opt.mass_tolerance times the lightest particle).
   double mass_floor() const { return mass_floor_; }
+  // The light nodes an extension with `ratio` would take from the particles as they lie now, the
+  // nodes the boundary layers weigh left out (bilinear shapes, one velocity field, after
+  // finalize; 0 otherwise): for the case's note. The grid's arrays are left cleared.
+  std::size_t light_nodes_at_start(double ratio);
   // Cell rows the particles occupied after the last step that moved them (lo > hi: none).
   void occupied_rows(long& lo, long& hi) const;
   // Shape functions (S: Bilinear, UGimp, BSpline2) of boundary particle q of layer L at its
