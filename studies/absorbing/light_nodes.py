@@ -17,7 +17,6 @@ Writes OUTDIR/light_nodes/metrics.json and OUTDIR/light_nodes/light_nodes.png (t
 """
 import json
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -28,36 +27,11 @@ import style  # noqa: E402
 
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.abspath(os.path.join(here, "..", ".."))
-BIN = os.environ.get("SILENTMPM", os.path.join(ROOT, "build", "silentmpm"))
-MPM = os.path.join(ROOT, "examples", "half-space-pml.json")
-FEM = os.path.join(ROOT, "examples", "half-space-fem-pml.json")
+from half_space import FEM, MPM, T_END, relative_l2, run  # noqa: E402
+
 CELL = 0.002
 OFFSETS = [0.0, 0.1, 0.2, 0.3, 0.35, 0.4, 0.45, 0.5]
 RECEIVERS = ["S20.vy", "S50.vy"]
-T_END = 8e-5
-
-
-def history(path):
-    with open(os.path.join(path, "history.csv")) as f:
-        head = f.readline().strip().split(",")
-        data = np.loadtxt(f, delimiter=",")
-    return {k: data[:, i] for i, k in enumerate(head)}
-
-
-def run(case, overrides, out):
-    cmd = [BIN, "run", case, "--out", out, "--quiet", "--set", "output.snapshots=0"]
-    for o in overrides:
-        cmd += ["--set", o]
-    subprocess.run(cmd, check=True)
-    return history(out)
-
-
-def relative_l2(a, ref, col):
-    t = a["time"]
-    keep = t <= T_END * (1 + 1e-9)
-    b = np.interp(t[keep], ref["time"], ref[col])
-    return float(np.sqrt(np.sum((a[col][keep] - b) ** 2) / np.sum(b ** 2)))
 
 
 def late_level(h):
