@@ -904,7 +904,7 @@ class Builder {
     const std::string ln = s.choice("light_nodes", {"keep", "extend"}, "keep");
     if (s.has("light_node_ratio") && ln != "extend")
       s.fail("light_node_ratio", "needs \"light_nodes\": \"extend\"");
-    const double lr = s.num("light_node_ratio", 0.15);
+    const double lr = s.num("light_node_ratio", LightNodes::kDefaultRatio);
     s.gt("light_node_ratio", lr, 0);
     s.le("light_node_ratio", lr, 0.25);
     s_->opt.light_node_ratio = ln == "extend" ? lr : 0.0;
@@ -1149,7 +1149,7 @@ class Builder {
   // a note counts the nodes the default extension would take at the start.
   void note_light_nodes(Case& c) const {
     if (s_->opt.light_node_ratio > 0) return;
-    const std::size_t n = s_->light_nodes_at_start(0.15);
+    const std::size_t n = s_->light_nodes_at_start(LightNodes::kDefaultRatio);
     if (n > 0)
       c.notes.push_back("note: " + std::to_string(n) + " grid nodes beyond the bodies' faces "
                         "hold a sliver of their particles (a face just past a grid line), whose "

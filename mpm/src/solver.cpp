@@ -3024,16 +3024,12 @@ std::size_t Solver::light_nodes_at_start(double ratio) {
     std::fill(grid.py.begin(), grid.py.end(), 0.0);
   };
   clear();
+  Bilinear sf;
   for (std::size_t k = 0; k < p.size(); ++k) {  // the lumped masses, m_i = sum_p m_p N_i(x_p)
-    const double fx = (p.x[k] - grid.x0) * grid.inv_h, fy = (p.y[k] - grid.y0) * grid.inv_h;
-    const long i = static_cast<long>(std::floor(fx)), j = static_cast<long>(std::floor(fy));
-    if (i < 0 || j < 0 || i >= grid.nx || j >= grid.ny) continue;
-    const double rx = fx - i, ry = fy - j, m = p.mass[k];
-    const long q = j * grid.nnx + i;
-    grid.m[q] += m * (1 - rx) * (1 - ry);
-    grid.m[q + 1] += m * rx * (1 - ry);
-    grid.m[q + grid.nnx] += m * (1 - rx) * ry;
-    grid.m[q + grid.nnx + 1] += m * rx * ry;
+    sf.eval(grid, p.x[k], p.y[k]);
+    if (sf.ci < 0 || sf.cj < 0 || sf.ci >= grid.nx || sf.cj >= grid.ny) continue;
+    for (int a = 0; a < Bilinear::kNodes; ++a)
+      grid.m[(sf.cj + sf.dj[a]) * grid.nnx + sf.ci + sf.di[a]] += p.mass[k] * sf.N[a];
   }
   LightNodes found;
   found.ratio = ratio;

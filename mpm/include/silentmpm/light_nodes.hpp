@@ -18,6 +18,7 @@ class LightNodes {
   // A node is light when it is at most `ratio` times as heavy as every node its extension
   // reads (and the body ends beyond it); 0 turns the extension off.
   double ratio = 0;
+  static constexpr double kDefaultRatio = 0.15;  // the case key's default
   bool active() const { return ratio > 0; }
   std::size_t count() const { return links_.size(); }  // light nodes this step
 
